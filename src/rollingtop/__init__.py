@@ -1,0 +1,50 @@
+"""rollingtop: dynamics of rolling spherical tops under nonholonomic constraints.
+
+Implements A. A. Kilin, T. B. Ivanova, "The Integrable Problem of the Rolling Motion of a
+Dynamically Symmetric Spherical Top with One Nonholonomic Constraint", Russian Journal of
+Nonlinear Dynamics 19(1), 2023, 3-17 (doi:10.20537/nd221205), and its neighbour contact models.
+"""
+
+from rollingtop._errors import (
+    BodyError,
+    ContactLostWarning,
+    ContactModelError,
+    InitialStateError,
+    IntegrationError,
+    OutputError,
+    RollingTopError,
+    ScenarioError,
+)
+from rollingtop.body import SphericalTop
+from rollingtop.contact import MODELS, ContactModel, get_model
+from rollingtop.dynamics.integrals import INTEGRALS
+from rollingtop.dynamics.state import initial_state
+from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario, load_scenario
+from rollingtop.simulate import simulate
+from rollingtop.trajectory import Trajectory
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "BodyError",
+    "ContactLostWarning",
+    "ContactModel",
+    "ContactModelError",
+    "INTEGRALS",
+    "InitialConditions",
+    "InitialStateError",
+    "IntegrationError",
+    "IntegrationOptions",
+    "MODELS",
+    "OutputError",
+    "RollingTopError",
+    "Scenario",
+    "ScenarioError",
+    "SphericalTop",
+    "Trajectory",
+    "__version__",
+    "get_model",
+    "initial_state",
+    "load_scenario",
+    "simulate",
+]

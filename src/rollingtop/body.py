@@ -1,0 +1,136 @@
+"""The spherical top: parameters, validation and derived quantities.
+
+Notation of Kilin & Ivanova (2023), Sec. 2 (see also ``MODEL.md``, "Body and frames"): a sphere of
+radius ``R`` and mass ``m`` whose centre of mass lies on the symmetry axis ``e3`` at
+``a = (0, 0, a3)`` from the geometric centre, with central inertia ``diag(I1, I2, I3)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rollingtop._errors import BodyError
+
+__all__ = ["SphericalTop"]
+
+#: Names and meanings of the parameters, in the order of the compiled parameter vector.
+PARAMETERS = {
+    "R": "radius of the sphere",
+    "m": "mass",
+    "g": "gravitational acceleration",
+    "a3": "offset of the centre of mass along the symmetry axis e3",
+    "I1": "central moment of inertia about e1",
+    "I2": "central moment of inertia about e2",
+    "I3": "central moment of inertia about the symmetry axis e3",
+}
+
+
+def _is_real(x: object) -> bool:
+    return isinstance(x, int | float | np.floating | np.integer) and not isinstance(x, bool)
+
+
+@dataclass(frozen=True)
+class SphericalTop:
+    """A sphere with its centre of mass on its symmetry axis (a spherical top).
+
+    Parameters
+    ----------
+    R : float
+        Radius, ``R > 0``.
+    m : float
+        Mass, ``m > 0``.
+    g : float
+        Gravitational acceleration, ``g >= 0``.
+    a3 : float
+        Centre of mass offset along ``e3`` from the geometric centre, ``|a3| < R``.
+    I1, I3 : float
+        Central moments of inertia about ``e1`` and the symmetry axis ``e3``, positive.
+    I2 : float, optional
+        Central moment about ``e2``; defaults to ``I1`` (dynamically symmetric body, the case of
+        the paper). The triangle inequalities of a rigid body must hold.
+
+    Raises
+    ------
+    BodyError
+        Listing *every* violated rule at once, each with the field, its value and the rule.
+
+    Notes
+    -----
+    All parameters are in one consistent unit system of the user's choice; nothing is
+    non-dimensionalised.
+    """
+
+    R: float
+    m: float
+    g: float
+    a3: float
+    I1: float
+    I3: float
+    I2: float | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        problems = []
+        values = {}
+        for name in ("R", "m", "g", "a3", "I1", "I3", "I2"):
+            x = getattr(self, name)
+            if name == "I2" and x is None:
+                continue
+            if not _is_real(x) or not math.isfinite(float(x)):
+                problems.append(f"{name} = {x!r} must be a finite real number")
+                continue
+            values[name] = float(x)
+            object.__setattr__(self, name, float(x))
+        if self.I2 is None and "I1" in values:
+            object.__setattr__(self, "I2", values["I1"])
+            values["I2"] = values["I1"]
+        for name in ("R", "m", "I1", "I2", "I3"):
+            if name in values and values[name] <= 0:
+                problems.append(f"{name} = {values[name]:g} must be > 0 ({PARAMETERS[name]})")
+        if "g" in values and values["g"] < 0:
+            problems.append(f"g = {values['g']:g} must be >= 0")
+        if all(k in values and values[k] > 0 for k in ("I1", "I2", "I3")):
+            i1, i2, i3 = values["I1"], values["I2"], values["I3"]
+            for name, lhs, a, b, rest in (
+                ("I1", i1, "I2", "I3", i2 + i3),
+                ("I2", i2, "I1", "I3", i1 + i3),
+                ("I3", i3, "I1", "I2", i1 + i2),
+            ):
+                if lhs > rest * (1.0 + 1e-12):
+                    problems.append(
+                        f"{name} = {lhs:g} violates the rigid-body triangle inequality "
+                        f"{name} <= {a} + {b} = {rest:g}"
+                    )
+        if "a3" in values and "R" in values and values["R"] > 0:
+            if abs(values["a3"]) >= values["R"]:
+                problems.append(
+                    f"a3 = {values['a3']:g} violates |a3| < R = {values['R']:g} "
+                    "(the centre of mass must lie inside the sphere)"
+                )
+        if problems:
+            raise BodyError("inadmissible body: " + "; ".join(problems))
+
+    @property
+    def symmetric(self) -> bool:
+        """``True`` when ``I1 == I2`` (dynamical symmetry, the case of the paper)."""
+        return self.I1 == self.I2
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """Central inertia diagonal ``(I1, I2, I3)``, shape (3,)."""
+        return np.array([self.I1, self.I2, self.I3])
+
+    @property
+    def params(self) -> np.ndarray:
+        """Parameter vector ``(R, m, g, a3, I1, I2, I3)`` passed to the compiled kernels, shape (7,)."""
+        return np.array([self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3], dtype=float)
+
+    def rho(self, gamma3):
+        """Density of the invariant measure ``rho = I1 + m (a3^2 + R^2 + 2 a3 R gamma3)`` (eq. 3.3)."""
+        return self.I1 + self.m * (self.a3**2 + self.R**2 + 2 * self.a3 * self.R * np.asarray(gamma3))
+
+    def to_dict(self) -> dict[str, float]:
+        """Parameters as a plain dictionary (``I2`` included)."""
+        return {k: float(getattr(self, k)) for k in ("R", "m", "g", "a3", "I1", "I2", "I3")}

@@ -1,0 +1,151 @@
+"""Command-line interface: thin wrappers that parse, call the library, print or write.
+
+Every input error is reported as one line on stderr with exit status 2 and no traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import warnings
+
+import click
+
+from rollingtop._errors import ContactLostWarning, IntegrationError, RollingTopError
+
+EXIT_USAGE = 2
+_NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
+EXIT_FAILURE = 1
+
+
+def _fail(message: str, status: int = EXIT_USAGE) -> None:
+    click.echo(f"rollingtop: error: {message}", err=True)
+    sys.exit(status)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="rollingtop")
+def cli() -> None:
+    """Rolling spherical tops under nonholonomic constraints (Kilin & Ivanova 2023)."""
+
+
+def _progress_bar(t_end: float):
+    """A rich progress bar on stderr when it is a terminal, else ``None``."""
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        return None
+    return Progress(
+        TextColumn("integrating"),
+        BarColumn(),
+        TextColumn("t = {task.completed:.4g} / {task.total:.4g}"),
+        TimeRemainingColumn(),
+        console=console,
+        transient=True,
+    )
+
+
+def _integrals_table(summary: dict):
+    from rich.table import Table
+
+    table = Table(title=f"{summary['model']} model, t = 0 .. {summary['t_end']:g}")
+    for col in ("integral", "initial", "final", "max |drift|", "relative"):
+        table.add_column(col, justify="right" if col != "integral" else "left")
+    for name, row in summary["integrals"].items():
+        rel = row["max_rel_drift"]
+        table.add_row(name, f"{row['initial']:.15g}", f"{row['final']:.15g}",
+                      f"{row['max_abs_drift']:.2e}", "-" if rel is None else f"{rel:.2e}")  # fmt: skip
+    return table
+
+
+def _print_report(summary: dict) -> None:
+    from rich.console import Console
+
+    console = Console()
+    console.print(_integrals_table(summary))
+    c, r, s = summary["constraints"], summary["reactions"], summary["stats"]
+    lost = r["contact_lost_at"]
+    console.print(
+        f"constraints: max |residual| {c['max_abs_residual']:.2e}, "
+        f"orthonormality error {c['orthonormality_max_error']:.2e}\n"
+        f"reactions: min normal force {r['min_normal_force']:.6g}, friction coefficient needed "
+        f"{r['max_friction_ratio']:.6g}" + ("" if lost is None else f", CONTACT LOST at t = {lost:.6g}")
+        + f"\nsteps {s['steps']} (+{s['rejected_steps']} rejected), {s['rhs_evals']} rhs "
+        f"evaluations, {s['wall_time_s']:.3f} s (+{s['compile_time_s']:.2f} s compile/load)",
+        highlight=False,
+    )
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("--t-end", type=float, default=None, help="End time (overrides the scenario).")
+@click.option("--rtol", type=float, default=None, help="Relative tolerance.")
+@click.option("--atol", type=float, default=None, help="Absolute tolerance.")
+@click.option("--samples", type=int, default=None, help="Number of output samples.")
+@click.option(
+    "--model",
+    type=str,
+    default=None,
+    help="Contact model, overriding the scenario's: meridian, smooth, rough.",
+)
+@click.option("-o", "--output", type=click.Path(), default=None, help="Write samples to OUT.nc or OUT.csv.")
+@click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
+def simulate(scenario, t_end, rtol, atol, samples, model, output, as_json):
+    """Simulate SCENARIO.toml and print its integrals, constraints and reactions."""
+    from rollingtop.io import check_output_path
+    from rollingtop.simulate import simulate as run
+    from rollingtop.trajectory import OUTPUT_SUFFIXES
+
+    if output is not None:
+        check_output_path(output, OUTPUT_SUFFIXES)
+    overrides = dict(t_end=t_end, rtol=rtol, atol=atol, samples=samples, model=model)
+    from rollingtop.scenario import load_scenario
+
+    sc = load_scenario(scenario).with_overrides(**overrides)
+    bar = _progress_bar(sc.integration.t_end)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ContactLostWarning)
+        if bar is None:
+            traj = run(sc)
+        else:
+            with bar:
+                task = bar.add_task("integrate", total=sc.integration.t_end)
+                traj = run(sc, progress=lambda t: bar.update(task, completed=t))
+    for w in caught:
+        click.echo(f"rollingtop: warning: {w.message}", err=True)
+    if output is not None:
+        traj.save(output)
+    summary = traj.summary()
+    if as_json:
+        click.echo(json.dumps(summary))
+    else:
+        _print_report(summary)
+        if output is not None:
+            click.echo(f"wrote {output}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point."""
+    try:
+        cli.main(args=argv, prog_name="rollingtop", standalone_mode=False)
+    except _NO_ARGS_IS_HELP as exc:  # click >= 8.2 raises this for a bare ``rollingtop``
+        click.echo(exc.format_message())
+        sys.exit(0)
+    except click.UsageError as exc:
+        _fail(exc.format_message())
+    except click.exceptions.Abort:
+        _fail("aborted", 130)
+    except RollingTopError as exc:
+        _fail(str(exc))
+    except IntegrationError as exc:
+        _fail(str(exc), EXIT_FAILURE)
+    except KeyboardInterrupt:
+        _fail("interrupted; nothing was written", 130)
+    except OSError as exc:
+        _fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "), EXIT_FAILURE)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

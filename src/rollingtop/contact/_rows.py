@@ -1,0 +1,55 @@
+"""Compiled helpers shared by the contact models' constraint kernels.
+
+A constraint row is a linear condition ``J . u = 0`` on the generalised velocity
+``u = (v, w)``. Its reaction is ``lambda * J`` (ideal constraint, d'Alembert-Lagrange), and the
+time derivative of the condition along the motion adds the *bias* ``dJ/dt . u`` to the
+acceleration equation (``MODEL.md``, "Dynamics").
+"""
+
+from numba import njit
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
+    """Write row ``k`` for the no-slip condition ``(vp, d) = 0`` of the contact point.
+
+    ``vp = v + w x r`` with ``r = -R gamma - a``, so ``J = (d, r x d)``; the reaction is the
+    force ``lambda d`` applied at the contact point. ``(dd1, dd2, dd3)`` is ``d'`` along the
+    motion; ``r' = -R gamma'`` and ``gamma' = gamma x w`` (paper eq. 2.1).
+    """
+    R = p[0]
+    a3 = p[3]
+    v1, v2, v3 = y[0], y[1], y[2]
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
+    # r' = -R (gamma x w)
+    rd1 = -R * (g2 * w3 - g3 * w2)
+    rd2 = -R * (g3 * w1 - g1 * w3)
+    rd3 = -R * (g1 * w2 - g2 * w1)
+    J[k, 0] = d1
+    J[k, 1] = d2
+    J[k, 2] = d3
+    J[k, 3] = r2 * d3 - r3 * d2
+    J[k, 4] = r3 * d1 - r1 * d3
+    J[k, 5] = r1 * d2 - r2 * d1
+    # (r x d)' = r' x d + r x d'
+    q1 = rd2 * d3 - rd3 * d2 + r2 * dd3 - r3 * dd2
+    q2 = rd3 * d1 - rd1 * d3 + r3 * dd1 - r1 * dd3
+    q3 = rd1 * d2 - rd2 * d1 + r1 * dd2 - r2 * dd1
+    bias[k] = dd1 * v1 + dd2 * v2 + dd3 * v3 + q1 * w1 + q2 * w2 + q3 * w3
+    dirs[k, 0] = d1
+    dirs[k, 1] = d2
+    dirs[k, 2] = d3
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def normal_row(p, y, k, J, bias, dirs):
+    """Row ``k`` for the contact condition ``f1 = (vp, gamma) = 0`` (paper eq. 2.4)."""
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    contact_row(
+        p, y, k, g1, g2, g3,
+        g2 * w3 - g3 * w2, g3 * w1 - g1 * w3, g1 * w2 - g2 * w1,
+        J, bias, dirs,
+    )  # fmt: skip

@@ -1,0 +1,1 @@
+"""Constrained dynamics: state layout, compiled right-hand side, projections, integrals."""

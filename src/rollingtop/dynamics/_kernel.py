@@ -1,0 +1,239 @@
+"""Compiled constrained dynamics shared by every contact model (``MODEL.md``, "Dynamics").
+
+With ``u = (v, w)`` and the diagonal mass matrix ``M = diag(m, m, m, I1, I2, I3)``, the free
+motion is (paper eq. 2.7 with gravity written out)
+
+    M u' = f + J^T lambda,    f = (m v x w - m g gamma,  I w x w),
+
+and the constraint rows ``J u = 0`` of the contact model, differentiated along the motion, give
+``J u' = -bias``. Eliminating ``u'`` leaves the small symmetric positive-definite system
+
+    (J M^-1 J^T) lambda = -bias - J M^-1 f
+
+(at most 4x4), solved here by an unrolled Cholesky factorisation: no allocation, no LAPACK call.
+Kinematics: ``alpha' = alpha x w``, ``beta' = beta x w``, ``gamma' = gamma x w``,
+``X' = (v, alpha)``, ``Y' = (v, beta)`` (eq. 2.1).
+
+All functions take bare arrays (state ``y`` of :mod:`._layout`, parameters
+``p = (R, m, g, a3, I1, I2, I3)``) and preallocated work arrays ``ws = (J, bias, dirs, A, lam)``
+of shapes ``(4, 6), (4,), (4, 3), (4, 4), (4,)``.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rollingtop.contact import meridian, rough, smooth
+from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
+
+
+def new_workspace():
+    """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels."""
+    return (
+        np.zeros((MAX_ROWS, 6)),
+        np.zeros(MAX_ROWS),
+        np.zeros((MAX_ROWS, 3)),
+        np.zeros((MAX_ROWS, MAX_ROWS)),
+        np.zeros(MAX_ROWS),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def constraint_rows(code, p, y, J, bias, dirs):
+    """Fill the contact model's rows ``J``, their ``bias = J' u`` and force directions ``dirs``.
+
+    Returns the number of rows. ``code`` selects the model (``rollingtop.contact.*.CODE``).
+    """
+    if code == meridian.CODE:
+        return meridian.rows(p, y, J, bias, dirs)
+    elif code == smooth.CODE:
+        return smooth.rows(p, y, J, bias, dirs)
+    elif code == rough.CODE:
+        return rough.rows(p, y, J, bias, dirs)
+    return -1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _solve_spd(n, A, x):
+    """Solve ``A z = x`` in place (``x <- z``) for SPD ``A`` given by its lower triangle."""
+    for j in range(n):
+        d = A[j, j]
+        for k in range(j):
+            d -= A[j, k] * A[j, k]
+        d = math.sqrt(d)
+        A[j, j] = d
+        for i in range(j + 1, n):
+            s = A[i, j]
+            for k in range(j):
+                s -= A[i, k] * A[j, k]
+            A[i, j] = s / d
+    for i in range(n):
+        s = x[i]
+        for k in range(i):
+            s -= A[i, k] * x[k]
+        x[i] = s / A[i, i]
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, n):
+            s -= A[k, i] * x[k]
+        x[i] = s / A[i, i]
+
+
+@njit(cache=True, error_model="numpy")
+def rhs(code, p, y, dy, ws):
+    """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
+
+    After the call ``ws[4][:nrows]`` holds the multipliers ``lambda`` and ``ws[2]`` the force
+    directions, from which :func:`reaction` forms the contact force.
+    """
+    J, bias, dirs, A, lam = ws
+    nc = constraint_rows(code, p, y, J, bias, dirs)
+    m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
+    v1, v2, v3 = y[0], y[1], y[2]
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    # free forces: m v x w - m g gamma and (I w) x w
+    f = (
+        m * (v2 * w3 - v3 * w2) - m * g * g1,
+        m * (v3 * w1 - v1 * w3) - m * g * g2,
+        m * (v1 * w2 - v2 * w1) - m * g * g3,
+        (I2 - I3) * w2 * w3,
+        (I3 - I1) * w3 * w1,
+        (I1 - I2) * w1 * w2,
+    )
+    minv = (1.0 / m, 1.0 / m, 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3)
+    for i in range(nc):
+        s = -bias[i]
+        for k in range(6):
+            s -= J[i, k] * minv[k] * f[k]
+        lam[i] = s
+        for j in range(i + 1):
+            a = 0.0
+            for k in range(6):
+                a += J[i, k] * J[j, k] * minv[k]
+            A[i, j] = a
+    _solve_spd(nc, A, lam)
+    for k in range(6):
+        s = f[k]
+        for i in range(nc):
+            s += J[i, k] * lam[i]
+        dy[k] = minv[k] * s
+    # frame kinematics: e' = e x w for e = alpha, beta, gamma
+    for base in (6, 9, 12):
+        e1, e2, e3 = y[base], y[base + 1], y[base + 2]
+        dy[base] = e2 * w3 - e3 * w2
+        dy[base + 1] = e3 * w1 - e1 * w3
+        dy[base + 2] = e1 * w2 - e2 * w1
+    dy[15] = v1 * y[6] + v2 * y[7] + v3 * y[8]
+    dy[16] = v1 * y[9] + v2 * y[10] + v3 * y[11]
+    return nc
+
+
+@njit(cache=True, error_model="numpy")
+def reaction(nc, y, ws):
+    """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` of the last :func:`rhs`.
+
+    ``F = sum_k lambda_k d_k`` is the constraint force at the contact point (body frame).
+    """
+    dirs, lam = ws[2], ws[4]
+    F1 = F2 = F3 = 0.0
+    for i in range(nc):
+        F1 += lam[i] * dirs[i, 0]
+        F2 += lam[i] * dirs[i, 1]
+        F3 += lam[i] * dirs[i, 2]
+    g1, g2, g3 = y[12], y[13], y[14]
+    N = F1 * g1 + F2 * g2 + F3 * g3
+    t1, t2, t3 = F1 - N * g1, F2 - N * g2, F3 - N * g3
+    return N, math.sqrt(t1 * t1 + t2 * t2 + t3 * t3)
+
+
+@njit(cache=True, error_model="numpy")
+def project(code, p, y, ws):
+    """Project ``y`` in place onto the constraint manifold.
+
+    The frame ``Q = [alpha; beta; gamma]`` goes to its nearest orthogonal matrix by one
+    Newton-Schulz step ``Q <- (3 Q - Q Q^T Q) / 2`` (quadratic convergence; the error after an
+    accepted step is at truncation level). The velocity ``u`` then goes to the nearest point, in
+    the kinetic-energy metric, of ``J u = 0``: ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
+    """
+    J, bias, dirs, A, lam = ws
+    # Q Q^T (rows alpha, beta, gamma at offsets 6, 9, 12)
+    G00 = y[6] * y[6] + y[7] * y[7] + y[8] * y[8]
+    G11 = y[9] * y[9] + y[10] * y[10] + y[11] * y[11]
+    G22 = y[12] * y[12] + y[13] * y[13] + y[14] * y[14]
+    G01 = y[6] * y[9] + y[7] * y[10] + y[8] * y[11]
+    G02 = y[6] * y[12] + y[7] * y[13] + y[8] * y[14]
+    G12 = y[9] * y[12] + y[10] * y[13] + y[11] * y[14]
+    for c in range(3):
+        a, b, g = y[6 + c], y[9 + c], y[12 + c]
+        y[6 + c] = 1.5 * a - 0.5 * (G00 * a + G01 * b + G02 * g)
+        y[9 + c] = 1.5 * b - 0.5 * (G01 * a + G11 * b + G12 * g)
+        y[12 + c] = 1.5 * g - 0.5 * (G02 * a + G12 * b + G22 * g)
+    nc = constraint_rows(code, p, y, J, bias, dirs)
+    m, I1, I2, I3 = p[1], p[4], p[5], p[6]
+    minv = (1.0 / m, 1.0 / m, 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3)
+    for i in range(nc):
+        s = 0.0
+        for k in range(6):
+            s += J[i, k] * y[k]
+        lam[i] = s
+        for j in range(i + 1):
+            a = 0.0
+            for k in range(6):
+                a += J[i, k] * J[j, k] * minv[k]
+            A[i, j] = a
+    _solve_spd(nc, A, lam)
+    for k in range(6):
+        s = 0.0
+        for i in range(nc):
+            s += J[i, k] * lam[i]
+        y[k] -= minv[k] * s
+
+
+@njit(cache=True, error_model="numpy")
+def diagnostics(code, p, Y, out):
+    """Per-sample reactions and constraint errors.
+
+    Parameters
+    ----------
+    Y : ndarray, shape (n, 17)
+        States.
+    out : ndarray, shape (n, 4 + 4)
+        Filled with: normal force, tangential force, max ``|J_k u|`` over the rows,
+        max ``|Q Q^T - 1|``, then each row's residual ``J_k u`` (zero-padded to 4).
+    """
+    ws = (
+        np.zeros((MAX_ROWS, 6)),
+        np.zeros(MAX_ROWS),
+        np.zeros((MAX_ROWS, 3)),
+        np.zeros((MAX_ROWS, MAX_ROWS)),
+        np.zeros(MAX_ROWS),
+    )
+    dy = np.empty(N_STATE)
+    for n in range(Y.shape[0]):
+        y = Y[n]
+        nc = rhs(code, p, y, dy, ws)
+        N, T = reaction(nc, y, ws)
+        out[n, 0] = N
+        out[n, 1] = T
+        J = ws[0]
+        worst = 0.0
+        for i in range(MAX_ROWS):
+            r = 0.0
+            if i < nc:
+                for k in range(6):
+                    r += J[i, k] * y[k]
+            out[n, 4 + i] = r
+            worst = max(worst, abs(r))
+        out[n, 2] = worst
+        err = 0.0
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                for c in range(3):
+                    s += y[6 + 3 * i + c] * y[6 + 3 * j + c]
+                if i == j:
+                    s -= 1.0
+                err = max(err, abs(s))
+        out[n, 3] = err

@@ -1,0 +1,167 @@
+"""Constraint-consistent initial states built from user inputs."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from rollingtop._errors import InitialStateError
+from rollingtop.body import SphericalTop
+from rollingtop.contact import ContactModel, get_model
+from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._layout import N_STATE
+
+__all__ = ["initial_state", "constraint_residuals", "UNIT_TOLERANCE"]
+
+#: Tolerance on the unit length and orthogonality of user-given vectors, and on the constraint
+#: residuals of a user-given velocity.
+UNIT_TOLERANCE = 1e-9
+
+
+def _vector(name: str, value, length: int) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InitialStateError(f"{name} = {value!r} must be a list of {length} numbers") from None
+    if arr.shape != (length,) or isinstance(value, str):
+        raise InitialStateError(f"{name} = {value!r} must be a list of {length} numbers")
+    if not np.all(np.isfinite(arr)):
+        raise InitialStateError(f"{name} = {value!r} must be finite")
+    return arr
+
+
+def _unit(name: str, value) -> np.ndarray:
+    x = _vector(name, value, 3)
+    norm = float(np.linalg.norm(x))
+    if abs(norm - 1.0) > UNIT_TOLERANCE:
+        raise InitialStateError(
+            f"{name} = {x.tolist()} is not a unit vector (|{name}| = {norm:.12g}, "
+            f"tolerance {UNIT_TOLERANCE:g})"
+        )
+    return x / norm
+
+
+def default_alpha(gamma: np.ndarray) -> np.ndarray:
+    """Default fixed ``x`` axis: the horizontal projection of the symmetry axis ``e3``.
+
+    In the body frame this is ``nu = (e3 - gamma3 gamma)/s``, so the azimuth of the axis starts at
+    ``psi = atan2(beta3, alpha3) = 0`` (``MODEL.md``, "Motion in absolute space"). When the axis
+    is vertical, the horizontal projection of ``e1`` is used instead.
+    """
+    for e in np.eye(3)[[2, 0, 1]]:
+        h = e - (e @ gamma) * gamma
+        norm = np.linalg.norm(h)
+        if norm > 1e-6:
+            return h / norm
+    raise AssertionError("unreachable: some body axis is not vertical")
+
+
+def constraint_residuals(body: SphericalTop, model, y: np.ndarray) -> np.ndarray:
+    """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
+    model = get_model(model)
+    J, bias, dirs, _, _ = _kernel.new_workspace()
+    nc = _kernel.constraint_rows(model.code, body.params, np.asarray(y, dtype=float), J, bias, dirs)
+    return J[:nc] @ np.asarray(y[:6], dtype=float)
+
+
+def initial_state(
+    body: SphericalTop,
+    model: str | ContactModel,
+    *,
+    gamma: Sequence[float],
+    omega: Sequence[float],
+    alpha: Sequence[float] | None = None,
+    position: Sequence[float] = (0.0, 0.0),
+    v: Sequence[float] | None = None,
+    free: Mapping[str, object] | None = None,
+) -> np.ndarray:
+    """Build a constraint-consistent state vector.
+
+    Parameters
+    ----------
+    body : SphericalTop
+    model : str or ContactModel
+        Contact model (``"meridian"``, ``"smooth"``, ``"rough"``).
+    gamma : array_like, shape (3,)
+        Upward vertical in the body frame; unit within 1e-9 (then normalised exactly).
+    omega : array_like, shape (3,)
+        Angular velocity, body frame.
+    alpha : array_like, shape (3,), optional
+        Fixed ``x`` axis in the body frame, unit and orthogonal to ``gamma`` within 1e-9.
+        Default: :func:`default_alpha` (fixed ``x`` along the horizontal projection of the axis).
+    position : array_like, shape (2,)
+        Horizontal CoM position ``(X, Y)`` in the fixed frame.
+    v : array_like, shape (3,), optional
+        Full body-frame CoM velocity; must satisfy every constraint of the model within 1e-9.
+    free : mapping, optional
+        The model's free velocity components (``meridian``: ``v_tau``; ``smooth``:
+        ``v_horizontal = (vx, vy)`` along the fixed axes; ``rough``: none). Missing ones are 0.
+        Exclusive with ``v``.
+
+    Returns
+    -------
+    y : ndarray, shape (17,)
+        ``(v, w, alpha, beta, gamma, X, Y)`` with ``beta = gamma x alpha``.
+    """
+    model = get_model(model)
+    free = dict(free or {})
+    gamma = _unit("gamma", gamma)
+    omega = _vector("omega", omega, 3)
+    if model.singular is not None and (why := model.singular(gamma)) is not None:
+        raise InitialStateError(f"model {model.name!r}: {why}")
+    if alpha is None:
+        alpha = default_alpha(gamma)
+    else:
+        alpha = _unit("alpha", alpha)
+        dot = float(alpha @ gamma)
+        if abs(dot) > UNIT_TOLERANCE:
+            raise InitialStateError(
+                f"alpha = {alpha.tolist()} is not orthogonal to gamma ((alpha, gamma) = {dot:.3g}, "
+                f"tolerance {UNIT_TOLERANCE:g})"
+            )
+        alpha = alpha - dot * gamma
+        alpha /= np.linalg.norm(alpha)
+    beta = np.cross(gamma, alpha)
+    position = _vector("position", position, 2)
+
+    unknown = sorted(set(free) - set(model.free_velocity))
+    if unknown:
+        allowed = ", ".join(model.free_velocity) or "none; give omega only, or a full v"
+        raise InitialStateError(
+            f"{', '.join(unknown)} is not a free velocity component of model {model.name!r} "
+            f"(it has: {allowed})"
+        )
+    y = np.empty(N_STATE)
+    y[3:6] = omega
+    y[6:9], y[9:12], y[12:15] = alpha, beta, gamma
+    y[15:17] = position
+    if v is not None:
+        if free:
+            raise InitialStateError(
+                f"give either v or the free velocity components ({', '.join(free)}), not both"
+            )
+        y[0:3] = _vector("v", v, 3)
+        residuals = constraint_residuals(body, model, y)
+        for name, res in zip(model.constraints, residuals, strict=True):
+            if abs(res) > UNIT_TOLERANCE:
+                raise InitialStateError(
+                    f"v = {y[0:3].tolist()} violates the constraint {name} of model "
+                    f"{model.name!r} (residual {res:.3g}, tolerance {UNIT_TOLERANCE:g})"
+                )
+    else:
+        values = {}
+        for name, length in model.free_velocity.items():
+            raw = free.get(name, 0.0 if length == 1 else [0.0] * length)
+            if length == 1:
+                if isinstance(raw, bool) or not isinstance(raw, int | float):
+                    raise InitialStateError(f"{name} = {raw!r} must be a number")
+                if not math.isfinite(raw):
+                    raise InitialStateError(f"{name} = {raw!r} must be finite")
+                values[name] = float(raw)
+            else:
+                values[name] = _vector(name, raw, length)
+        y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
+    _kernel.project(model.code, body.params, y, _kernel.new_workspace())
+    return y

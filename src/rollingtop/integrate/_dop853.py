@@ -1,0 +1,249 @@
+"""Compiled DOP853 stepper with after-step projection, dense output and reaction monitoring.
+
+The method is Dormand & Prince's explicit Runge-Kutta pair of order 8(5,3) with its 7th-order
+continuous extension (Hairer, Norsett & Wanner, *Solving ODEs I*, Sec. II.10), with the step-size
+control of Hairer's ``dop853.f`` as also used by ``scipy.integrate.DOP853``: the error norm
+combines the 5th- and 3rd-order estimates, safety factor 0.9, step ratio in [0.2, 10].
+
+Why a stepper of our own rather than CyRK's ``nbsolve_ivp`` or numbalsoda (both evaluated): after
+every accepted step the state must be projected back onto the constraint manifold (orthonormal
+frame, velocity on the constraints), the dense output must be built from the step's own stages,
+the contact reaction must be monitored at every step, and later work needs events and one
+stepper per thread in parallel ensembles. Neither library exposes an after-step hook, and
+numbalsoda's LSODA/DOP853 wrappers offer no dense output or events; the method itself is short.
+
+Everything here takes bare arrays and runs in numba's nopython mode; see
+:func:`rollingtop.integrate.driver.integrate` for the validated entry point.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rollingtop.dynamics._kernel import project, reaction, rhs
+from rollingtop.integrate._dop853_tableau import A, B, C, D, E3, E5
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+ERROR_EXPONENT = -1.0 / 8.0
+
+# Status codes returned by ``run``.
+FINISHED = 0
+BUDGET_EXHAUSTED = 1
+STEP_TOO_SMALL = -1
+NOT_FINITE = -2
+
+# Indices into the float control array ``ctrl``.
+T, H_ABS, T_END, RTOL, ATOL = 0, 1, 2, 3, 4
+# Indices into the integer counter array ``counts``.
+NEXT_SAMPLE, STEPS, REJECTED, NFEV = 0, 1, 2, 3
+# Indices into the reaction-tracking array ``track``.
+MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO = 0, 1, 2, 3, 4
+
+
+def new_track():
+    """Reaction-tracking array: min normal force and when, first time it is < 0, max ratio."""
+    return np.array([np.inf, np.nan, np.nan, 0.0, np.nan])
+
+
+@njit(cache=True, error_model="numpy")
+def update_track(track, t, N, T_force):
+    """Fold one evaluation of the contact force into ``track``."""
+    if N < track[MIN_NORMAL]:
+        track[MIN_NORMAL] = N
+        track[T_MIN_NORMAL] = t
+    if N < 0.0 and math.isnan(track[T_CONTACT_LOST]):
+        track[T_CONTACT_LOST] = t
+    if N > 0.0:
+        ratio = T_force / N
+        if ratio > track[MAX_RATIO]:
+            track[MAX_RATIO] = ratio
+            track[T_MAX_RATIO] = t
+
+
+@njit(cache=True, error_model="numpy")
+def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
+    """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy."""
+    n = y.shape[0]
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(n):
+        sc = atol + abs(y[i]) * rtol
+        d0 += (y[i] / sc) ** 2
+        d1 += (f[i] / sc) ** 2
+    d0 = math.sqrt(d0 / n)
+    d1 = math.sqrt(d1 / n)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, t_end - t0)
+    for i in range(n):
+        ytmp[i] = y[i] + h0 * f[i]
+    rhs(code, p, ytmp, ftmp, ws)
+    d2 = 0.0
+    for i in range(n):
+        sc = atol + abs(y[i]) * rtol
+        d2 += ((ftmp[i] - f[i]) / sc) ** 2
+    d2 = math.sqrt(d2 / n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, t_end - t0)
+
+
+@njit(cache=True, error_model="numpy")
+def _stage(K, s, y, h, ytmp):
+    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]``."""
+    n = y.shape[0]
+    for i in range(n):
+        acc = 0.0
+        for j in range(s):
+            acc += A[s, j] * K[j, i]
+        ytmp[i] = y[i] + h * acc
+
+
+@njit(cache=True, error_model="numpy")
+def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, Fd, ws):
+    """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
+
+    Parameters
+    ----------
+    code : int
+        Contact model code.
+    p : ndarray, shape (7,)
+        Body parameters.
+    y, f : ndarray, shape (17,)
+        Current state (projected) and its derivative; updated in place.
+    ctrl : ndarray, shape (5,)
+        ``t, h_abs, t_end, rtol, atol``; ``t`` and ``h_abs`` are updated.
+    counts : ndarray of int64, shape (4,)
+        Next sample index, accepted steps, rejected steps, right-hand-side evaluations.
+    track : ndarray, shape (5,)
+        Reaction tracking (see :func:`new_track`), updated at every accepted step.
+    t_eval : ndarray, shape (n_samples,)
+        Increasing sample times within ``[t0, t_end]``.
+    out : ndarray, shape (n_samples, 17)
+        Samples, each projected onto the constraints.
+    budget : int
+        Maximum number of accepted steps in this call (the caller resumes for progress output).
+    K, ynew, ytmp, Fd, ws
+        Work arrays: stages ``(16, 17)``, two states, dense-output coefficients ``(7, 17)`` and the
+        kernel workspace.
+
+    Returns
+    -------
+    status : int
+        ``FINISHED``, ``BUDGET_EXHAUSTED``, ``STEP_TOO_SMALL`` or ``NOT_FINITE``.
+    """
+    n = y.shape[0]
+    t = ctrl[T]
+    h_abs = ctrl[H_ABS]
+    t_end = ctrl[T_END]
+    rtol = ctrl[RTOL]
+    atol = ctrl[ATOL]
+    n_samples = t_eval.shape[0]
+    taken = 0
+    while t < t_end:
+        if taken >= budget:
+            ctrl[T] = t
+            ctrl[H_ABS] = h_abs
+            return BUDGET_EXHAUSTED
+        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        rejected = False
+        while True:
+            if h_abs < min_step:
+                ctrl[T] = t
+                ctrl[H_ABS] = h_abs
+                return STEP_TOO_SMALL
+            t_new = t + h_abs
+            if t_new > t_end:
+                t_new = t_end
+            h = t_new - t
+            for i in range(n):
+                K[0, i] = f[i]
+            for s in range(1, 12):
+                _stage(K, s, y, h, ytmp)
+                rhs(code, p, ytmp, K[s], ws)
+            for i in range(n):
+                acc = 0.0
+                for j in range(12):
+                    acc += B[j] * K[j, i]
+                ynew[i] = y[i] + h * acc
+            rhs(code, p, ynew, K[12], ws)
+            counts[NFEV] += 12
+            e5 = 0.0
+            e3 = 0.0
+            for i in range(n):
+                sc = atol + max(abs(y[i]), abs(ynew[i])) * rtol
+                a5 = 0.0
+                a3 = 0.0
+                for j in range(13):
+                    a5 += E5[j] * K[j, i]
+                    a3 += E3[j] * K[j, i]
+                e5 += (a5 / sc) ** 2
+                e3 += (a3 / sc) ** 2
+            if e5 == 0.0 and e3 == 0.0:
+                err = 0.0
+            else:
+                err = h * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+            if not math.isfinite(err):
+                h_abs *= MIN_FACTOR
+                counts[REJECTED] += 1
+                rejected = True
+            elif err < 1.0:
+                factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_abs *= factor
+                break
+            else:
+                h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
+                counts[REJECTED] += 1
+                rejected = True
+        # Dense output over [t, t_new] for the samples that fall in it.
+        k = counts[NEXT_SAMPLE]
+        if k < n_samples and t_eval[k] <= t_new:
+            for s in range(13, 16):
+                _stage(K, s, y, h, ytmp)
+                rhs(code, p, ytmp, K[s], ws)
+            counts[NFEV] += 3
+            for i in range(n):
+                dlt = ynew[i] - y[i]
+                Fd[0, i] = dlt
+                Fd[1, i] = h * K[0, i] - dlt
+                Fd[2, i] = 2.0 * dlt - h * (K[12, i] + K[0, i])
+                for r in range(4):
+                    acc = 0.0
+                    for j in range(16):
+                        acc += D[r, j] * K[j, i]
+                    Fd[3 + r, i] = h * acc
+            while k < n_samples and t_eval[k] <= t_new:
+                x = (t_eval[k] - t) / h
+                for i in range(n):
+                    acc = 0.0
+                    for r in range(6, -1, -1):
+                        acc += Fd[r, i]
+                        acc *= x if (6 - r) % 2 == 0 else 1.0 - x
+                    out[k, i] = y[i] + acc
+                project(code, p, out[k], ws)
+                k += 1
+            counts[NEXT_SAMPLE] = k
+        # Accept: project onto the constraints and re-evaluate the derivative there.
+        for i in range(n):
+            y[i] = ynew[i]
+        project(code, p, y, ws)
+        nc = rhs(code, p, y, f, ws)
+        counts[NFEV] += 1
+        for i in range(n):
+            if not math.isfinite(y[i]) or not math.isfinite(f[i]):
+                ctrl[T] = t_new
+                return NOT_FINITE
+        N, T_force = reaction(nc, y, ws)
+        update_track(track, t_new, N, T_force)
+        t = t_new
+        counts[STEPS] += 1
+        taken += 1
+    ctrl[T] = t
+    ctrl[H_ABS] = h_abs
+    return FINISHED

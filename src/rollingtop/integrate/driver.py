@@ -1,0 +1,191 @@
+"""Validated entry point of the compiled integrator."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rollingtop._errors import IntegrationError
+from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._layout import N_STATE
+from rollingtop.integrate import _dop853 as dop
+
+__all__ = ["IntegrationResult", "integrate", "compile_kernels"]
+
+#: Accepted steps per call of the compiled loop when a progress callback is given.
+PROGRESS_CHUNK = 20_000
+
+_compile_time: float | None = None
+
+
+@dataclass
+class IntegrationResult:
+    """Samples and statistics of one integration.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+    y : ndarray, shape (n, 17)
+        States at ``t``, each projected onto the constraint manifold.
+    steps, rejected_steps, rhs_evals : int
+    wall_time_s : float
+        Time spent in the compiled loop (compilation excluded).
+    compile_time_s : float
+        Time this call spent compiling or loading the cached kernels (0 once they are loaded).
+    reactions : dict
+        ``min_normal_force`` and ``t_min_normal_force``, ``contact_lost_at`` (first accepted step
+        with negative normal force, or ``None``), ``max_friction_ratio`` and its time, monitored at
+        every accepted step.
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    steps: int
+    rejected_steps: int
+    rhs_evals: int
+    wall_time_s: float
+    compile_time_s: float
+    reactions: dict = field(default_factory=dict)
+
+
+def _workspace(n_samples: int):
+    return dict(
+        K=np.zeros((16, N_STATE)),
+        ynew=np.zeros(N_STATE),
+        ytmp=np.zeros(N_STATE),
+        Fd=np.zeros((7, N_STATE)),
+        ws=_kernel.new_workspace(),
+        out=np.full((n_samples, N_STATE), np.nan),
+    )
+
+
+def compile_kernels() -> float:
+    """Compile (or load from numba's cache) the integrator's kernels; returns the seconds spent.
+
+    Only the first call in a process does work; later calls return 0.
+    """
+    global _compile_time
+    if _compile_time is not None:
+        return 0.0
+    start = time.perf_counter()
+    p = np.array([1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5])
+    y = np.zeros(N_STATE)
+    y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
+    y[3:6] = (0.1, 0.2, 0.3)
+    for code in (0, 1, 2):
+        yy = y.copy()
+        _kernel.project(code, p, yy, _kernel.new_workspace())
+        _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None)
+        _kernel.diagnostics(code, p, yy[None, :].copy(), np.zeros((1, 8)))
+    _compile_time = time.perf_counter() - start
+    return _compile_time
+
+
+def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
+    n = t_eval.shape[0]
+    w = _workspace(n)
+    y = y0.copy()
+    f = np.zeros(N_STATE)
+    nc = _kernel.rhs(code, p, y, f, w["ws"])
+    track = dop.new_track()
+    dop.update_track(track, t_eval[0], *_kernel.reaction(nc, y, w["ws"]))
+    t0, t_end = float(t_eval[0]), float(t_eval[-1])
+    h0 = dop.initial_step(code, p, y, f, t_end, t0, rtol, atol, w["ytmp"], w["ynew"], w["ws"])
+    ctrl = np.array([t0, h0, t_end, rtol, atol])
+    counts = np.zeros(4, dtype=np.int64)
+    counts[dop.NFEV] = 2
+    w["out"][0] = y
+    counts[dop.NEXT_SAMPLE] = 1
+    budget = PROGRESS_CHUNK if progress is not None else (max_steps or 2**62)
+    start = time.perf_counter()
+    while True:
+        if max_steps is not None:
+            budget = min(budget, max_steps - int(counts[dop.STEPS]))
+        status = dop.run(code, p, y, f, ctrl, counts, track, t_eval, w["out"], budget,
+                         w["K"], w["ynew"], w["ytmp"], w["Fd"], w["ws"])  # fmt: skip
+        if progress is not None:
+            progress(float(ctrl[dop.T]))
+        if status != dop.BUDGET_EXHAUSTED:
+            break
+        if max_steps is not None and counts[dop.STEPS] >= max_steps:
+            raise IntegrationError(
+                f"max_steps = {max_steps} accepted steps reached at t = {ctrl[dop.T]:.6g} "
+                f"before t_end = {t_end:g}; raise max_steps or loosen rtol"
+            )
+    wall = time.perf_counter() - start
+    if status == dop.STEP_TOO_SMALL:
+        raise IntegrationError(
+            f"step size underflow at t = {ctrl[dop.T]:.9g} (h = {ctrl[dop.H_ABS]:.3g}): "
+            "the equations are singular or the tolerance is too tight"
+        )
+    if status == dop.NOT_FINITE:
+        raise IntegrationError(
+            f"the state became non-finite at t = {ctrl[dop.T]:.9g} "
+            "(for the meridian model: the symmetry axis reached the vertical?)"
+        )
+    return w["out"], counts, track, wall
+
+
+def integrate(
+    code: int,
+    params: np.ndarray,
+    y0: np.ndarray,
+    t_eval: np.ndarray,
+    *,
+    rtol: float,
+    atol: float,
+    max_steps: int | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> IntegrationResult:
+    """Integrate the constrained equations from ``y0`` at ``t_eval[0]`` to ``t_eval[-1]``.
+
+    Parameters
+    ----------
+    code : int
+        Contact model code (``ContactModel.code``).
+    params : ndarray, shape (7,)
+        ``SphericalTop.params``.
+    y0 : ndarray, shape (17,)
+        Constraint-consistent initial state (:func:`rollingtop.dynamics.state.initial_state`).
+    t_eval : ndarray, shape (n,)
+        Strictly increasing sample times, ``n >= 2``; the integration spans them.
+    rtol, atol : float
+        Tolerances of the error control (mixed, per component: ``atol + rtol |y|``).
+    max_steps : int, optional
+        Bound on accepted steps; :class:`IntegrationError` when reached.
+    progress : callable, optional
+        Called with the current time every :data:`PROGRESS_CHUNK` steps and at the end. Does
+        not change the step sequence.
+    """
+    t_eval = np.ascontiguousarray(t_eval, dtype=float)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    if t_eval.ndim != 1 or t_eval.size < 2 or np.any(np.diff(t_eval) <= 0):
+        raise ValueError("t_eval must be strictly increasing with at least 2 entries")
+    if y0.shape != (N_STATE,):
+        raise ValueError(f"y0 must have shape ({N_STATE},), got {y0.shape}")
+    compile_s = compile_kernels()
+    out, counts, track, wall = _run_compiled(
+        int(code), np.asarray(params, dtype=float), y0, t_eval, float(rtol), float(atol),
+        max_steps, progress,
+    )  # fmt: skip
+    return IntegrationResult(
+        t=t_eval,
+        y=out,
+        steps=int(counts[dop.STEPS]),
+        rejected_steps=int(counts[dop.REJECTED]),
+        rhs_evals=int(counts[dop.NFEV]),
+        wall_time_s=wall,
+        compile_time_s=compile_s,
+        reactions={
+            "min_normal_force": float(track[dop.MIN_NORMAL]),
+            "t_min_normal_force": float(track[dop.T_MIN_NORMAL]),
+            "contact_lost_at": None
+            if np.isnan(track[dop.T_CONTACT_LOST])
+            else float(track[dop.T_CONTACT_LOST]),
+            "max_friction_ratio": float(track[dop.MAX_RATIO]),
+            "t_max_friction_ratio": float(track[dop.T_MAX_RATIO]),
+        },
+    )

@@ -1,0 +1,80 @@
+"""One entry point for simulations: :func:`simulate`."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Callable
+
+from rollingtop._errors import ContactLostWarning
+from rollingtop.integrate import integrate
+from rollingtop.scenario import Scenario, load_scenario
+from rollingtop.trajectory import Trajectory
+
+__all__ = ["simulate"]
+
+
+def simulate(
+    scenario: Scenario | str | os.PathLike,
+    *,
+    progress: Callable[[float], None] | None = None,
+    **overrides,
+) -> Trajectory:
+    """Integrate a scenario and return its :class:`~rollingtop.trajectory.Trajectory`.
+
+    Parameters
+    ----------
+    scenario : Scenario or path
+        A :class:`~rollingtop.scenario.Scenario` or the path of a TOML scenario file.
+    progress : callable, optional
+        Called with the current time now and then during the run (see
+        :func:`rollingtop.integrate.integrate`).
+    **overrides
+        ``t_end, rtol, atol, samples, max_steps`` or ``model``, replacing the scenario's values.
+
+    Warns
+    -----
+    ContactLostWarning
+        When the normal reaction turns negative: the motion leaves the model's assumption that the
+        contact is kept. The trajectory is still returned, with ``contact_lost_at`` recorded.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    scenario = scenario.with_overrides(**overrides)
+    opts = scenario.integration
+    result = integrate(
+        scenario.model.code,
+        scenario.body.params,
+        scenario.y0,
+        opts.t_eval,
+        rtol=opts.rtol,
+        atol=opts.resolved_atol,
+        max_steps=opts.max_steps,
+        progress=progress,
+    )
+    traj = Trajectory(
+        body=scenario.body,
+        model=scenario.model,
+        t=result.t,
+        y=result.y,
+        rtol=opts.rtol,
+        atol=opts.resolved_atol,
+        stats={
+            "steps": result.steps,
+            "rejected_steps": result.rejected_steps,
+            "rhs_evals": result.rhs_evals,
+            "wall_time_s": result.wall_time_s,
+            "compile_time_s": result.compile_time_s,
+        },
+        step_reactions=result.reactions,
+    )
+    lost = traj.contact_lost_at
+    if lost is not None:
+        warnings.warn(
+            ContactLostWarning(
+                f"the normal reaction turns negative at t = {lost:.6g}: the body would leave the "
+                f"plane, and the {scenario.model.name!r} model (contact kept) no longer applies"
+            ),
+            stacklevel=2,
+        )
+    return traj

@@ -1,0 +1,331 @@
+"""The result of a simulation: samples, first integrals, reactions, export."""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rollingtop.body import SphericalTop
+from rollingtop.contact import ContactModel
+from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, POSITION, V, W
+from rollingtop.dynamics.integrals import evaluate
+from rollingtop.io import atomic_write, check_output_path
+
+__all__ = ["Trajectory", "OUTPUT_SUFFIXES"]
+
+OUTPUT_SUFFIXES = (".nc", ".csv")
+
+_UNITS = {
+    "t": "T",
+    "v": "L T-1",
+    "omega": "T-1",
+    "alpha": "1",
+    "beta": "1",
+    "gamma": "1",
+    "position": "L",
+    "contact_point": "L",
+    "normal_force": "M L T-2",
+    "tangential_force": "M L T-2",
+    "constraint_residual": "L T-1",
+    "orthonormality_error": "1",
+    "energy": "M L2 T-2",
+    "lagrange": "M L2 T-1",
+    "jellett": "M L3 T-1",
+    "area": "M L2 T-1",
+    "F6": "M L3 T-1",
+    "momentum_x": "M L T-1",
+    "momentum_y": "M L T-1",
+    "routh": "M L2 T-1",
+}
+
+
+def _finite_or_none(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+@dataclass
+class Trajectory:
+    """Samples of one motion with everything measured along it.
+
+    Attributes
+    ----------
+    body : SphericalTop
+    model : ContactModel
+    t : ndarray, shape (n,)
+    y : ndarray, shape (n, 17)
+        States ``(v, w, alpha, beta, gamma, X, Y)``, body-frame vectors.
+    rtol, atol : float
+        Tolerances the motion was integrated with.
+    stats : dict
+        ``steps, rejected_steps, rhs_evals, wall_time_s, compile_time_s``.
+    step_reactions : dict
+        Contact reactions monitored at every accepted step (not only at samples):
+        ``min_normal_force, t_min_normal_force, contact_lost_at, max_friction_ratio, ...``.
+    """
+
+    body: SphericalTop
+    model: ContactModel
+    t: np.ndarray
+    y: np.ndarray
+    rtol: float
+    atol: float
+    stats: dict = field(default_factory=dict)
+    step_reactions: dict = field(default_factory=dict)
+
+    # ---- state components -------------------------------------------------------------------
+    @property
+    def v(self) -> np.ndarray:
+        """CoM velocity, body frame, shape (n, 3)."""
+        return self.y[:, V]
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Angular velocity, body frame, shape (n, 3)."""
+        return self.y[:, W]
+
+    @property
+    def alpha(self) -> np.ndarray:
+        """Fixed ``x`` axis in the body frame, shape (n, 3)."""
+        return self.y[:, ALPHA]
+
+    @property
+    def beta(self) -> np.ndarray:
+        """Fixed ``y`` axis in the body frame, shape (n, 3)."""
+        return self.y[:, BETA]
+
+    @property
+    def gamma(self) -> np.ndarray:
+        """Upward vertical in the body frame, shape (n, 3)."""
+        return self.y[:, GAMMA]
+
+    @property
+    def position(self) -> np.ndarray:
+        """Horizontal CoM position ``(X, Y)`` in the fixed frame, shape (n, 2)."""
+        return self.y[:, POSITION]
+
+    @property
+    def contact_point(self) -> np.ndarray:
+        """Contact point on the plane, fixed frame, shape (n, 2).
+
+        ``(X, Y) + ((r, alpha), (r, beta))`` with ``r = -R gamma - a``, i.e.
+        ``(X - a3 alpha3, Y - a3 beta3)`` (``MODEL.md``, "Motion in absolute space").
+        """
+        return self.position - self.body.a3 * np.stack([self.y[:, 8], self.y[:, 11]], axis=-1)
+
+    # ---- measured quantities ----------------------------------------------------------------
+    @functools.cached_property
+    def integrals(self) -> dict[str, np.ndarray]:
+        """First integrals of the model and body along the samples, each shape (n,)."""
+        return evaluate(self.body, self.y, self.model.integrals(self.body.symmetric))
+
+    @functools.cached_property
+    def _diagnostics(self) -> np.ndarray:
+        out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
+        _kernel.diagnostics(self.model.code, self.body.params, np.ascontiguousarray(self.y), out)
+        return out
+
+    @property
+    def normal_force(self) -> np.ndarray:
+        """Normal reaction ``N = (F, gamma)`` at the samples, shape (n,); must stay positive."""
+        return self._diagnostics[:, 0]
+
+    @property
+    def tangential_force(self) -> np.ndarray:
+        """Magnitude of the constraint's horizontal force at the samples, shape (n,)."""
+        return self._diagnostics[:, 1]
+
+    @property
+    def friction_ratio(self) -> np.ndarray:
+        """Tangential over normal force, shape (n,): the friction coefficient the motion needs."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.normal_force > 0, self.tangential_force / self.normal_force, np.nan)
+
+    @property
+    def constraint_residuals(self) -> np.ndarray:
+        """Residual ``J_k u`` of each constraint row at the samples, shape (n, rows)."""
+        return self._diagnostics[:, 4 : 4 + len(self.model.constraints)]
+
+    @property
+    def orthonormality_error(self) -> np.ndarray:
+        """``max |Q Q^T - 1|`` of the frame ``Q = [alpha; beta; gamma]``, shape (n,)."""
+        return self._diagnostics[:, 3]
+
+    @property
+    def contact_lost_at(self) -> float | None:
+        """First time the normal force was negative (steps or samples), else ``None``."""
+        times = []
+        if self.step_reactions.get("contact_lost_at") is not None:
+            times.append(self.step_reactions["contact_lost_at"])
+        negative = np.flatnonzero(self.normal_force < 0)
+        if negative.size:
+            times.append(float(self.t[negative[0]]))
+        return min(times) if times else None
+
+    # ---- reports ----------------------------------------------------------------------------
+    def summary(self) -> dict:
+        """Summary as a JSON-ready dict (the output of ``rollingtop simulate --json``).
+
+        Keys: ``model, t_end, final, integrals, constraints, reactions, stats`` (see README).
+        """
+        last = self.y[-1]
+        final = {
+            "t": float(self.t[-1]),
+            "v": last[V].tolist(),
+            "omega": last[W].tolist(),
+            "alpha": last[ALPHA].tolist(),
+            "beta": last[BETA].tolist(),
+            "gamma": last[GAMMA].tolist(),
+            "position": last[POSITION].tolist(),
+            "contact_point": self.contact_point[-1].tolist(),
+        }
+        integrals = {}
+        for name, values in self.integrals.items():
+            drift = float(np.max(np.abs(values - values[0])))
+            initial = float(values[0])
+            integrals[name] = {
+                "initial": initial,
+                "final": float(values[-1]),
+                "max_abs_drift": drift,
+                "max_rel_drift": drift / abs(initial) if initial != 0 else None,
+            }
+        min_normal = min(float(np.min(self.normal_force)),
+                         self.step_reactions.get("min_normal_force", np.inf))  # fmt: skip
+        ratio = np.nanmax(self.friction_ratio) if np.any(self.normal_force > 0) else np.nan
+        max_ratio = max(float(ratio) if np.isfinite(ratio) else 0.0,
+                        self.step_reactions.get("max_friction_ratio", 0.0))  # fmt: skip
+        return {
+            "model": self.model.name,
+            "t_end": float(self.t[-1]),
+            "final": final,
+            "integrals": integrals,
+            "constraints": {
+                "max_abs_residual": float(np.max(np.abs(self.constraint_residuals))),
+                "orthonormality_max_error": float(np.max(self.orthonormality_error)),
+            },
+            "reactions": {
+                "min_normal_force": _finite_or_none(min_normal),
+                "max_friction_ratio": _finite_or_none(max_ratio),
+                "contact_lost_at": self.contact_lost_at,
+            },
+            "stats": {
+                "steps": int(self.stats["steps"]),
+                "rejected_steps": int(self.stats["rejected_steps"]),
+                "rhs_evals": int(self.stats["rhs_evals"]),
+                "wall_time_s": float(self.stats["wall_time_s"]),
+                "compile_time_s": float(self.stats.get("compile_time_s", 0.0)),
+            },
+        }
+
+    # ---- export -----------------------------------------------------------------------------
+    def _attrs(self) -> dict:
+        attrs = {f"body_{k}": v for k, v in self.body.to_dict().items()}
+        attrs.update(
+            model=self.model.name,
+            model_description=self.model.description,
+            constraints="; ".join(self.model.constraints),
+            rtol=self.rtol,
+            atol=self.atol,
+            summary_json=json.dumps(self.summary()),
+            units_note=(
+                "Quantities are in the scenario's own consistent units: L (length, the unit of R), "
+                "M (mass, of m), T (time, set by g). Vectors v, omega, alpha, beta, gamma are "
+                "body-frame components; position and contact_point are fixed-frame."
+            ),
+            references=(
+                "A. A. Kilin, T. B. Ivanova, Russian Journal of Nonlinear Dynamics 19(1), 2023, "
+                "3-17, doi:10.20537/nd221205"
+            ),
+            source="rollingtop",
+        )
+        return attrs
+
+    def to_xarray(self):
+        """The samples as an :class:`xarray.Dataset` with units and parameters as attributes."""
+        import xarray as xr
+
+        comp = ("1", "2", "3")
+        data = {
+            "v": (("t", "component"), self.v),
+            "omega": (("t", "component"), self.omega),
+            "alpha": (("t", "component"), self.alpha),
+            "beta": (("t", "component"), self.beta),
+            "gamma": (("t", "component"), self.gamma),
+            "position": (("t", "plane"), self.position),
+            "contact_point": (("t", "plane"), self.contact_point),
+            "normal_force": ("t", self.normal_force),
+            "tangential_force": ("t", self.tangential_force),
+            "constraint_residual": (("t", "constraint"), self.constraint_residuals),
+            "orthonormality_error": ("t", self.orthonormality_error),
+        }
+        for name, values in self.integrals.items():
+            data[name] = ("t", values)
+        ds = xr.Dataset(
+            data,
+            coords={
+                "t": self.t,
+                "component": list(comp),
+                "plane": ["X", "Y"],
+                "constraint": list(self.model.constraints),
+            },
+            attrs=self._attrs(),
+        )
+        for name in ds.variables:
+            if name in _UNITS:
+                ds[name].attrs["units"] = _UNITS[name]
+        ds["t"].attrs["long_name"] = "time"
+        return ds
+
+    def _csv_table(self) -> tuple[list[str], np.ndarray]:
+        cols = ["t"]
+        blocks = [self.t[:, None]]
+        for name, arr, parts in (
+            ("v", self.v, "123"),
+            ("omega", self.omega, "123"),
+            ("alpha", self.alpha, "123"),
+            ("beta", self.beta, "123"),
+            ("gamma", self.gamma, "123"),
+            ("", self.position, ("X", "Y")),
+            ("contact_", self.contact_point, ("x", "y")),
+        ):
+            cols += [f"{name}{c}" for c in parts]
+            blocks.append(arr)
+        cols += ["normal_force", "tangential_force", "max_constraint_residual"]
+        blocks.append(np.stack([self.normal_force, self.tangential_force,
+                                np.max(np.abs(self.constraint_residuals), axis=1)], axis=1))  # fmt: skip
+        for name, values in self.integrals.items():
+            cols.append(name)
+            blocks.append(values[:, None])
+        return cols, np.hstack(blocks)
+
+    def to_csv(self, path) -> Path:
+        """Write the samples as CSV (one header row; ``#`` comment lines carry the parameters)."""
+        path = check_output_path(path, (".csv",))
+        cols, table = self._csv_table()
+        header = "\n".join(f"{k} = {v}" for k, v in self._attrs().items() if k != "summary_json")
+
+        def write(tmp: Path) -> None:
+            with open(tmp, "w", encoding="utf-8", newline="") as fh:
+                for line in header.splitlines():
+                    fh.write(f"# {line}\n")
+                fh.write(",".join(cols) + "\n")
+                np.savetxt(fh, table, delimiter=",", fmt="%.17g")
+
+        return atomic_write(path, write)
+
+    def to_netcdf(self, path) -> Path:
+        """Write the samples as NetCDF-4 (engine ``h5netcdf``), atomically."""
+        path = check_output_path(path, (".nc",))
+        ds = self.to_xarray()
+        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+    def save(self, path) -> Path:
+        """Write to ``.nc`` (NetCDF) or ``.csv``, chosen by the suffix."""
+        path = check_output_path(path, OUTPUT_SUFFIXES)
+        return self.to_netcdf(path) if path.suffix.lower() == ".nc" else self.to_csv(path)
