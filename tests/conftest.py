@@ -1,0 +1,42 @@
+"""Shared fixtures. Reference values cite their source; tolerances are named where used."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rollingtop import SphericalTop
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+#: Kilin & Ivanova (2023), Fig. 5: R = 1, m = 1, g = 1, a3 = 0.1, I1 = 0.3, I3 = 0.5.
+PAPER_BODY = dict(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5)
+
+#: Initial conditions of examples/paper.toml, with each model's free velocity.
+GAMMA0 = (0.0, 0.6, 0.8)
+OMEGA0 = (0.7, -0.3, 2.0)
+FREE = {"meridian": {"v_tau": 0.25}, "smooth": {"v_horizontal": (0.3, -0.2)}, "rough": {}}
+
+
+@pytest.fixture
+def paper_body() -> SphericalTop:
+    return SphericalTop(**PAPER_BODY)
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20231205)
+
+
+def scenario_text(model: str = "meridian", **sections) -> str:
+    """TOML text of a scenario on the paper's body; ``sections`` replace whole tables."""
+    free = {"meridian": "v_tau = 0.25", "smooth": "v_horizontal = [0.3, -0.2]", "rough": ""}[model]
+    tables = {
+        "body": "R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5",
+        "contact": f'model = "{model}"',
+        "initial": f"gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\n{free}",
+        "integration": "t_end = 2.0\nrtol = 1e-10\nsamples = 21",
+    }
+    tables.update(sections)
+    return "\n".join(f"[{k}]\n{v}\n" for k, v in tables.items() if v is not None)

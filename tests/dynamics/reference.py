@@ -1,0 +1,76 @@
+"""A plain NumPy implementation of the equations of motion, written from MODEL.md for the tests.
+
+It does not import the package. It solves the full linear system of MODEL.md, "Dynamics", for
+the unknowns ``(v', w', lambda_1..k)`` with ``numpy.linalg.solve`` (the package eliminates the
+accelerations and factorises the multiplier block instead), and differentiates the constraints
+in the vector form ``d/dt (vp, d) = (v' + w' x r + w x r', d) + (vp, d') = 0`` with
+``nu = (e3 - gamma3 gamma)/sqrt(1 - gamma3^2)`` written exactly as in the paper (eq. 2.6).
+"""
+
+import numpy as np
+
+E3 = np.array([0.0, 0.0, 1.0])
+
+
+def directions(model, alpha, beta, gamma, w):
+    """Constraint directions ``d_k`` and their time derivatives ``d_k'`` along the motion."""
+    gdot = np.cross(gamma, w)
+    dirs = [(gamma, gdot)]
+    if model == "meridian":
+        g3, g3dot = gamma[2], gdot[2]
+        s = np.sqrt(1.0 - g3**2)
+        sdot = -g3 * g3dot / s
+        p = E3 - g3 * gamma
+        pdot = -g3dot * gamma - g3 * gdot
+        dirs.append((p / s, pdot / s - p * sdot / s**2))
+    elif model == "rough":
+        # vp = 0 as f1 plus (vp, alpha) = (vp, beta) = 0 (MODEL.md; the package uses body axes)
+        dirs += [(alpha, np.cross(alpha, w)), (beta, np.cross(beta, w))]
+    elif model != "smooth":
+        raise ValueError(model)
+    return dirs
+
+
+def rhs(model, p, y):
+    """``y'`` and the contact force ``F`` (body frame) for state ``y`` of the package's layout."""
+    R, m, g, a3, I1, I2, I3 = p
+    Iv = np.array([I1, I2, I3])
+    v, w = y[0:3], y[3:6]
+    alpha, beta, gamma = y[6:9], y[9:12], y[12:15]
+    r = -R * gamma - np.array([0.0, 0.0, a3])
+    rdot = -R * np.cross(gamma, w)
+    vp = v + np.cross(w, r)
+    dirs = directions(model, alpha, beta, gamma, w)
+    k = len(dirs)
+    M = np.zeros((6 + k, 6 + k))
+    b = np.zeros(6 + k)
+    M[0:3, 0:3] = m * np.eye(3)
+    M[3:6, 3:6] = np.diag(Iv)
+    b[0:3] = m * np.cross(v, w) - m * g * gamma
+    b[3:6] = np.cross(Iv * w, w)
+    for i, (d, ddot) in enumerate(dirs):
+        M[0:3, 6 + i] = -d
+        M[3:6, 6 + i] = -np.cross(r, d)
+        # (v', d) + (w' x r, d) = -(w x r', d) - (vp, d');  (w' x r, d) = (w', r x d)
+        M[6 + i, 0:3] = d
+        M[6 + i, 3:6] = np.cross(r, d)
+        b[6 + i] = -np.cross(w, rdot) @ d - vp @ ddot
+    sol = np.linalg.solve(M, b)
+    lam = sol[6:]
+    force = sum(l * d for l, (d, _) in zip(lam, dirs, strict=True))
+    dy = np.empty(17)
+    dy[0:6] = sol[0:6]
+    dy[6:9] = np.cross(alpha, w)
+    dy[9:12] = np.cross(beta, w)
+    dy[12:15] = np.cross(gamma, w)
+    dy[15] = v @ alpha
+    dy[16] = v @ beta
+    return dy, force
+
+
+def reactions(model, p, y):
+    """Normal force ``(F, gamma)`` and tangential force ``|F - (F, gamma) gamma|``."""
+    _, F = rhs(model, p, y)
+    gamma = y[12:15]
+    N = F @ gamma
+    return N, np.linalg.norm(F - N * gamma)
