@@ -40,12 +40,13 @@ T, H_ABS, T_END, RTOL, ATOL = 0, 1, 2, 3, 4
 # Indices into the integer counter array ``counts``.
 NEXT_SAMPLE, STEPS, REJECTED, NFEV = 0, 1, 2, 3
 # Indices into the reaction-tracking array ``track``.
-MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO = 0, 1, 2, 3, 4
+MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 0, 1, 2, 3, 4, 5
 
 
 def new_track():
-    """Reaction-tracking array: min normal force and when, first time it is < 0, max ratio."""
-    return np.array([np.inf, np.nan, np.nan, 0.0, np.nan])
+    """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
+    the normal force at the last accepted step."""
+    return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
 
 
 @njit(cache=True, error_model="numpy")
@@ -104,7 +105,56 @@ def _stage(K, s, y, h, ytmp):
 
 
 @njit(cache=True, error_model="numpy")
-def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, Fd, ws):
+def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
+    """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
+    n = y.shape[0]
+    for s in range(13, 16):
+        _stage(K, s, y, h, ytmp)
+        rhs(code, p, ytmp, K[s], ws)
+    for i in range(n):
+        dlt = ynew[i] - y[i]
+        Fd[0, i] = dlt
+        Fd[1, i] = h * K[0, i] - dlt
+        Fd[2, i] = 2.0 * dlt - h * (K[12, i] + K[0, i])
+        for r in range(4):
+            acc = 0.0
+            for j in range(16):
+                acc += D[r, j] * K[j, i]
+            Fd[3 + r, i] = h * acc
+
+
+@njit(cache=True, error_model="numpy")
+def _dense_eval(Fd, y, x, out):
+    """State at the fraction ``x`` of the step: ``y + sum`` of the interpolant's terms."""
+    for i in range(y.shape[0]):
+        acc = 0.0
+        for r in range(6, -1, -1):
+            acc += Fd[r, i]
+            acc *= x if (6 - r) % 2 == 0 else 1.0 - x
+        out[i] = y[i] + acc
+
+
+@njit(cache=True, error_model="numpy")
+def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
+    """Time in ``[t, t + h]`` where the normal force crosses zero, by bisection on the dense
+    output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings."""
+    dy = np.empty(y.shape[0])
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        _dense_eval(Fd, y, mid, ytmp)
+        project(code, p, ytmp, ws)
+        nc = rhs(code, p, ytmp, dy, ws)
+        N, _ = reaction(nc, ytmp, ws)
+        if N >= 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return t + 0.5 * (lo + hi) * h
+
+
+@njit(cache=True, error_model="numpy")
+def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, y_old, Fd, ws):
     """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
 
     Parameters
@@ -127,9 +177,9 @@ def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, 
         Samples, each projected onto the constraints.
     budget : int
         Maximum number of accepted steps in this call (the caller resumes for progress output).
-    K, ynew, ytmp, Fd, ws
-        Work arrays: stages ``(16, 17)``, two states, dense-output coefficients ``(7, 17)`` and the
-        kernel workspace.
+    K, ynew, ytmp, y_old, Fd, ws
+        Work arrays: stages ``(16, 17)``, three states, dense-output coefficients ``(7, 17)`` and
+        the kernel workspace.
 
     Returns
     -------
@@ -202,35 +252,20 @@ def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, 
                 counts[REJECTED] += 1
                 rejected = True
         # Dense output over [t, t_new] for the samples that fall in it.
+        dense_ready = False
         k = counts[NEXT_SAMPLE]
         if k < n_samples and t_eval[k] <= t_new:
-            for s in range(13, 16):
-                _stage(K, s, y, h, ytmp)
-                rhs(code, p, ytmp, K[s], ws)
+            _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
             counts[NFEV] += 3
-            for i in range(n):
-                dlt = ynew[i] - y[i]
-                Fd[0, i] = dlt
-                Fd[1, i] = h * K[0, i] - dlt
-                Fd[2, i] = 2.0 * dlt - h * (K[12, i] + K[0, i])
-                for r in range(4):
-                    acc = 0.0
-                    for j in range(16):
-                        acc += D[r, j] * K[j, i]
-                    Fd[3 + r, i] = h * acc
+            dense_ready = True
             while k < n_samples and t_eval[k] <= t_new:
-                x = (t_eval[k] - t) / h
-                for i in range(n):
-                    acc = 0.0
-                    for r in range(6, -1, -1):
-                        acc += Fd[r, i]
-                        acc *= x if (6 - r) % 2 == 0 else 1.0 - x
-                    out[k, i] = y[i] + acc
+                _dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
                 project(code, p, out[k], ws)
                 k += 1
             counts[NEXT_SAMPLE] = k
         # Accept: project onto the constraints and re-evaluate the derivative there.
         for i in range(n):
+            y_old[i] = y[i]
             y[i] = ynew[i]
         project(code, p, y, ws)
         nc = rhs(code, p, y, f, ws)
@@ -240,6 +275,14 @@ def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, 
                 ctrl[T] = t_new
                 return NOT_FINITE
         N, T_force = reaction(nc, y, ws)
+        if N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and track[LAST_NORMAL] >= 0.0:
+            # first loss of contact: locate N = 0 inside the step on the dense output
+            if not dense_ready:
+                _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
+                counts[NFEV] += 3
+            track[T_CONTACT_LOST] = _normal_root(code, p, Fd, y_old, t, h, ytmp, ws)
+            counts[NFEV] += 60
+        track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
         t = t_new
         counts[STEPS] += 1

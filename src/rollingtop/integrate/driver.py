@@ -56,6 +56,7 @@ def _workspace(n_samples: int):
         K=np.zeros((16, N_STATE)),
         ynew=np.zeros(N_STATE),
         ytmp=np.zeros(N_STATE),
+        y_old=np.zeros(N_STATE),
         Fd=np.zeros((7, N_STATE)),
         ws=_kernel.new_workspace(),
         out=np.full((n_samples, N_STATE), np.nan),
@@ -91,7 +92,9 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
     f = np.zeros(N_STATE)
     nc = _kernel.rhs(code, p, y, f, w["ws"])
     track = dop.new_track()
-    dop.update_track(track, t_eval[0], *_kernel.reaction(nc, y, w["ws"]))
+    N0, T0 = _kernel.reaction(nc, y, w["ws"])
+    dop.update_track(track, t_eval[0], N0, T0)
+    track[dop.LAST_NORMAL] = N0
     t0, t_end = float(t_eval[0]), float(t_eval[-1])
     h0 = dop.initial_step(code, p, y, f, t_end, t0, rtol, atol, w["ytmp"], w["ynew"], w["ws"])
     ctrl = np.array([t0, h0, t_end, rtol, atol])
@@ -105,7 +108,7 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
         if max_steps is not None:
             budget = min(budget, max_steps - int(counts[dop.STEPS]))
         status = dop.run(code, p, y, f, ctrl, counts, track, t_eval, w["out"], budget,
-                         w["K"], w["ynew"], w["ytmp"], w["Fd"], w["ws"])  # fmt: skip
+                         w["K"], w["ynew"], w["ytmp"], w["y_old"], w["Fd"], w["ws"])  # fmt: skip
         if progress is not None:
             progress(float(ctrl[dop.T]))
         if status != dop.BUDGET_EXHAUSTED:

@@ -1,0 +1,129 @@
+"""The compiled DOP853 stepper: dense output, convergence, step control, monitoring."""
+
+import warnings
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from rollingtop import ContactLostWarning, IntegrationError, SphericalTop, simulate
+from rollingtop.dynamics import _kernel
+from rollingtop.integrate import integrate
+from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
+
+from ..conftest import GAMMA0, OMEGA0, PAPER_BODY
+from ..dynamics import reference
+
+
+def scenario(t_end=20.0, rtol=1e-10, atol=None, samples=101, model="meridian", **initial):
+    init = dict(gamma=GAMMA0, omega=OMEGA0, free={"v_tau": 0.25}) | initial
+    if model != "meridian":
+        init["free"] = {}
+    return Scenario(SphericalTop(**PAPER_BODY), model, InitialConditions(**init),
+                    IntegrationOptions(t_end=t_end, rtol=rtol, atol=atol, samples=samples))  # fmt: skip
+
+
+def test_dense_output_matches_integration_to_each_sample():
+    """A sample from the 7th-order interpolant equals integrating to that time as the end point."""
+    sc = scenario(t_end=3.0, rtol=1e-12, samples=7)
+    t_eval = np.array([0.0, 0.37, 1.1, 1.234567, 2.9])
+    dense = integrate(0, sc.body.params, sc.y0, t_eval, rtol=1e-12, atol=1e-14).y
+    for k in range(1, len(t_eval)):
+        direct = integrate(0, sc.body.params, sc.y0, t_eval[[0, k]], rtol=1e-12, atol=1e-14).y[-1]
+        np.testing.assert_allclose(dense[k], direct, rtol=0, atol=1e-10)
+
+
+def test_error_decreases_with_tolerance_like_an_eighth_order_method():
+    """Final-state error against solve_ivp(DOP853, rtol 1e-13) shrinks as rtol does, and the
+    number of steps grows like rtol**(-1/8) (within a factor 2)."""
+    sc = scenario(t_end=10.0)
+    ref = solve_ivp(lambda t, y: reference.rhs("meridian", sc.body.params, y)[0], (0, 10.0), sc.y0,
+                    method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]  # fmt: skip
+    errors, steps = [], []
+    for rtol in (1e-6, 1e-8, 1e-10):
+        r = integrate(0, sc.body.params, sc.y0, np.array([0.0, 10.0]), rtol=rtol, atol=rtol / 100)
+        errors.append(np.max(np.abs(r.y[-1] - ref)))
+        steps.append(r.steps)
+    assert errors[0] > 10 * errors[1] > 100 * errors[2]
+    assert errors[2] < 1e-8
+    ratio = steps[2] / steps[0]
+    assert 100 ** (1 / 8) / 2 < ratio < 100 ** (1 / 8) * 2
+
+
+def test_step_count_close_to_scipy_dop853():
+    """Same method and controller as SciPy's DOP853: similar number of accepted steps."""
+    sc = scenario(t_end=20.0)
+    ws = _kernel.new_workspace()
+
+    def f(t, y):
+        dy = np.empty(17)
+        _kernel.rhs(0, sc.body.params, np.ascontiguousarray(y), dy, ws)
+        return dy
+
+    sol = solve_ivp(f, (0, 20.0), sc.y0, method="DOP853", rtol=1e-10, atol=1e-12)
+    ours = integrate(0, sc.body.params, sc.y0, np.array([0.0, 20.0]), rtol=1e-10, atol=1e-12)
+    scipy_steps = len(sol.t) - 1
+    assert abs(ours.steps - scipy_steps) <= 0.1 * scipy_steps
+    assert ours.rhs_evals >= 12 * ours.steps
+
+
+def test_progress_callback_does_not_change_the_result(monkeypatch):
+    from rollingtop.integrate import driver
+
+    monkeypatch.setattr(driver, "PROGRESS_CHUNK", 50)
+    sc = scenario(t_end=50.0, samples=11)
+    seen = []
+    with_progress = simulate(sc, progress=seen.append)
+    plain = simulate(sc)
+    np.testing.assert_array_equal(with_progress.y, plain.y)
+    assert len(seen) > 5 and seen == sorted(seen) and seen[-1] == 50.0
+
+
+def test_max_steps_is_enforced():
+    with pytest.raises(IntegrationError, match="max_steps = 10 accepted steps reached"):
+        simulate(scenario(t_end=100.0), max_steps=10)
+
+
+def test_contact_loss_is_warned_and_located():
+    """A top with a3 = 0.5 spun about a horizontal axis lifts off; the time N = 0 is located to
+    1e-8 against a root of the NumPy reference's normal force on a solve_ivp dense solution."""
+    body = SphericalTop(R=1, m=1, g=1, a3=0.5, I1=0.3, I3=0.5)
+    sc = Scenario(body, "meridian", InitialConditions(gamma=GAMMA0, omega=(1.4, 0, 0.3)),
+                  IntegrationOptions(t_end=10, samples=201))  # fmt: skip
+    with pytest.warns(ContactLostWarning, match="normal reaction turns negative at t = 2.83"):
+        traj = simulate(sc)
+    sol = solve_ivp(lambda t, y: reference.rhs("meridian", body.params, y)[0], (0, 4), sc.y0,
+                    method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)  # fmt: skip
+
+    def normal(t):
+        return reference.reactions("meridian", body.params, sol.sol(t))[0]
+
+    grid = np.linspace(0, 4, 401)
+    first = np.flatnonzero([normal(t) < 0 for t in grid])[0]
+    root = brentq(normal, grid[first - 1], grid[first], xtol=1e-14)
+    assert traj.contact_lost_at == pytest.approx(root, abs=1e-8)
+    assert traj.summary()["reactions"]["contact_lost_at"] == traj.contact_lost_at
+    assert traj.summary()["reactions"]["min_normal_force"] < 0
+
+
+def test_no_warning_when_contact_is_kept():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ContactLostWarning)
+        traj = simulate(scenario(t_end=5.0))
+    assert traj.contact_lost_at is None
+    assert traj.summary()["reactions"]["min_normal_force"] > 0
+
+
+def test_friction_ratio_tracked_at_steps_covers_samples():
+    traj = simulate(scenario(t_end=20.0, samples=51))
+    s = traj.summary()["reactions"]
+    assert s["max_friction_ratio"] >= np.nanmax(traj.friction_ratio)
+    smooth = simulate(scenario(t_end=5.0, model="smooth"))
+    assert smooth.summary()["reactions"]["max_friction_ratio"] < 1e-12  # frictionless
+
+
+def test_rejects_bad_t_eval():
+    sc = scenario()
+    with pytest.raises(ValueError, match="strictly increasing"):
+        integrate(0, sc.body.params, sc.y0, np.array([0.0, 1.0, 1.0]), rtol=1e-8, atol=1e-10)
