@@ -20,8 +20,12 @@ def test_all_violations_reported_together():
     with pytest.raises(BodyError) as err:
         SphericalTop(R=-1.0, m=0.0, g=-9.8, a3=0.1, I1=0.3, I3=0.7)
     msg = str(err.value)
-    for part in ("R = -1 must be > 0", "m = 0 must be > 0", "g = -9.8 must be >= 0",
-                 "I3 = 0.7 violates the rigid-body triangle inequality I3 <= I1 + I2 = 0.6"):  # fmt: skip
+    for part in (
+        "R = -1 must be > 0",
+        "m = 0 must be > 0",
+        "g = -9.8 must be >= 0",
+        "I3 = 0.7 violates the rigid-body triangle inequality I3 <= I1 + I2 = 0.6",
+    ):
         assert part in msg
     assert msg.count(";") == 3
 
@@ -32,7 +36,10 @@ def test_all_violations_reported_together():
         (dict(a3=1.0), r"a3 = 1 violates \|a3\| < R = 1"),
         (dict(a3=-1.5), r"a3 = -1.5 violates \|a3\| < R"),
         (dict(I1=0.0), "I1 = 0 must be > 0"),
-        (dict(I2=0.9), "I2 = 0.9 violates the rigid-body triangle inequality I2 <= I1 \\+ I3 = 0.8"),
+        (
+            dict(I2=0.9),
+            "I2 = 0.9 violates the rigid-body triangle inequality I2 <= I1 \\+ I3 = 0.8",
+        ),
         (dict(m=float("nan")), "m = nan must be a finite real number"),
         (dict(R="1"), "R = '1' must be a finite real number"),
         (dict(g=True), "g = True must be a finite real number"),

@@ -124,12 +124,14 @@ class SphericalTop:
 
     @property
     def params(self) -> np.ndarray:
-        """Parameter vector ``(R, m, g, a3, I1, I2, I3)`` passed to the compiled kernels, shape (7,)."""
+        """Parameters ``(R, m, g, a3, I1, I2, I3)`` for the compiled kernels, shape (7,)."""
         return np.array([self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3], dtype=float)
 
     def rho(self, gamma3):
-        """Density of the invariant measure ``rho = I1 + m (a3^2 + R^2 + 2 a3 R gamma3)`` (eq. 3.3)."""
-        return self.I1 + self.m * (self.a3**2 + self.R**2 + 2 * self.a3 * self.R * np.asarray(gamma3))
+        """Invariant-measure density ``rho = I1 + m (a3^2 + R^2 + 2 a3 R gamma3)`` (eq. 3.3)."""
+        return self.I1 + self.m * (
+            self.a3**2 + self.R**2 + 2 * self.a3 * self.R * np.asarray(gamma3)
+        )
 
     def to_dict(self) -> dict[str, float]:
         """Parameters as a plain dictionary (``I2`` included)."""

@@ -55,8 +55,13 @@ def _integrals_table(summary: dict):
         table.add_column(col, justify="right" if col != "integral" else "left")
     for name, row in summary["integrals"].items():
         rel = row["max_rel_drift"]
-        table.add_row(name, f"{row['initial']:.15g}", f"{row['final']:.15g}",
-                      f"{row['max_abs_drift']:.2e}", "-" if rel is None else f"{rel:.2e}")  # fmt: skip
+        table.add_row(
+            name,
+            f"{row['initial']:.15g}",
+            f"{row['final']:.15g}",
+            f"{row['max_abs_drift']:.2e}",
+            "-" if rel is None else f"{rel:.2e}",
+        )
     return table
 
 
@@ -71,7 +76,8 @@ def _print_report(summary: dict) -> None:
         f"constraints: max |residual| {c['max_abs_residual']:.2e}, "
         f"orthonormality error {c['orthonormality_max_error']:.2e}\n"
         f"reactions: min normal force {r['min_normal_force']:.6g}, friction coefficient needed "
-        f"{r['max_friction_ratio']:.6g}" + ("" if lost is None else f", CONTACT LOST at t = {lost:.6g}")
+        f"{r['max_friction_ratio']:.6g}"
+        + ("" if lost is None else f", CONTACT LOST at t = {lost:.6g}")
         + f"\nsteps {s['steps']} (+{s['rejected_steps']} rejected), {s['rhs_evals']} rhs "
         f"evaluations, {s['wall_time_s']:.3f} s (+{s['compile_time_s']:.2f} s compile/load)",
         highlight=False,
@@ -90,7 +96,9 @@ def _print_report(summary: dict) -> None:
     default=None,
     help="Contact model, overriding the scenario's: meridian, smooth, rough.",
 )
-@click.option("-o", "--output", type=click.Path(), default=None, help="Write samples to OUT.nc or OUT.csv.")
+@click.option(
+    "-o", "--output", type=click.Path(), default=None, help="Write samples to OUT.nc or OUT.csv."
+)
 @click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
 def simulate(scenario, t_end, rtol, atol, samples, model, output, as_json):
     """Simulate SCENARIO.toml and print its integrals, constraints and reactions."""

@@ -93,8 +93,12 @@ class IntegrationOptions:
             raise ScenarioError(f"integration.samples = {samples} must be >= 2")
         if max_steps < 1:
             raise ScenarioError(f"integration.max_steps = {max_steps} must be >= 1")
-        for k, val in (("t_end", t_end), ("rtol", rtol), ("samples", samples),
-                       ("max_steps", max_steps)):  # fmt: skip
+        for k, val in (
+            ("t_end", t_end),
+            ("rtol", rtol),
+            ("samples", samples),
+            ("max_steps", max_steps),
+        ):
             object.__setattr__(self, k, val)
         if self.atol is not None:
             object.__setattr__(self, "atol", atol)
@@ -124,9 +128,15 @@ class InitialConditions:
     def state(self, body: SphericalTop, model: ContactModel) -> np.ndarray:
         """The constraint-consistent state vector, shape (17,)."""
         return initial_state(
-            body, model, gamma=self.gamma, omega=self.omega, alpha=self.alpha,
-            position=self.position, v=self.v, free=self.free,
-        )  # fmt: skip
+            body,
+            model,
+            gamma=self.gamma,
+            omega=self.omega,
+            alpha=self.alpha,
+            position=self.position,
+            v=self.v,
+            free=self.free,
+        )
 
 
 @dataclass(frozen=True)
@@ -167,9 +177,7 @@ class Scenario:
         allowed_tables = ("body", "contact", "initial", "integration")
         for key, value in data.items():
             if key not in allowed_tables:
-                raise ScenarioError(
-                    f"unknown table [{key}] (allowed: {', '.join(allowed_tables)})"
-                )
+                raise ScenarioError(f"unknown table [{key}] (allowed: {', '.join(allowed_tables)})")
             if not isinstance(value, dict):
                 raise ScenarioError(f"[{key}] must be a table")
         for required in ("body", "initial"):

@@ -145,7 +145,9 @@ class Trajectory:
     def friction_ratio(self) -> np.ndarray:
         """Tangential over normal force, shape (n,): the friction coefficient the motion needs."""
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.normal_force > 0, self.tangential_force / self.normal_force, np.nan)
+            return np.where(
+                self.normal_force > 0, self.tangential_force / self.normal_force, np.nan
+            )
 
     @property
     def constraint_residuals(self) -> np.ndarray:
@@ -195,11 +197,14 @@ class Trajectory:
                 "max_abs_drift": drift,
                 "max_rel_drift": drift / abs(initial) if initial != 0 else None,
             }
-        min_normal = min(float(np.min(self.normal_force)),
-                         self.step_reactions.get("min_normal_force", np.inf))  # fmt: skip
+        min_normal = min(
+            float(np.min(self.normal_force)), self.step_reactions.get("min_normal_force", np.inf)
+        )
         ratio = np.nanmax(self.friction_ratio) if np.any(self.normal_force > 0) else np.nan
-        max_ratio = max(float(ratio) if np.isfinite(ratio) else 0.0,
-                        self.step_reactions.get("max_friction_ratio", 0.0))  # fmt: skip
+        max_ratio = max(
+            float(ratio) if np.isfinite(ratio) else 0.0,
+            self.step_reactions.get("max_friction_ratio", 0.0),
+        )
         return {
             "model": self.model.name,
             "t_end": float(self.t[-1]),
@@ -297,8 +302,16 @@ class Trajectory:
             cols += [f"{name}{c}" for c in parts]
             blocks.append(arr)
         cols += ["normal_force", "tangential_force", "max_constraint_residual"]
-        blocks.append(np.stack([self.normal_force, self.tangential_force,
-                                np.max(np.abs(self.constraint_residuals), axis=1)], axis=1))  # fmt: skip
+        blocks.append(
+            np.stack(
+                [
+                    self.normal_force,
+                    self.tangential_force,
+                    np.max(np.abs(self.constraint_residuals), axis=1),
+                ],
+                axis=1,
+            )
+        )
         for name, values in self.integrals.items():
             cols.append(name)
             blocks.append(values[:, None])

@@ -18,8 +18,12 @@ VARIES = 1e-3
 
 def run(model, *, t_end=1000.0, I2=None, rtol=1e-12, atol=1e-14, samples=2001):
     body = SphericalTop(**PAPER_BODY, I2=I2)
-    sc = Scenario(body, model, InitialConditions(gamma=GAMMA0, omega=OMEGA0, free=FREE[model]),
-                  IntegrationOptions(t_end=t_end, rtol=rtol, atol=atol, samples=samples))  # fmt: skip
+    sc = Scenario(
+        body,
+        model,
+        InitialConditions(gamma=GAMMA0, omega=OMEGA0, free=FREE[model]),
+        IntegrationOptions(t_end=t_end, rtol=rtol, atol=atol, samples=samples),
+    )
     return simulate(sc)
 
 
@@ -68,16 +72,20 @@ def test_jellett_area_lagrange_identity(long_run):
     """MODEL.md: F4 + a3 F3 + R F5 = 0 holds identically (it is a kinematic identity)."""
     body = long_run.body
     F = evaluate(body, long_run.y, ["jellett", "lagrange", "area"])
-    np.testing.assert_allclose(F["jellett"] + body.a3 * F["lagrange"] + body.R * F["area"], 0,
-                               atol=1e-14)  # fmt: skip
+    np.testing.assert_allclose(
+        F["jellett"] + body.a3 * F["lagrange"] + body.R * F["area"], 0, atol=1e-14
+    )
 
 
 @pytest.mark.parametrize("model", ["meridian", "smooth", "rough"])
 def test_general_body_keeps_only_what_holds(model):
     """With I2 != I1 the symmetric integrals are dropped, and what is kept is conserved."""
     traj = run(model, t_end=200.0, I2=0.4, samples=401)
-    expected = {"meridian": {"energy", "area"}, "smooth": {"energy", "area", "momentum_x",
-                "momentum_y"}, "rough": {"energy"}}[model]  # fmt: skip
+    expected = {
+        "meridian": {"energy", "area"},
+        "smooth": {"energy", "area", "momentum_x", "momentum_y"},
+        "rough": {"energy"},
+    }[model]
     assert set(traj.integrals) == expected
     for name, values in traj.integrals.items():
         assert rel_variation(values) <= DRIFT_REL, name

@@ -19,21 +19,38 @@ FINAL_STATE_TOL = 1e-8  # final-state agreement after t = 20 (both integrate at 
 def random_state(rng, body, model):
     gamma = rng.normal(size=3)
     gamma /= np.linalg.norm(gamma)
-    free = {"meridian": {"v_tau": rng.normal()}, "smooth": {"v_horizontal": rng.normal(size=2)},
-            "rough": {}}[model]  # fmt: skip
+    free = {
+        "meridian": {"v_tau": rng.normal()},
+        "smooth": {"v_horizontal": rng.normal(size=2)},
+        "rough": {},
+    }[model]
     a = rng.normal(size=3)
     alpha = a - (a @ gamma) * gamma
     alpha /= np.linalg.norm(alpha)
-    return initial_state(body, model, gamma=gamma, omega=rng.normal(size=3) * 2, alpha=alpha,
-                         position=rng.normal(size=2), free=free)  # fmt: skip
+    return initial_state(
+        body,
+        model,
+        gamma=gamma,
+        omega=rng.normal(size=3) * 2,
+        alpha=alpha,
+        position=rng.normal(size=2),
+        free=free,
+    )
 
 
 def random_body(rng):
     I1, I2 = rng.uniform(0.2, 1.0, size=2)
     I3 = rng.uniform(abs(I1 - I2) + 0.05, I1 + I2 - 0.05)
     R = rng.uniform(0.5, 2.0)
-    return SphericalTop(R=R, m=rng.uniform(0.5, 3), g=rng.uniform(0, 10),
-                        a3=rng.uniform(-0.9, 0.9) * R, I1=I1, I3=I3, I2=I2)  # fmt: skip
+    return SphericalTop(
+        R=R,
+        m=rng.uniform(0.5, 3),
+        g=rng.uniform(0, 10),
+        a3=rng.uniform(-0.9, 0.9) * R,
+        I1=I1,
+        I3=I3,
+        I2=I2,
+    )
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -73,11 +90,22 @@ def test_rhs_keeps_constraints_to_first_order(model, rng):
 def test_final_state_matches_solve_ivp(model, I2):
     """Package (compiled DOP853 + projection) vs solve_ivp(DOP853) on the NumPy reference."""
     body = SphericalTop(**PAPER_BODY, I2=I2)
-    sc = Scenario(body, model, InitialConditions(gamma=GAMMA0, omega=OMEGA0, free=FREE[model]),
-                  IntegrationOptions(t_end=20.0, rtol=1e-12, atol=1e-14, samples=5))  # fmt: skip
+    sc = Scenario(
+        body,
+        model,
+        InitialConditions(gamma=GAMMA0, omega=OMEGA0, free=FREE[model]),
+        IntegrationOptions(t_end=20.0, rtol=1e-12, atol=1e-14, samples=5),
+    )
     traj = simulate(sc)
-    sol = solve_ivp(lambda t, y: reference.rhs(model, body.params, y)[0], (0.0, 20.0), sc.y0,
-                    method="DOP853", rtol=1e-12, atol=1e-14, t_eval=traj.t)  # fmt: skip
+    sol = solve_ivp(
+        lambda t, y: reference.rhs(model, body.params, y)[0],
+        (0.0, 20.0),
+        sc.y0,
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-14,
+        t_eval=traj.t,
+    )
     assert sol.success
     np.testing.assert_allclose(traj.y, sol.y.T, rtol=0, atol=FINAL_STATE_TOL)
     # the reference reactions at the package's samples

@@ -38,7 +38,7 @@ def test_constructed_state_satisfies_constraints(paper_body, model, free):
 
 
 def test_default_alpha_points_along_the_axis_projection(paper_body):
-    """Default: fixed x axis along the horizontal projection of e3, so psi = atan2(beta3, alpha3) = 0."""
+    """Default: fixed x axis along the axis projection, so psi = atan2(beta3, alpha3) = 0."""
     y = initial_state(paper_body, "meridian", gamma=GAMMA0, omega=OMEGA0)
     alpha, beta = y[6:9], y[9:12]
     assert np.arctan2(beta[2], alpha[2]) == pytest.approx(0.0, abs=EXACT)
@@ -76,8 +76,9 @@ def test_bad_initial_conditions(paper_body, kwargs, message):
 
 def test_velocity_violating_only_the_meridian_row(paper_body):
     """A velocity consistent with contact but slipping along nu names the meridian constraint."""
-    y = initial_state(paper_body, "smooth", gamma=GAMMA0, omega=OMEGA0,
-                      free={"v_horizontal": (0.5, 0.5)})  # fmt: skip
+    y = initial_state(
+        paper_body, "smooth", gamma=GAMMA0, omega=OMEGA0, free={"v_horizontal": (0.5, 0.5)}
+    )
     with pytest.raises(InitialStateError, match=r"no slip along the axis projection \(vp, nu\)"):
         initial_state(paper_body, "meridian", gamma=GAMMA0, omega=OMEGA0, v=y[0:3])
 

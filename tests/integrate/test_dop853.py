@@ -20,8 +20,12 @@ def scenario(t_end=20.0, rtol=1e-10, atol=None, samples=101, model="meridian", *
     init = dict(gamma=GAMMA0, omega=OMEGA0, free={"v_tau": 0.25}) | initial
     if model != "meridian":
         init["free"] = {}
-    return Scenario(SphericalTop(**PAPER_BODY), model, InitialConditions(**init),
-                    IntegrationOptions(t_end=t_end, rtol=rtol, atol=atol, samples=samples))  # fmt: skip
+    return Scenario(
+        SphericalTop(**PAPER_BODY),
+        model,
+        InitialConditions(**init),
+        IntegrationOptions(t_end=t_end, rtol=rtol, atol=atol, samples=samples),
+    )
 
 
 def test_dense_output_matches_integration_to_each_sample():
@@ -38,8 +42,14 @@ def test_error_decreases_with_tolerance_like_an_eighth_order_method():
     """Final-state error against solve_ivp(DOP853, rtol 1e-13) shrinks as rtol does, and the
     number of steps grows like rtol**(-1/8) (within a factor 2)."""
     sc = scenario(t_end=10.0)
-    ref = solve_ivp(lambda t, y: reference.rhs("meridian", sc.body.params, y)[0], (0, 10.0), sc.y0,
-                    method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]  # fmt: skip
+    ref = solve_ivp(
+        lambda t, y: reference.rhs("meridian", sc.body.params, y)[0],
+        (0, 10.0),
+        sc.y0,
+        method="DOP853",
+        rtol=1e-13,
+        atol=1e-15,
+    ).y[:, -1]
     errors, steps = [], []
     for rtol in (1e-6, 1e-8, 1e-10):
         r = integrate(0, sc.body.params, sc.y0, np.array([0.0, 10.0]), rtol=rtol, atol=rtol / 100)
@@ -89,12 +99,23 @@ def test_contact_loss_is_warned_and_located():
     """A top with a3 = 0.5 spun about a horizontal axis lifts off; the time N = 0 is located to
     1e-8 against a root of the NumPy reference's normal force on a solve_ivp dense solution."""
     body = SphericalTop(R=1, m=1, g=1, a3=0.5, I1=0.3, I3=0.5)
-    sc = Scenario(body, "meridian", InitialConditions(gamma=GAMMA0, omega=(1.4, 0, 0.3)),
-                  IntegrationOptions(t_end=10, samples=201))  # fmt: skip
+    sc = Scenario(
+        body,
+        "meridian",
+        InitialConditions(gamma=GAMMA0, omega=(1.4, 0, 0.3)),
+        IntegrationOptions(t_end=10, samples=201),
+    )
     with pytest.warns(ContactLostWarning, match="normal reaction turns negative at t = 2.83"):
         traj = simulate(sc)
-    sol = solve_ivp(lambda t, y: reference.rhs("meridian", body.params, y)[0], (0, 4), sc.y0,
-                    method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)  # fmt: skip
+    sol = solve_ivp(
+        lambda t, y: reference.rhs("meridian", body.params, y)[0],
+        (0, 4),
+        sc.y0,
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-14,
+        dense_output=True,
+    )
 
     def normal(t):
         return reference.reactions("meridian", body.params, sol.sol(t))[0]

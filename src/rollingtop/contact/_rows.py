@@ -49,7 +49,16 @@ def normal_row(p, y, k, J, bias, dirs):
     w1, w2, w3 = y[3], y[4], y[5]
     g1, g2, g3 = y[12], y[13], y[14]
     contact_row(
-        p, y, k, g1, g2, g3,
-        g2 * w3 - g3 * w2, g3 * w1 - g1 * w3, g1 * w2 - g2 * w1,
-        J, bias, dirs,
-    )  # fmt: skip
+        p,
+        y,
+        k,
+        g1,
+        g2,
+        g3,
+        g2 * w3 - g3 * w2,
+        g3 * w1 - g1 * w3,
+        g1 * w2 - g2 * w1,
+        J,
+        bias,
+        dirs,
+    )

@@ -132,7 +132,7 @@ def rhs(code, p, y, dy, ws):
 
 @njit(cache=True, error_model="numpy")
 def reaction(nc, y, ws):
-    """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` of the last :func:`rhs`.
+    """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` (last :func:`rhs`).
 
     ``F = sum_k lambda_k d_k`` is the constraint force at the contact point (body frame).
     """

@@ -26,7 +26,7 @@ def _Iw(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
 
 
 def energy(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
-    """``E = m (v, v)/2 + (w, I w)/2 - m g (r, gamma)``; zero potential with the CoM on the plane."""
+    """``E = m (v, v)/2 + (w, I w)/2 - m g (r, gamma)``; zero with the CoM on the plane."""
     v, w, gamma = Y[..., V], Y[..., W], Y[..., GAMMA]
     kinetic = 0.5 * body.m * np.sum(v * v, axis=-1) + 0.5 * np.sum(w * _Iw(body, Y), axis=-1)
     return kinetic - body.m * body.g * np.sum(_arm(body, Y) * gamma, axis=-1)

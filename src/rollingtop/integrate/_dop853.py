@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit
 
 from rollingtop.dynamics._kernel import project, reaction, rhs
-from rollingtop.integrate._dop853_tableau import A, B, C, D, E3, E5
+from rollingtop.integrate._dop853_tableau import E3, E5, A, B, D
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2

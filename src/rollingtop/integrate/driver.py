@@ -107,8 +107,24 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
     while True:
         if max_steps is not None:
             budget = min(budget, max_steps - int(counts[dop.STEPS]))
-        status = dop.run(code, p, y, f, ctrl, counts, track, t_eval, w["out"], budget,
-                         w["K"], w["ynew"], w["ytmp"], w["y_old"], w["Fd"], w["ws"])  # fmt: skip
+        status = dop.run(
+            code,
+            p,
+            y,
+            f,
+            ctrl,
+            counts,
+            track,
+            t_eval,
+            w["out"],
+            budget,
+            w["K"],
+            w["ynew"],
+            w["ytmp"],
+            w["y_old"],
+            w["Fd"],
+            w["ws"],
+        )
         if progress is not None:
             progress(float(ctrl[dop.T]))
         if status != dop.BUDGET_EXHAUSTED:
@@ -171,9 +187,15 @@ def integrate(
         raise ValueError(f"y0 must have shape ({N_STATE},), got {y0.shape}")
     compile_s = compile_kernels()
     out, counts, track, wall = _run_compiled(
-        int(code), np.asarray(params, dtype=float), y0, t_eval, float(rtol), float(atol),
-        max_steps, progress,
-    )  # fmt: skip
+        int(code),
+        np.asarray(params, dtype=float),
+        y0,
+        t_eval,
+        float(rtol),
+        float(atol),
+        max_steps,
+        progress,
+    )
     return IntegrationResult(
         t=t_eval,
         y=out,

@@ -1,0 +1,153 @@
+"""Command line: the simulate contract, and one clear line with exit status 2 for bad input."""
+
+import json
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+from rollingtop.cli import main
+
+from .conftest import EXAMPLES, scenario_text
+
+
+def run_cli(capsys, *args):
+    with pytest.raises(SystemExit) as exc:
+        main(list(args))
+        raise SystemExit(0)
+    out, err = capsys.readouterr()
+    return exc.value.code, out, err
+
+
+def test_simulate_json_end_to_end(tmp_path):
+    """Real process: stdout is exactly one JSON object with the documented keys."""
+    out_file = tmp_path / "run.nc"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "rollingtop",
+            "simulate",
+            str(EXAMPLES / "paper.toml"),
+            "--t-end",
+            "5",
+            "--rtol",
+            "1e-11",
+            "-o",
+            str(out_file),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+        env=os.environ | {"COLUMNS": "120"},
+    )
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads(proc.stdout)
+    assert summary["model"] == "meridian" and summary["t_end"] == 5.0
+    assert set(summary["integrals"]) == {"energy", "lagrange", "jellett", "area", "F6"}
+    for row in summary["integrals"].values():
+        assert row["max_abs_drift"] < 1e-9
+    assert summary["final"]["t"] == 5.0
+    assert out_file.stat().st_size > 0
+    assert proc.stderr == ""
+
+
+def test_simulate_table(capsys):
+    code, out, _ = run_cli(capsys, "simulate", str(EXAMPLES / "rough.toml"), "--t-end", "2")
+    assert code == 0
+    assert "routh" in out and "jellett" in out and "friction coefficient needed" in out
+
+
+def test_model_override(capsys):
+    code, out, _ = run_cli(
+        capsys,
+        "simulate",
+        str(EXAMPLES / "rough.toml"),
+        "--t-end",
+        "1",
+        "--model",
+        "smooth",
+        "--json",
+    )
+    assert code == 0 and json.loads(out)["model"] == "smooth"
+
+
+@pytest.mark.parametrize(
+    ("setup", "args", "message"),
+    [
+        (None, ["simulate", "absent.toml"], "cannot read scenario 'absent.toml'"),
+        ("[body\n", [], "invalid TOML"),
+        (scenario_text(contact='model = "ice"'), [], "unknown contact model 'ice'"),
+        (scenario_text(extra="a = 1"), [], r"unknown table \[extra\]"),
+        (
+            scenario_text(body="R = 1.0\nm = -1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5"),
+            [],
+            "inadmissible body: m = -1 must be > 0",
+        ),
+        (
+            scenario_text(initial="gamma = [0.0, 0.6, 0.7]\nomega = [0.0, 0.0, 1.0]"),
+            [],
+            "gamma .* is not a unit vector",
+        ),
+        (
+            scenario_text(
+                initial="gamma = [0.0, 0.6, 0.8]\nomega = [0.0, 0.0, 1.0]\nalpha = [0.0, 0.6, 0.8]"
+            ),
+            [],
+            "alpha .* is not orthogonal to gamma",
+        ),
+        (
+            scenario_text(initial="gamma = [0.0, 0.0, -1.0]\nomega = [0.0, 0.0, 1.0]"),
+            [],
+            "symmetry axis is vertical",
+        ),
+        (scenario_text(), ["--rtol", "x"], "Invalid value for '--rtol'"),
+        (scenario_text(), ["--rtol", "2"], r"rtol = 2 must lie in \[1e-15, 0.1\]"),
+        (scenario_text(), ["-o", "{tmp}/no/such/dir/out.nc"], "does not exist"),
+        (scenario_text(), ["-o", "{tmp}/out.xlsx"], "unknown output format '.xlsx'"),
+        (scenario_text(), ["--frobnicate"], "No such option.*--frobnicate"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, monkeypatch, setup, args, message):
+    monkeypatch.chdir(tmp_path)
+    if setup is not None:
+        (tmp_path / "s.toml").write_text(setup)
+        args = ["simulate", "s.toml", *[a.format(tmp=tmp_path) for a in args]]
+    code, out, err = run_cli(capsys, *args)
+    assert code == 2
+    assert out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("rollingtop: error: ")
+    assert re.search(message, lines[0]), lines[0]
+    assert "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == (["s.toml"] if setup else [])
+
+
+def test_unwritable_output_refused_before_running(tmp_path, capsys):
+    if os.geteuid() == 0:
+        target = tmp_path / "dir.nc"
+        target.mkdir()  # root may write anywhere: use a folder in the way instead
+        expected = "it is a folder"
+    else:
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        target = locked / "out.nc"
+        expected = "permission denied"
+    code, _, err = run_cli(capsys, "simulate", str(EXAMPLES / "paper.toml"), "-o", str(target))
+    assert code == 2 and expected in err
+
+
+def test_contact_loss_warns_on_stderr(tmp_path, capsys):
+    text = scenario_text(
+        body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.5\nI1 = 0.3\nI3 = 0.5",
+        initial="gamma = [0.0, 0.6, 0.8]\nomega = [1.4, 0.0, 0.3]",
+        integration="t_end = 4.0",
+    )
+    (tmp_path / "s.toml").write_text(text)
+    code, out, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"), "--json")
+    assert code == 0
+    assert json.loads(out)["reactions"]["contact_lost_at"] == pytest.approx(2.8305379, abs=1e-6)
+    assert err.startswith("rollingtop: warning: the normal reaction turns negative at t = 2.83")

@@ -1,0 +1,134 @@
+"""Scenario files: the documented format loads, every malformed input is refused clearly."""
+
+import numpy as np
+import pytest
+
+from rollingtop import (
+    BodyError,
+    ContactModelError,
+    InitialStateError,
+    RollingTopError,
+    ScenarioError,
+    load_scenario,
+)
+from rollingtop.scenario import DEFAULTS
+
+from .conftest import EXAMPLES, scenario_text
+
+
+@pytest.mark.parametrize("name", ["paper", "smooth", "rough"])
+def test_examples_load(name):
+    sc = load_scenario(EXAMPLES / f"{name}.toml")
+    assert sc.model.name == {"paper": "meridian"}.get(name, name)
+    assert sc.integration.t_end == 50.0 and sc.integration.samples == 1001
+    assert sc.body.a3 == 0.1 and sc.body.I2 == 0.3
+    np.testing.assert_allclose(sc.y0[12:15], (0, 0.6, 0.8))
+
+
+def write(tmp_path, text):
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    return path
+
+
+def test_defaults(tmp_path):
+    sc = load_scenario(write(tmp_path, scenario_text(contact=None, integration=None)))
+    assert sc.model.name == "meridian"
+    assert sc.integration.t_end == DEFAULTS["t_end"] and sc.integration.rtol == 1e-10
+    assert sc.integration.resolved_atol == pytest.approx(1e-12)
+    assert sc.with_overrides(rtol=1e-12).integration.resolved_atol == pytest.approx(1e-14)
+
+
+def test_overrides(tmp_path):
+    sc = load_scenario(write(tmp_path, scenario_text()))
+    sc2 = sc.with_overrides(t_end=7.0, samples=None)
+    assert sc2.integration.t_end == 7.0 and sc2.model.name == "meridian"
+    assert sc2.integration.samples == sc.integration.samples
+    # another model must accept the same initial conditions
+    with pytest.raises(InitialStateError, match="v_tau is not a free velocity component of model"):
+        sc.with_overrides(model="smooth")
+    rough = load_scenario(write(tmp_path, scenario_text("rough"))).with_overrides(model="smooth")
+    assert rough.model.name == "smooth"
+    with pytest.raises(ScenarioError, match="unknown override speed"):
+        sc.with_overrides(speed=3)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        (dict(extra="x = 1"), ScenarioError, r"unknown table \[extra\]"),
+        (
+            dict(body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3"),
+            ScenarioError,
+            r"\[body\] is missing I3",
+        ),
+        (
+            dict(body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 1.1\nI1 = 0.3\nI3 = 0.5"),
+            BodyError,
+            r"a3 = 1.1 violates \|a3\| < R",
+        ),
+        (
+            dict(body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\nJ = 2"),
+            ScenarioError,
+            "unknown key body.J",
+        ),
+        (dict(contact='model = "rubber"'), ContactModelError, "unknown contact model 'rubber'"),
+        (
+            dict(initial="gamma = [0.0, 0.6, 0.9]\nomega = [0.7, -0.3, 2.0]"),
+            InitialStateError,
+            "gamma .* is not a unit vector",
+        ),
+        (
+            dict(initial="gamma = [0.0, 0.0, 1.0]\nomega = [0.7, -0.3, 2.0]"),
+            InitialStateError,
+            "symmetry axis is vertical",
+        ),
+        (
+            dict(initial="gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nspeed = 1"),
+            ScenarioError,
+            "unknown key initial.speed",
+        ),
+        (
+            dict(
+                initial="gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nv_horizontal = [1, 0]"
+            ),
+            ScenarioError,
+            "unknown key initial.v_horizontal for model 'meridian'",
+        ),
+        (dict(initial="gamma = [0.0, 0.6, 0.8]"), ScenarioError, r"\[initial\] is missing omega"),
+        (dict(integration="t_end = -1.0"), ScenarioError, "t_end = -1 must be > 0"),
+        (dict(integration="rtol = 1.0"), ScenarioError, r"rtol = 1 must lie in \[1e-15, 0.1\]"),
+        (dict(integration="atol = 0.0"), ScenarioError, "atol = 0 must be > 0"),
+        (dict(integration="samples = 1"), ScenarioError, "samples = 1 must be >= 2"),
+        (dict(integration="samples = 2.5"), ScenarioError, "samples = 2.5 must be an integer"),
+        (dict(integration='t_end = "long"'), ScenarioError, "t_end = 'long' must be a number"),
+        (
+            dict(integration="t_end = 5.0\nmethod = 'rk4'"),
+            ScenarioError,
+            "unknown key integration.method",
+        ),
+    ],
+)
+def test_bad_scenarios(tmp_path, kwargs, error, message):
+    path = write(tmp_path, scenario_text(**kwargs))
+    with pytest.raises(error, match=message) as err:
+        load_scenario(path)
+    assert str(path) in str(err.value)  # the file is named
+
+
+def test_invalid_toml_and_missing_file(tmp_path):
+    with pytest.raises(ScenarioError, match="invalid TOML"):
+        load_scenario(write(tmp_path, "[body\nR = 1"))
+    with pytest.raises(ScenarioError, match="cannot read scenario .*No such file"):
+        load_scenario(tmp_path / "absent.toml")
+    assert issubclass(ScenarioError, RollingTopError)
+
+
+def test_smooth_and_full_velocity(tmp_path):
+    sc = load_scenario(write(tmp_path, scenario_text("smooth")))
+    assert sc.y0[0:3] @ sc.y0[6:9] == pytest.approx(0.3)
+    v = ", ".join(repr(float(x)) for x in sc.y0[0:3])
+    text = scenario_text(
+        "smooth", initial=f"gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nv = [{v}]"
+    )
+    np.testing.assert_allclose(load_scenario(write(tmp_path, text)).y0, sc.y0, atol=1e-15)
