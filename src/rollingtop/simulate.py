@@ -18,6 +18,8 @@ def simulate(
     scenario: Scenario | str | os.PathLike,
     *,
     progress: Callable[[float], None] | None = None,
+    events: str | None = None,
+    event_direction: int = 0,
     **overrides,
 ) -> Trajectory:
     """Integrate a scenario and return its :class:`~rollingtop.trajectory.Trajectory`.
@@ -29,6 +31,11 @@ def simulate(
     progress : callable, optional
         Called with the current time now and then during the run (see
         :func:`rollingtop.integrate.integrate`).
+    events : str, optional
+        Locate the zeros of an event function along the motion (``"w_tau"``: the turning points
+        of ``gamma3``); they are in :attr:`Trajectory.event_t` and :attr:`Trajectory.event_y`.
+    event_direction : int
+        ``+1`` rising zeros only, ``-1`` falling only, ``0`` both.
     **overrides
         ``t_end, rtol, atol, samples, max_steps`` or ``model``, replacing the scenario's values.
 
@@ -51,6 +58,8 @@ def simulate(
         atol=opts.resolved_atol,
         max_steps=opts.max_steps,
         progress=progress,
+        events=events,
+        event_direction=event_direction,
     )
     traj = Trajectory(
         body=scenario.body,
@@ -67,6 +76,8 @@ def simulate(
             "compile_time_s": result.compile_time_s,
         },
         step_reactions=result.reactions,
+        event_t=result.event_t,
+        event_y=result.event_y,
     )
     lost = traj.contact_lost_at
     if lost is not None:

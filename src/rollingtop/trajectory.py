@@ -68,6 +68,10 @@ class Trajectory:
     step_reactions : dict
         Contact reactions monitored at every accepted step (not only at samples):
         ``min_normal_force, t_min_normal_force, contact_lost_at, max_friction_ratio, ...``.
+    event_t : ndarray, shape (k,)
+        Times of the events asked of :func:`rollingtop.simulate` (empty otherwise).
+    event_y : ndarray, shape (k, 17)
+        States at those events.
     """
 
     body: SphericalTop
@@ -78,6 +82,8 @@ class Trajectory:
     atol: float
     stats: dict = field(default_factory=dict)
     step_reactions: dict = field(default_factory=dict)
+    event_t: np.ndarray = field(default_factory=lambda: np.empty(0))
+    event_y: np.ndarray = field(default_factory=lambda: np.empty((0, 17)))
 
     # ---- state components -------------------------------------------------------------------
     @property

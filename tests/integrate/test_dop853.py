@@ -148,3 +148,25 @@ def test_rejects_bad_t_eval():
     sc = scenario()
     with pytest.raises(ValueError, match="strictly increasing"):
         integrate(0, sc.body.params, sc.y0, np.array([0.0, 1.0, 1.0]), rtol=1e-8, atol=1e-10)
+
+
+def test_events_on_w_tau_are_turning_points_of_gamma3():
+    """Rising zeros of w_tau are the minima of gamma3: located to round-off of the event function,
+    and the same period between consecutive ones as a brentq root on solve_ivp's dense output."""
+    sc = scenario(t_end=30.0, rtol=1e-12, atol=1e-14)
+    traj = simulate(sc, events="w_tau", event_direction=1)
+    y = traj.event_y
+    s_w_tau = y[:, 12] * y[:, 4] - y[:, 13] * y[:, 3]
+    assert len(traj.event_t) == 10
+    np.testing.assert_allclose(s_w_tau, 0, atol=1e-12)
+    np.testing.assert_allclose(y[:, 14], y[0, 14], atol=1e-10)  # the same minimum of gamma3
+
+    def g(t, yy):
+        return yy[12] * yy[4] - yy[13] * yy[3]
+
+    g.direction = 1
+    sol = solve_ivp(lambda t, yy: reference.rhs("meridian", sc.body.params, yy)[0], (0, 30.0),
+                    sc.y0, method="DOP853", rtol=1e-12, atol=1e-14, events=g)  # fmt: skip
+    np.testing.assert_allclose(traj.event_t, sol.t_events[0], rtol=0, atol=1e-9)
+    both = simulate(sc, events="w_tau")
+    assert len(both.event_t) in (19, 20, 21)

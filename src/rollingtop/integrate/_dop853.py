@@ -21,6 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
+from rollingtop.dynamics._events import event_value
 from rollingtop.dynamics._kernel import project, reaction, rhs
 from rollingtop.integrate._dop853_tableau import E3, E5, A, B, D
 
@@ -36,9 +37,11 @@ STEP_TOO_SMALL = -1
 NOT_FINITE = -2
 
 # Indices into the float control array ``ctrl``.
-T, H_ABS, T_END, RTOL, ATOL = 0, 1, 2, 3, 4
+T, H_ABS, T_END, RTOL, ATOL, G_OLD = 0, 1, 2, 3, 4, 5
 # Indices into the integer counter array ``counts``.
-NEXT_SAMPLE, STEPS, REJECTED, NFEV = 0, 1, 2, 3
+NEXT_SAMPLE, STEPS, REJECTED, NFEV, N_EVENTS = 0, 1, 2, 3, 4
+# Indices into the integer event specification ``ev_spec``.
+EV_CODE, EV_DIRECTION = 0, 1
 # Indices into the reaction-tracking array ``track``.
 MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 0, 1, 2, 3, 4, 5
 
@@ -154,7 +157,45 @@ def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
 
 
 @njit(cache=True, error_model="numpy")
-def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, y_old, Fd, ws):
+def _event_root(ev_code, Fd, y, t, h, ytmp):
+    """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
+    output (60 halvings: to the resolution of the interpolant)."""
+    _dense_eval(Fd, y, 0.0, ytmp)
+    g_lo = event_value(ev_code, ytmp)
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        _dense_eval(Fd, y, mid, ytmp)
+        g = event_value(ev_code, ytmp)
+        if (g > 0.0) == (g_lo > 0.0) and g != 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True, error_model="numpy")
+def run(
+    code,
+    p,
+    y,
+    f,
+    ctrl,
+    counts,
+    track,
+    t_eval,
+    out,
+    ev_spec,
+    ev_t,
+    ev_y,
+    budget,
+    K,
+    ynew,
+    ytmp,
+    y_old,
+    Fd,
+    ws,
+):
     """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
 
     Parameters
@@ -165,16 +206,22 @@ def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, 
         Body parameters.
     y, f : ndarray, shape (17,)
         Current state (projected) and its derivative; updated in place.
-    ctrl : ndarray, shape (5,)
-        ``t, h_abs, t_end, rtol, atol``; ``t`` and ``h_abs`` are updated.
-    counts : ndarray of int64, shape (4,)
-        Next sample index, accepted steps, rejected steps, right-hand-side evaluations.
+    ctrl : ndarray, shape (6,)
+        ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``); updated.
+    counts : ndarray of int64, shape (5,)
+        Next sample index, accepted steps, rejected steps, right-hand-side evaluations, events
+        found (also those beyond the capacity of ``ev_t``).
     track : ndarray, shape (5,)
         Reaction tracking (see :func:`new_track`), updated at every accepted step.
     t_eval : ndarray, shape (n_samples,)
         Increasing sample times within ``[t0, t_end]``.
     out : ndarray, shape (n_samples, 17)
         Samples, each projected onto the constraints.
+    ev_spec : ndarray of int64, shape (2,)
+        Event function code (:mod:`rollingtop.dynamics._events`, 0 for none) and direction
+        (+1: rising zeros only, -1: falling, 0: both).
+    ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 17)
+        Times and projected states of the located events.
     budget : int
         Maximum number of accepted steps in this call (the caller resumes for progress output).
     K, ynew, ytmp, y_old, Fd, ws
@@ -280,10 +327,29 @@ def run(code, p, y, f, ctrl, counts, track, t_eval, out, budget, K, ynew, ytmp, 
             if not dense_ready:
                 _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
                 counts[NFEV] += 3
+                dense_ready = True
             track[T_CONTACT_LOST] = _normal_root(code, p, Fd, y_old, t, h, ytmp, ws)
             counts[NFEV] += 60
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
+        if ev_spec[EV_CODE] != 0:
+            g_new = event_value(ev_spec[EV_CODE], y)
+            g_old = ctrl[G_OLD]
+            crossed = (g_old < 0.0 and g_new >= 0.0) or (g_old > 0.0 and g_new <= 0.0)
+            rising = g_new > g_old
+            if crossed and (ev_spec[EV_DIRECTION] == 0 or (ev_spec[EV_DIRECTION] > 0) == rising):
+                if not dense_ready:
+                    _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
+                    counts[NFEV] += 3
+                    dense_ready = True
+                x = _event_root(ev_spec[EV_CODE], Fd, y_old, t, h, ytmp)
+                m = counts[N_EVENTS]
+                if m < ev_t.shape[0]:
+                    ev_t[m] = t + x * h
+                    _dense_eval(Fd, y_old, x, ev_y[m])
+                    project(code, p, ev_y[m], ws)
+                counts[N_EVENTS] += 1
+            ctrl[G_OLD] = g_new
         t = t_new
         counts[STEPS] += 1
         taken += 1

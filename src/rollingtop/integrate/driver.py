@@ -10,6 +10,7 @@ import numpy as np
 
 from rollingtop._errors import IntegrationError
 from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._events import EVENTS, event_value
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
 
@@ -39,6 +40,12 @@ class IntegrationResult:
         ``min_normal_force`` and ``t_min_normal_force``, ``contact_lost_at`` (first accepted step
         with negative normal force, or ``None``), ``max_friction_ratio`` and its time, monitored at
         every accepted step.
+    event_t : ndarray, shape (k,)
+        Times of the located events (empty without ``events``).
+    event_y : ndarray, shape (k, 17)
+        States at the events, projected onto the constraints.
+    events_dropped : int
+        Events found beyond ``max_events`` (not stored).
     """
 
     t: np.ndarray
@@ -49,6 +56,9 @@ class IntegrationResult:
     wall_time_s: float
     compile_time_s: float
     reactions: dict = field(default_factory=dict)
+    event_t: np.ndarray = field(default_factory=lambda: np.empty(0))
+    event_y: np.ndarray = field(default_factory=lambda: np.empty((0, N_STATE)))
+    events_dropped: int = 0
 
 
 def _workspace(n_samples: int):
@@ -79,15 +89,19 @@ def compile_kernels() -> float:
     for code in (0, 1, 2):
         yy = y.copy()
         _kernel.project(code, p, yy, _kernel.new_workspace())
-        _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None)
+        _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
         _kernel.diagnostics(code, p, yy[None, :].copy(), np.zeros((1, 8)))
     _compile_time = time.perf_counter() - start
     return _compile_time
 
 
-def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
+def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
     n = t_eval.shape[0]
     w = _workspace(n)
+    ev_code, ev_direction, capacity = event
+    ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
+    ev_t = np.full(capacity, np.nan)
+    ev_y = np.full((capacity, N_STATE), np.nan)
     y = y0.copy()
     f = np.zeros(N_STATE)
     nc = _kernel.rhs(code, p, y, f, w["ws"])
@@ -97,8 +111,8 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
     track[dop.LAST_NORMAL] = N0
     t0, t_end = float(t_eval[0]), float(t_eval[-1])
     h0 = dop.initial_step(code, p, y, f, t_end, t0, rtol, atol, w["ytmp"], w["ynew"], w["ws"])
-    ctrl = np.array([t0, h0, t_end, rtol, atol])
-    counts = np.zeros(4, dtype=np.int64)
+    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, y)])
+    counts = np.zeros(5, dtype=np.int64)
     counts[dop.NFEV] = 2
     w["out"][0] = y
     counts[dop.NEXT_SAMPLE] = 1
@@ -117,6 +131,9 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
             track,
             t_eval,
             w["out"],
+            ev_spec,
+            ev_t,
+            ev_y,
             budget,
             w["K"],
             w["ynew"],
@@ -145,7 +162,9 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress=None):
             f"the state became non-finite at t = {ctrl[dop.T]:.9g} "
             "(for the meridian model: the symmetry axis reached the vertical?)"
         )
-    return w["out"], counts, track, wall
+    found = int(counts[dop.N_EVENTS])
+    kept = min(found, capacity)
+    return w["out"], counts, track, wall, (ev_t[:kept], ev_y[:kept], found - kept)
 
 
 def integrate(
@@ -158,6 +177,9 @@ def integrate(
     atol: float,
     max_steps: int | None = None,
     progress: Callable[[float], None] | None = None,
+    events: str | None = None,
+    event_direction: int = 0,
+    max_events: int = 100_000,
 ) -> IntegrationResult:
     """Integrate the constrained equations from ``y0`` at ``t_eval[0]`` to ``t_eval[-1]``.
 
@@ -178,6 +200,13 @@ def integrate(
     progress : callable, optional
         Called with the current time every :data:`PROGRESS_CHUNK` steps and at the end. Does
         not change the step sequence.
+    events : str, optional
+        Name of an event function (``"w_tau"``: zeros of ``w_tau``, the turning points of
+        ``gamma3``) whose zeros are located on the dense output of each step.
+    event_direction : int
+        ``+1``: only rising zeros, ``-1``: only falling, ``0``: both.
+    max_events : int
+        Events stored at most (further ones are counted in ``events_dropped``).
     """
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     y0 = np.ascontiguousarray(y0, dtype=float)
@@ -185,8 +214,13 @@ def integrate(
         raise ValueError("t_eval must be strictly increasing with at least 2 entries")
     if y0.shape != (N_STATE,):
         raise ValueError(f"y0 must have shape ({N_STATE},), got {y0.shape}")
+    if events is not None and events not in EVENTS:
+        raise ValueError(f"unknown event {events!r} (known: {', '.join(EVENTS)})")
+    if event_direction not in (-1, 0, 1):
+        raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
+    event = (EVENTS[events] if events else 0, event_direction, max(int(max_events), 1))
     compile_s = compile_kernels()
-    out, counts, track, wall = _run_compiled(
+    out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
         np.asarray(params, dtype=float),
         y0,
@@ -195,6 +229,7 @@ def integrate(
         float(atol),
         max_steps,
         progress,
+        event,
     )
     return IntegrationResult(
         t=t_eval,
@@ -213,4 +248,7 @@ def integrate(
             "max_friction_ratio": float(track[dop.MAX_RATIO]),
             "t_max_friction_ratio": float(track[dop.T_MAX_RATIO]),
         },
+        event_t=ev_t,
+        event_y=ev_y,
+        events_dropped=dropped,
     )
