@@ -1,0 +1,36 @@
+"""Reduction of the meridian model to one degree of freedom (paper Sec. 3).
+
+- :mod:`.variables`: full state <-> reduced variables and integrals.
+- :mod:`.system`: the reduced system (eq. 3.3).
+- :mod:`.level`: level sets ``(M3, C1, C2)`` and the effective potential ``U``.
+- :mod:`.steady`: steady motions (critical points of ``U``).
+- :mod:`.orbits`: orbits on ``(M3, C1, C2, h)``, turning points, periods.
+"""
+
+from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
+from rollingtop.reduction.orbits import Orbit, orbits
+from rollingtop.reduction.steady import SteadyMotion, steady_motions
+from rollingtop.reduction.system import integrate_reduced, reduced_integrals_of, reduced_rhs
+from rollingtop.reduction.variables import (
+    euler_angles,
+    reduce_state,
+    reduced_integrals,
+    state_from_level,
+)
+
+__all__ = [
+    "POLE_TOLERANCE",
+    "LevelSet",
+    "LevelSetError",
+    "Orbit",
+    "SteadyMotion",
+    "euler_angles",
+    "integrate_reduced",
+    "orbits",
+    "reduce_state",
+    "reduced_integrals",
+    "reduced_integrals_of",
+    "reduced_rhs",
+    "state_from_level",
+    "steady_motions",
+]

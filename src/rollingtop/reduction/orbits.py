@@ -1,0 +1,270 @@
+"""Orbits on a level set ``(M3, C1, C2, h)``: turning points and periods (paper eqs. 3.10-3.11).
+
+With ``theta' = -w_tau`` and ``h = rho theta'^2/2 + U(theta)`` (see :mod:`.level`), each connected
+component of ``{U(theta) <= h}`` between two simple turning points is a periodic orbit of period
+
+    T = 2 * integral_{theta1}^{theta2} sqrt(rho(theta) / (2 (h - U(theta)))) dtheta.
+
+The inverse-square-root singularities at the turning points are removed by the substitution
+``theta = c + d sin(phi)``, ``phi in [-pi/2, pi/2]``, which makes the integrand smooth (analytic):
+Gauss-Legendre quadrature then converges exponentially and is doubled until two successive
+values agree to 1e-14. Near a separatrix (a saddle of ``U`` at a level within a tiny margin of
+``h``, inside or at the edge of the orbit) the integrand develops a logarithmic peak: the
+quadrature switches to adaptive QUADPACK with the peak as a break point, and within
+:data:`SEPARATRIX_TOLERANCE` of the separatrix the period is reported as unbounded instead of a
+number that would be noise.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.steady import critical_points, steady_motion
+
+__all__ = ["Orbit", "orbits", "period"]
+
+#: ``|h - U(saddle)|`` below this (relative to the scale of ``U``) is on the separatrix.
+SEPARATRIX_TOLERANCE = 1e-10
+#: Target relative accuracy of the period quadrature.
+PERIOD_RTOL = 1e-13
+#: ``h - U_min`` below this (relative) is the steady motion itself.
+STEADY_TOLERANCE = 1e-13
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """One connected component of the level set ``(M3, C1, C2, h)``.
+
+    Attributes
+    ----------
+    gamma3_min, gamma3_max : float
+        Range of ``gamma3`` on the orbit (a pole passage reaches ``+-1``).
+    theta_min, theta_max : float
+        Turning points in the signed nutation angle (``gamma3 = cos theta``).
+    period : float
+        Period of ``gamma3(t)`` (``inf`` on a separatrix).
+    period_error : float
+        Estimated absolute error of ``period``.
+    kind : {"periodic", "steady", "separatrix"}
+    pole_passage : bool
+        The orbit passes through the pole (pole cases only).
+    w_tau_max : float
+        Largest ``|w_tau|`` on the orbit.
+    note : str
+        Plain-language remark (near separatrix, pole passage, ...), or empty.
+    """
+
+    gamma3_min: float
+    gamma3_max: float
+    theta_min: float
+    theta_max: float
+    period: float
+    period_error: float
+    kind: str
+    pole_passage: bool
+    w_tau_max: float
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict (``inf``/NaN become ``None``)."""
+        return {k: (v if not isinstance(v, float) or math.isfinite(v) else None)
+                for k, v in asdict(self).items()}  # fmt: skip
+
+
+#: Gauss-Legendre rule for the energy gap near the turning points (see :func:`_gap`).
+_GAP_NODES, _GAP_WEIGHTS = np.polynomial.legendre.leggauss(20)
+#: Within this fraction of the orbit's width from a turning point the gap is integrated.
+_GAP_NEAR = 0.1
+
+
+def _gap(level: LevelSet, h: float, t1: float, t2: float, phi) -> np.ndarray:
+    """``h - U(theta)`` at ``theta = c + d sin(phi)`` on ``[t1, t2]``, accurate to a few ulps
+    *relative* to itself.
+
+    Far from the turning points it is the plain difference. Near them the plain difference
+    loses all digits (``h`` and ``U`` agree there), so it is computed as
+    ``U(end) - U(theta) = integral_theta^end U'`` (``end`` the nearer turning point) by a
+    20-point Gauss-Legendre rule, with the distance to ``end`` taken from ``phi`` without
+    cancellation (``t2 - theta = 2 d sin^2(pi/4 - phi/2)``): ``U'`` is evaluated to full
+    absolute accuracy, so the gap keeps its relative accuracy down to the turning point, also
+    when that is nearly a double root (just outside a separatrix).
+    """
+    shape = np.shape(phi)
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    d = (t2 - t1) / 2
+    theta = (t1 + t2) / 2 + d * np.sin(phi)
+    out = h - level.U(theta)
+    for end, dist in (
+        (t2, 2 * d * np.sin(np.pi / 4 - phi / 2) ** 2),
+        (t1, -2 * d * np.sin(np.pi / 4 + phi / 2) ** 2),
+    ):
+        near = np.abs(dist) < _GAP_NEAR * (t2 - t1)
+        if np.any(near):
+            half = dist[near] / 2  # signed: (end - theta) / 2
+            x = end - half[:, None] * (1 + _GAP_NODES[None, :])
+            out[near] = np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half  # U(end) - U(theta)
+    return out.reshape(shape)
+
+
+def _integrand(level: LevelSet, h: float, t1: float, t2: float):
+    c, d = (t1 + t2) / 2, (t2 - t1) / 2
+
+    def f(phi):
+        theta = c + d * np.sin(phi)
+        gap = np.maximum(_gap(level, h, t1, t2, phi), 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * gap)) * d * np.cos(phi)
+        return np.where(np.isfinite(val), val, 0.0)
+
+    return f
+
+
+def _gauss(f, n: int) -> float:
+    x, w = np.polynomial.legendre.leggauss(n)
+    return float(np.sum(w * f(x * (math.pi / 2))) * (math.pi / 2))
+
+
+def period(
+    level: LevelSet, h: float, theta1: float, theta2: float, peaks=()
+) -> tuple[float, float]:
+    """Period of the orbit between the simple turning points ``theta1 < theta2``.
+
+    ``peaks`` are theta values of saddles near the orbit (break points for the adaptive
+    fallback). Returns ``(period, estimated absolute error)``.
+    """
+    c, d = (theta1 + theta2) / 2, (theta2 - theta1) / 2
+    f = _integrand(level, h, theta1, theta2)
+    prev = _gauss(f, 32)
+    n = 64
+    while n <= 4096:
+        cur = _gauss(f, n)
+        if abs(cur - prev) <= PERIOD_RTOL * abs(cur):
+            return cur, abs(cur - prev)
+        prev, n = cur, 2 * n
+    # Slow convergence: a logarithmic peak near a saddle. Adaptive quadrature with break points.
+    breaks = sorted(
+        math.asin(min(1.0, max(-1.0, (p - c) / d))) for p in peaks if theta1 < p < theta2
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # QUADPACK's round-off notice: its estimate is returned
+        value, err = quad(f, -math.pi / 2, math.pi / 2, points=breaks or None, epsabs=0.0,
+                          epsrel=PERIOD_RTOL, limit=2000)  # fmt: skip
+    return value, err
+
+
+def _root(level: LevelSet, h: float, a: float, b: float) -> float:
+    return brentq(lambda t: h - level.U(t), a, b, xtol=1e-16, rtol=8.9e-16, maxiter=500)
+
+
+def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
+    """A point near a domain end where ``U > h`` (the potential's barrier)."""
+    for eps in (1e-6, 1e-9, 1e-12, 1e-15):
+        t = end + inward * eps * (1 + abs(end))
+        with np.errstate(all="ignore"):
+            if level.U(t) > h:
+                return t
+    raise LevelSetError(
+        f"the motion reaches within 1e-15 of theta = {end:g} on {level.describe()}, h = {h:g}: "
+        "a pole case not recognised as one (set C1 = +-M3 exactly)"
+    )
+
+
+def orbits(level: LevelSet, h: float) -> list[Orbit]:
+    """All connected components of the level set ``(M3, C1, C2, h)``, sorted by ``gamma3_min``.
+
+    Raises
+    ------
+    LevelSetError
+        When ``h`` is below the minimum of ``U``: no motion on this level.
+    """
+    if not isinstance(h, int | float) or isinstance(h, bool) or not math.isfinite(h):
+        raise LevelSetError(f"level h = {h!r} must be a finite number")
+    h = float(h)
+    lo_end, hi_end = level.theta_domain
+    lo = _barrier_end(level, h, lo_end, +1)
+    hi = _barrier_end(level, h, hi_end, -1)
+    crit = [t for t in critical_points(level) if lo < t < hi]
+    knots = [lo, *crit, hi]
+    values = [float(level.U(t)) for t in knots]
+    scale = max(abs(h), max(abs(v) for v in values[1:-1]) if crit else abs(h), 1e-300)
+    steadies = {t: steady_motion(level, t) for t in crit}
+    # Walk the monotonic segments between knots; collect intervals where U <= h.
+    result: list[Orbit] = []
+    start = None
+    start_exact = False
+    for i in range(len(knots) - 1):
+        a, b, ua, ub = knots[i], knots[i + 1], values[i], values[i + 1]
+        if start is None:
+            if ua <= h and i > 0:  # a critical point at or below h begins a component
+                start, start_exact = a, ua == h
+            elif ua > h >= ub:
+                start, start_exact = _root(level, h, a, b), False
+        if start is not None and ub > h >= ua:
+            end = _root(level, h, a, b) if ua < h else a
+            result.append(_make_orbit(level, h, start, end, crit, steadies, scale))
+            start = None
+    if not result:
+        umin = min(values[1:-1]) if crit else math.nan
+        raise LevelSetError(
+            f"no motion on {level.describe()} at h = {h:.12g}: h is below the minimum of the "
+            f"effective potential U = {umin:.12g}"
+        )
+    pole = level.pole_theta
+    physical = [o for o in result if o.theta_max > 0.0 or pole is None]
+    if level.pole == "north":
+        physical = [o for o in result if o.theta_min < math.pi]
+    return sorted(physical or result, key=lambda o: (o.gamma3_min, o.theta_min))
+
+
+def _make_orbit(level, h, t1, t2, crit, steadies, scale) -> Orbit:
+    pole = level.pole_theta
+    passage = pole is not None and t1 < pole < t2
+    g = np.cos(np.linspace(t1, t2, 2001))
+    g_min, g_max = float(np.min(np.cos([t1, t2]))), float(np.max(np.cos([t1, t2])))
+    if passage:
+        g_min, g_max = min(g_min, float(g.min())), max(g_max, float(g.max()))
+        g_max = 1.0 if level.pole == "south" else g_max
+        g_min = -1.0 if level.pole == "north" else g_min
+    thetas = np.linspace(t1, t2, 2001)
+    w_tau_max = float(np.sqrt(np.max(np.maximum(2 * (h - level.U(thetas)) / level.rho(thetas),
+                                                0))))  # fmt: skip
+    note = "passes through the pole" if passage else ""
+    # steady motion: a centre with h at (or within round-off of) its potential
+    if t2 - t1 < 1e-7 or any(
+        steadies[c].type == "center" and t1 <= c <= t2 and h - steadies[c].U
+        <= STEADY_TOLERANCE * scale for c in crit
+    ):  # fmt: skip
+        c = min(crit, key=lambda x: abs(x - (t1 + t2) / 2)) if crit else (t1 + t2) / 2
+        m = steadies.get(c)
+        T = m.period if m is not None else math.nan
+        c = float(c)
+        return Orbit(math.cos(c), math.cos(c), c, c, T, 0.0, "steady", False, 0.0,
+                     "steady motion (h at the minimum of U); period of small oscillations")  # fmt: skip
+    # saddles that bound or split this orbit: inside it, or just outside a turning point
+    margin = 0.05 * (t2 - t1) + 1e-3
+    near = [c for c in crit if steadies[c].type != "center" and t1 - margin <= c <= t2 + margin
+            and abs(h - steadies[c].U) <= 1e-6 * scale]  # fmt: skip
+    gap = min((abs(h - steadies[c].U) for c in near), default=math.inf)
+    if gap <= SEPARATRIX_TOLERANCE * scale:
+        return Orbit(g_min, g_max, t1, t2, math.inf, math.inf, "separatrix", passage, w_tau_max,
+                     f"on the separatrix (|h - U(saddle)| = {gap:.2g}): the period grows without "
+                     "bound")  # fmt: skip
+    T, err = period(level, h, t1, t2, peaks=near)
+    if near:
+        # T ~ (2 / lambda) log(1/gap): the round-off of h and U (~eps * scale) moves T by
+        # (2 / lambda) * eps * scale / gap -- the period is ill-conditioned near a separatrix.
+        rates = [steadies[c].growth_rate for c in near if steadies[c].type == "saddle"]
+        lam = max(rates) if rates else 1.0
+        err = max(err, 2.0 / lam * 4 * np.finfo(float).eps * scale / gap)
+        note = (note + "; " if note else "") + (
+            f"near a separatrix (|h - U(saddle)| = {gap:.2g}): period ~ log(1/gap), "
+            f"relative uncertainty {err / T:.1g} from the round-off of h"
+        )
+    return Orbit(g_min, g_max, t1, t2, T, err, "periodic", passage, w_tau_max, note)

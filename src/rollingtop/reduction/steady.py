@@ -1,0 +1,148 @@
+"""Steady motions: critical points of the effective potential (``gamma3`` constant).
+
+At a critical point ``theta*`` of ``U`` the reduced motion rests: ``w_tau = 0``, so the CoM has
+``v_n = v3 = 0`` and moves with speed ``|v_tau|`` along ``tau``, the axis precesses at
+``psi' = -w_n / s`` and spins at ``w3 = M3 / I3``; the CoM runs on a circle of radius
+``|v_tau / psi'|``. Small oscillations about a centre have ``omega^2 = U''(theta*) / rho``
+(``h = rho theta'^2/2 + U``, a particle of mass ``rho`` in the potential ``U``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from rollingtop.reduction.level import LevelSet
+
+__all__ = ["SteadyMotion", "steady_motions", "critical_points"]
+
+#: Points of the theta grid on which sign changes of dU/dtheta are looked for.
+GRID_POINTS = 20_001
+#: A curvature below this (relative to the potential's scale) counts as degenerate.
+DEGENERATE_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class SteadyMotion:
+    """A steady motion (a critical point of ``U``) and what the body does there.
+
+    Attributes
+    ----------
+    gamma3, theta : float
+        Where (``gamma3 = cos theta``).
+    U : float
+        Effective potential there (``MODEL.md`` definition): the reduced energy ``h``.
+    type : {"center", "saddle", "degenerate"}
+        From the sign of ``U''``.
+    U2 : float
+        ``d^2 U / dgamma3^2`` (the paper's variable; ``= U''_theta / s^2``; NaN at a pole).
+    U2_theta : float
+        ``d^2 U / dtheta^2``.
+    frequency : float
+        Angular frequency of small oscillations ``sqrt(U''_theta / rho)`` (NaN unless centre).
+    period : float
+        ``2 pi / frequency`` (NaN unless centre).
+    growth_rate : float
+        ``sqrt(-U''_theta / rho)`` at a saddle (NaN otherwise).
+    w_n, v_tau, spin, precession_rate, com_speed, com_radius : float
+        ``w_n``, ``v_tau``, ``w3 = M3/I3``, ``psi'``, ``|v_tau|`` and ``|v_tau / psi'|`` (inf when
+        the axis does not precess).
+    """
+
+    gamma3: float
+    theta: float
+    U: float
+    type: str
+    U2: float
+    U2_theta: float
+    frequency: float
+    period: float
+    growth_rate: float
+    w_n: float
+    v_tau: float
+    spin: float
+    precession_rate: float
+    com_speed: float
+    com_radius: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict (non-finite values become ``None``)."""
+        return {k: (v if not isinstance(v, float) or math.isfinite(v) else None)
+                for k, v in asdict(self).items()}  # fmt: skip
+
+
+def _grid(level: LevelSet) -> np.ndarray:
+    lo, hi = level.theta_domain
+    # Chebyshev-like spacing clusters points near the barriers, where U varies fastest.
+    x = np.cos(np.linspace(math.pi, 0.0, GRID_POINTS))
+    return lo + (hi - lo) * (x + 1) / 2
+
+
+def critical_points(level: LevelSet) -> np.ndarray:
+    """All zeros of ``dU/dtheta`` inside the theta domain, increasing.
+
+    Sign changes of ``dU/dtheta`` on a fine grid (clustered at the ends), each refined by Brent's
+    method to machine precision; a zero of even multiplicity that does not change sign is found
+    when the grid lands on it exactly only.
+    """
+    grid = _grid(level)[1:-1]
+    with np.errstate(all="ignore"):
+        d = level.dU(grid)
+    roots = []
+    for i in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (d[:-1] * d[1:] <= 0)):
+        if d[i] == 0.0:
+            roots.append(grid[i])
+        elif d[i + 1] != 0.0:
+            roots.append(brentq(level.dU, grid[i], grid[i + 1], xtol=1e-15, rtol=8.9e-16,
+                                maxiter=200))  # fmt: skip
+    return np.unique(np.array(roots, dtype=float))
+
+
+def _scale(level: LevelSet, theta: float) -> float:
+    return max(abs(float(level.U(theta))), abs(float(level.d2U(theta))), 1e-300)
+
+
+def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
+    """Describe the steady motion at the critical point ``theta``."""
+    body = level.body
+    U2t = float(level.d2U(theta))
+    rho = float(level.rho(theta))
+    U = float(level.U(theta))
+    if abs(U2t) <= DEGENERATE_TOLERANCE * max(abs(U), 1.0):
+        kind = "degenerate"
+    else:
+        kind = "center" if U2t > 0 else "saddle"
+    s = math.sin(theta)
+    omega = math.sqrt(U2t / rho) if kind == "center" else math.nan
+    v_tau = float(level.v_tau(theta))
+    psi_dot = float(level.psi_dot(theta))
+    return SteadyMotion(
+        gamma3=math.cos(theta),
+        theta=theta,
+        U=U,
+        type=kind,
+        U2=U2t / s**2 if abs(s) > 1e-12 else math.nan,
+        U2_theta=U2t,
+        frequency=omega,
+        period=2 * math.pi / omega if kind == "center" else math.nan,
+        growth_rate=math.sqrt(-U2t / rho) if kind == "saddle" else math.nan,
+        w_n=float(level.w_n(theta)) if abs(s) > 1e-12 else 0.0,
+        v_tau=v_tau,
+        spin=level.M3 / body.I3,
+        precession_rate=psi_dot,
+        com_speed=abs(v_tau),
+        com_radius=abs(v_tau / psi_dot) if psi_dot != 0 else math.inf,
+    )
+
+
+def steady_motions(level: LevelSet) -> list[SteadyMotion]:
+    """Every steady motion on the level set, sorted by ``gamma3``.
+
+    In a pole case the list may include motions on the negative-``s`` branch (after a pole
+    passage); their ``theta`` lies outside ``(0, pi)``.
+    """
+    motions = [steady_motion(level, float(t)) for t in critical_points(level)]
+    return sorted(motions, key=lambda m: (m.gamma3, m.theta))

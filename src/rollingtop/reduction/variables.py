@@ -1,0 +1,137 @@
+"""Maps between the full state and the reduced description (paper Sec. 3.1).
+
+Full state ``y`` (17,) -> reduced variables ``(gamma3, v_tau, w_tau, w_n)`` and the integrals
+``(M3, C1, C2, h)``; and back, from a level set, ``h`` and a starting ``gamma3``, to a full,
+constraint-consistent state.
+
+The orientation left free by the reduced variables is fixed by the Euler angles of the
+3-1-3 convention: the vertical in the body frame is ``gamma = (s sin phi, s cos phi, gamma3)``
+(``phi``: proper rotation about the symmetry axis), and ``psi = atan2(beta3, alpha3)`` is the
+azimuth of the horizontal projection of the axis in the fixed frame (``MODEL.md``, "Motion in
+absolute space"), so that ``nu = cos(psi) alpha + sin(psi) beta`` and
+``tau = sin(psi) alpha - cos(psi) beta``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rollingtop.body import SphericalTop
+from rollingtop.dynamics.integrals import F6, area, energy, lagrange
+from rollingtop.reduction.level import LevelSet, LevelSetError
+
+__all__ = ["reduce_state", "reduced_integrals", "euler_angles", "state_from_level"]
+
+
+def reduce_state(Y) -> dict[str, np.ndarray]:
+    """Reduced variables of states ``Y`` (shape ``(..., 17)``), each of shape ``(...)``.
+
+    Returns ``gamma3, s, v_tau, w_tau, w_n, v_n, v3, w3`` with ``s = sqrt(gamma1^2 + gamma2^2)``,
+    ``tau = e3 x gamma / s`` and ``n = -(gamma1, gamma2, 0) / s`` (undefined where ``s = 0``).
+    """
+    Y = np.asarray(Y, dtype=float)
+    g1, g2, g3 = Y[..., 12], Y[..., 13], Y[..., 14]
+    s = np.hypot(g1, g2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tau1, tau2 = -g2 / s, g1 / s
+        n1, n2 = -g1 / s, -g2 / s
+    v1, v2, v3 = Y[..., 0], Y[..., 1], Y[..., 2]
+    w1, w2, w3 = Y[..., 3], Y[..., 4], Y[..., 5]
+    return {
+        "gamma3": g3,
+        "s": s,
+        "v_tau": tau1 * v1 + tau2 * v2,
+        "w_tau": tau1 * w1 + tau2 * w2,
+        "w_n": n1 * w1 + n2 * w2,
+        "v_n": n1 * v1 + n2 * v2,
+        "v3": v3,
+        "w3": w3,
+    }
+
+
+def reduced_integrals(body: SphericalTop, Y) -> dict[str, np.ndarray]:
+    """``M3 = I3 w3``, ``C1 = F5``, ``C2 = F6`` and ``h = E - I3 w3^2/2 - m g R`` of states ``Y``."""
+    Y = np.asarray(Y, dtype=float)
+    M3 = lagrange(body, Y)
+    return {
+        "M3": M3,
+        "C1": area(body, Y),
+        "C2": F6(body, Y),
+        "h": energy(body, Y) - M3**2 / (2 * body.I3) - body.m * body.g * body.R,
+    }
+
+
+def euler_angles(Y) -> dict[str, np.ndarray]:
+    """Euler angles ``psi, theta, phi`` (3-1-3) of states ``Y``, each shape ``(...)``:
+    ``gamma = (sin theta sin phi, sin theta cos phi, cos theta)``, ``psi = atan2(beta3, alpha3)``."""
+    Y = np.asarray(Y, dtype=float)
+    return {
+        "psi": np.arctan2(Y[..., 11], Y[..., 8]),
+        "theta": np.arctan2(np.hypot(Y[..., 12], Y[..., 13]), Y[..., 14]),
+        "phi": np.arctan2(Y[..., 12], Y[..., 13]),
+    }
+
+
+def state_from_level(
+    level: LevelSet,
+    h: float,
+    gamma3: float,
+    *,
+    branch: int = 1,
+    phi: float = 0.0,
+    psi: float = 0.0,
+    position=(0.0, 0.0),
+) -> np.ndarray:
+    """Full state on the level set ``(M3, C1, C2)`` with reduced energy ``h`` at ``gamma3``.
+
+    Parameters
+    ----------
+    level : LevelSet
+    h : float
+        Reduced energy ``rho w_tau^2/2 + U``; must be ``>= U(gamma3)``.
+    gamma3 : float
+        Starting ``gamma3`` in ``(-1, 1)``.
+    branch : {+1, -1}
+        Sign of ``w_tau`` (``gamma3' = s w_tau``: +1 starts with ``gamma3`` increasing).
+    phi, psi : float
+        Euler angles fixing the orientation (see the module docstring).
+    position : (float, float)
+        Horizontal CoM position.
+
+    Returns
+    -------
+    y : ndarray, shape (17,)
+        Satisfies the meridian model's constraints; ``(M3, C1, C2, h)`` as given.
+    """
+    body = level.body
+    if not -1.0 < gamma3 < 1.0:
+        raise LevelSetError(f"gamma3 = {gamma3!r} must lie strictly inside (-1, 1)")
+    if branch not in (1, -1):
+        raise LevelSetError(f"branch = {branch!r} must be +1 or -1")
+    theta = math.acos(gamma3)
+    U = float(level.U(theta))
+    if h < U:
+        raise LevelSetError(
+            f"h = {h:.12g} is below the effective potential U({gamma3:g}) = {U:.12g}: "
+            "no motion passes through this gamma3"
+        )
+    rho = float(level.rho(theta))
+    w_tau = branch * math.sqrt(2.0 * (h - U) / rho)
+    w_n = float(level.w_n(theta))
+    v_tau = float(level.v_tau(theta))
+    s = math.sin(theta)
+    gamma = np.array([s * math.sin(phi), s * math.cos(phi), gamma3])
+    e3 = np.array([0.0, 0.0, 1.0])
+    tau = np.cross(e3, gamma) / s
+    n = np.cross(e3, tau)
+    nu = (e3 - gamma3 * gamma) / s
+    alpha = math.cos(psi) * nu + math.sin(psi) * tau
+    beta = math.sin(psi) * nu - math.cos(psi) * tau
+    w = w_tau * tau + w_n * n + (level.M3 / body.I3) * e3
+    v = v_tau * tau - (body.R * gamma3 + body.a3) * w_tau * n - body.R * s * w_tau * e3
+    y = np.empty(17)
+    y[0:3], y[3:6], y[6:9], y[9:12], y[12:15] = v, w, alpha, beta, gamma
+    y[15:17] = position
+    return y
