@@ -166,7 +166,7 @@ class LevelSet:
         return np.imag(self.dU(theta + 1j * _COMPLEX_STEP)) / _COMPLEX_STEP
 
     def rho(self, theta):
-        """Invariant-measure density and mass of the reduced motion, ``rho(cos theta)`` (eq. 3.5)."""
+        """Invariant-measure density, also the reduced motion's mass: ``rho(cos theta)`` (3.5)."""
         return self.body.rho(np.cos(theta))
 
     def psi_dot(self, theta):

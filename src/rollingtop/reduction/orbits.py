@@ -74,8 +74,10 @@ class Orbit:
 
     def to_dict(self) -> dict:
         """JSON-ready dict (``inf``/NaN become ``None``)."""
-        return {k: (v if not isinstance(v, float) or math.isfinite(v) else None)
-                for k, v in asdict(self).items()}  # fmt: skip
+        return {
+            k: (v if not isinstance(v, float) or math.isfinite(v) else None)
+            for k, v in asdict(self).items()
+        }
 
 
 #: Gauss-Legendre rule for the energy gap near the turning points (see :func:`_gap`).
@@ -154,8 +156,15 @@ def period(
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # QUADPACK's round-off notice: its estimate is returned
-        value, err = quad(f, -math.pi / 2, math.pi / 2, points=breaks or None, epsabs=0.0,
-                          epsrel=PERIOD_RTOL, limit=2000)  # fmt: skip
+        value, err = quad(
+            f,
+            -math.pi / 2,
+            math.pi / 2,
+            points=breaks or None,
+            epsabs=0.0,
+            epsrel=PERIOD_RTOL,
+            limit=2000,
+        )
     return value, err
 
 
@@ -198,14 +207,13 @@ def orbits(level: LevelSet, h: float) -> list[Orbit]:
     # Walk the monotonic segments between knots; collect intervals where U <= h.
     result: list[Orbit] = []
     start = None
-    start_exact = False
     for i in range(len(knots) - 1):
         a, b, ua, ub = knots[i], knots[i + 1], values[i], values[i + 1]
         if start is None:
             if ua <= h and i > 0:  # a critical point at or below h begins a component
-                start, start_exact = a, ua == h
+                start = a
             elif ua > h >= ub:
-                start, start_exact = _root(level, h, a, b), False
+                start = _root(level, h, a, b)
         if start is not None and ub > h >= ua:
             end = _root(level, h, a, b) if ua < h else a
             result.append(_make_orbit(level, h, start, end, crit, steadies, scale))
@@ -233,29 +241,54 @@ def _make_orbit(level, h, t1, t2, crit, steadies, scale) -> Orbit:
         g_max = 1.0 if level.pole == "south" else g_max
         g_min = -1.0 if level.pole == "north" else g_min
     thetas = np.linspace(t1, t2, 2001)
-    w_tau_max = float(np.sqrt(np.max(np.maximum(2 * (h - level.U(thetas)) / level.rho(thetas),
-                                                0))))  # fmt: skip
+    w_tau_max = float(np.sqrt(np.max(np.maximum(2 * (h - level.U(thetas)) / level.rho(thetas), 0))))
     note = "passes through the pole" if passage else ""
     # steady motion: a centre with h at (or within round-off of) its potential
     if t2 - t1 < 1e-7 or any(
-        steadies[c].type == "center" and t1 <= c <= t2 and h - steadies[c].U
-        <= STEADY_TOLERANCE * scale for c in crit
-    ):  # fmt: skip
+        steadies[c].type == "center"
+        and t1 <= c <= t2
+        and h - steadies[c].U <= STEADY_TOLERANCE * scale
+        for c in crit
+    ):
         c = min(crit, key=lambda x: abs(x - (t1 + t2) / 2)) if crit else (t1 + t2) / 2
         m = steadies.get(c)
         T = m.period if m is not None else math.nan
         c = float(c)
-        return Orbit(math.cos(c), math.cos(c), c, c, T, 0.0, "steady", False, 0.0,
-                     "steady motion (h at the minimum of U); period of small oscillations")  # fmt: skip
+        return Orbit(
+            math.cos(c),
+            math.cos(c),
+            c,
+            c,
+            T,
+            0.0,
+            "steady",
+            False,
+            0.0,
+            "steady motion (h at the minimum of U); period of small oscillations",
+        )
     # saddles that bound or split this orbit: inside it, or just outside a turning point
     margin = 0.05 * (t2 - t1) + 1e-3
-    near = [c for c in crit if steadies[c].type != "center" and t1 - margin <= c <= t2 + margin
-            and abs(h - steadies[c].U) <= 1e-6 * scale]  # fmt: skip
+    near = [
+        c
+        for c in crit
+        if steadies[c].type != "center"
+        and t1 - margin <= c <= t2 + margin
+        and abs(h - steadies[c].U) <= 1e-6 * scale
+    ]
     gap = min((abs(h - steadies[c].U) for c in near), default=math.inf)
     if gap <= SEPARATRIX_TOLERANCE * scale:
-        return Orbit(g_min, g_max, t1, t2, math.inf, math.inf, "separatrix", passage, w_tau_max,
-                     f"on the separatrix (|h - U(saddle)| = {gap:.2g}): the period grows without "
-                     "bound")  # fmt: skip
+        return Orbit(
+            g_min,
+            g_max,
+            t1,
+            t2,
+            math.inf,
+            math.inf,
+            "separatrix",
+            passage,
+            w_tau_max,
+            f"on the separatrix (|h - U(saddle)| = {gap:.2g}): the period grows without bound",
+        )
     T, err = period(level, h, t1, t2, peaks=near)
     if near:
         # T ~ (2 / lambda) log(1/gap): the round-off of h and U (~eps * scale) moves T by

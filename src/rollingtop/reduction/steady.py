@@ -70,8 +70,10 @@ class SteadyMotion:
 
     def to_dict(self) -> dict:
         """JSON-ready dict (non-finite values become ``None``)."""
-        return {k: (v if not isinstance(v, float) or math.isfinite(v) else None)
-                for k, v in asdict(self).items()}  # fmt: skip
+        return {
+            k: (v if not isinstance(v, float) or math.isfinite(v) else None)
+            for k, v in asdict(self).items()
+        }
 
 
 def _grid(level: LevelSet) -> np.ndarray:
@@ -96,8 +98,9 @@ def critical_points(level: LevelSet) -> np.ndarray:
         if d[i] == 0.0:
             roots.append(grid[i])
         elif d[i + 1] != 0.0:
-            roots.append(brentq(level.dU, grid[i], grid[i + 1], xtol=1e-15, rtol=8.9e-16,
-                                maxiter=200))  # fmt: skip
+            roots.append(
+                brentq(level.dU, grid[i], grid[i + 1], xtol=1e-15, rtol=8.9e-16, maxiter=200)
+            )
     return np.unique(np.array(roots, dtype=float))
 
 

@@ -35,10 +35,15 @@ def reduced_rhs(body: SphericalTop, M3: float, x):
             s * w_tau,
             w_tau * w_n * k / s,
             w_tau * (M3 / I1 + g3 * w_n / s),
-            -(m * a3 * s * (g + R * w_tau**2) + M3 * w_n + I1 * g3 * w_n**2 / s
-              + m * v_tau * w_n * k / s) / rho,
+            -(
+                m * a3 * s * (g + R * w_tau**2)
+                + M3 * w_n
+                + I1 * g3 * w_n**2 / s
+                + m * v_tau * w_n * k / s
+            )
+            / rho,
         ]
-    )  # fmt: skip
+    )
 
 
 def reduced_integrals_of(body: SphericalTop, M3: float, x) -> dict[str, np.ndarray]:
@@ -60,9 +65,15 @@ def integrate_reduced(body: SphericalTop, M3: float, x0, t_eval, *, rtol=1e-12, 
     A 4-dimensional smooth system away from the poles: SciPy's integrator is adequate here.
     """
     t_eval = np.asarray(t_eval, dtype=float)
-    sol = solve_ivp(lambda t, x: reduced_rhs(body, M3, x), (t_eval[0], t_eval[-1]),
-                    np.asarray(x0, dtype=float), method="DOP853", rtol=rtol, atol=atol,
-                    t_eval=t_eval)  # fmt: skip
+    sol = solve_ivp(
+        lambda t, x: reduced_rhs(body, M3, x),
+        (t_eval[0], t_eval[-1]),
+        np.asarray(x0, dtype=float),
+        method="DOP853",
+        rtol=rtol,
+        atol=atol,
+        t_eval=t_eval,
+    )
     if not sol.success:
         raise RuntimeError(f"reduced integration failed: {sol.message}")
     return sol.y

@@ -52,7 +52,7 @@ def reduce_state(Y) -> dict[str, np.ndarray]:
 
 
 def reduced_integrals(body: SphericalTop, Y) -> dict[str, np.ndarray]:
-    """``M3 = I3 w3``, ``C1 = F5``, ``C2 = F6`` and ``h = E - I3 w3^2/2 - m g R`` of states ``Y``."""
+    """``M3 = I3 w3``, ``C1 = F5``, ``C2 = F6``, ``h = E - I3 w3^2/2 - m g R`` of states ``Y``."""
     Y = np.asarray(Y, dtype=float)
     M3 = lagrange(body, Y)
     return {
@@ -65,7 +65,8 @@ def reduced_integrals(body: SphericalTop, Y) -> dict[str, np.ndarray]:
 
 def euler_angles(Y) -> dict[str, np.ndarray]:
     """Euler angles ``psi, theta, phi`` (3-1-3) of states ``Y``, each shape ``(...)``:
-    ``gamma = (sin theta sin phi, sin theta cos phi, cos theta)``, ``psi = atan2(beta3, alpha3)``."""
+    ``gamma = (sin theta sin phi, sin theta cos phi, cos theta)``,
+    ``psi = atan2(beta3, alpha3)``."""
     Y = np.asarray(Y, dtype=float)
     return {
         "psi": np.arctan2(Y[..., 11], Y[..., 8]),
