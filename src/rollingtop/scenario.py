@@ -7,6 +7,9 @@ A scenario names a body, a contact model, initial conditions and integration opt
     [initial]     gamma, omega, optional alpha, position, and the model's free velocity
                   components (meridian: v_tau; smooth: v_horizontal = [vx, vy]) or a full v
     [integration] t_end, rtol, atol, samples, max_steps            (defaults: DEFAULTS)
+    [level]       M3, C1, C2 and optionally h, gamma3, branch, phi, psi: a level set of the
+                  meridian model's integrals (paper Sec. 3). With h and no [initial], the
+                  initial state is built on that level (:func:`rollingtop.reduction.state_from_level`)
 
 Unknown tables and keys are errors, so that a typo never silently falls back to a default.
 """
@@ -27,7 +30,14 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics.state import initial_state
 
-__all__ = ["Scenario", "InitialConditions", "IntegrationOptions", "load_scenario", "DEFAULTS"]
+__all__ = [
+    "DEFAULTS",
+    "InitialConditions",
+    "IntegrationOptions",
+    "LevelSpec",
+    "Scenario",
+    "load_scenario",
+]
 
 #: Integration defaults. ``atol`` defaults to ``rtol / 100`` when not given.
 DEFAULTS = {"t_end": 10.0, "rtol": 1e-10, "atol": None, "samples": 1001, "max_steps": 10**8}
@@ -35,6 +45,7 @@ DEFAULT_MODEL = "meridian"
 
 _BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3", "I2")
 _INITIAL_KEYS = ("gamma", "omega", "alpha", "position", "v")
+_LEVEL_KEYS = ("M3", "C1", "C2", "h", "gamma3", "branch", "phi", "psi")
 
 
 def _number(where: str, key: str, value: Any, *, integer: bool = False) -> float | int:
@@ -140,22 +151,107 @@ class InitialConditions:
 
 
 @dataclass(frozen=True)
+class LevelSpec:
+    """A level set of the meridian model's integrals, as given in a ``[level]`` table.
+
+    ``M3, C1, C2`` (Lagrange, area, F6) fix the level set; ``h`` (reduced energy
+    ``E - I3 w3^2/2 - m g R``) an orbit on it. ``gamma3`` (default: the lowest turning point),
+    ``branch`` (sign of ``w_tau``, default +1), ``phi`` and ``psi`` (Euler angles, default 0)
+    place the initial state when the scenario has no ``[initial]`` table.
+    """
+
+    M3: float
+    C1: float
+    C2: float
+    h: float | None = None
+    gamma3: float | None = None
+    branch: int = 1
+    phi: float = 0.0
+    psi: float = 0.0
+
+    def __post_init__(self) -> None:
+        for key in ("M3", "C1", "C2", "h", "gamma3", "phi", "psi"):
+            value = getattr(self, key)
+            if value is not None:
+                object.__setattr__(self, key, _number("level", key, value))
+        if self.branch not in (1, -1) or isinstance(self.branch, bool):
+            raise ScenarioError(f"level.branch = {self.branch!r} must be +1 or -1")
+
+
+@dataclass(frozen=True)
 class Scenario:
-    """A validated scenario: body, contact model, initial conditions, integration options.
+    """A validated scenario: body, contact model, initial conditions, integration options and
+    optionally a level set of the integrals.
 
     Construction checks the initial conditions against the model (so a scenario that loads can
-    be simulated); :attr:`y0` is the constraint-consistent initial state.
+    be simulated); :attr:`y0` is the constraint-consistent initial state, built from
+    ``initial``, else from ``level`` (with ``h``), else ``None`` (such a scenario serves the
+    reduction commands only).
     """
 
     body: SphericalTop
     model: ContactModel
-    initial: InitialConditions
+    initial: InitialConditions | None
     integration: IntegrationOptions = field(default_factory=IntegrationOptions)
     source: str | None = None
+    level: LevelSpec | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "model", get_model(self.model))
-        object.__setattr__(self, "y0", self.initial.state(self.body, self.model))
+        if self.initial is not None:
+            y0 = self.initial.state(self.body, self.model)
+        elif self.level is not None and self.level.h is not None:
+            y0 = self._state_on_level()
+        else:
+            y0 = None
+        object.__setattr__(self, "y0", y0)
+
+    def _require_meridian(self, what: str) -> None:
+        if self.model.name != "meridian":
+            raise ScenarioError(
+                f"{what} needs the meridian model (the reduction is the paper's), "
+                f"not {self.model.name!r}"
+            )
+
+    def _state_on_level(self):
+        from rollingtop.reduction import orbits, state_from_level
+
+        self._require_meridian("an initial state built from [level]")
+        level = self.level_set()
+        spec = self.level
+        gamma3 = spec.gamma3
+        if gamma3 is None:
+            gamma3 = orbits(level, spec.h)[0].gamma3_min
+        return state_from_level(level, spec.h, gamma3, branch=spec.branch, phi=spec.phi,
+                                psi=spec.psi)  # fmt: skip
+
+    def require_state(self):
+        """The initial state, or a :class:`ScenarioError` saying how to give one."""
+        if self.y0 is None:
+            raise ScenarioError(
+                "the scenario has no initial state: give an [initial] table, or h in [level]"
+            )
+        return self.y0
+
+    def level_set(self):
+        """The :class:`~rollingtop.reduction.LevelSet` of ``[level]``, else of the initial state."""
+        from rollingtop.reduction import LevelSet, reduced_integrals
+
+        self._require_meridian("the reduction to one degree of freedom")
+        if self.level is not None:
+            return LevelSet(self.body, self.level.M3, self.level.C1, self.level.C2)
+        ints = reduced_integrals(self.body, self.require_state())
+        return LevelSet(self.body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]))
+
+    def level_h(self) -> float:
+        """The reduced energy ``h`` of ``[level]``, else of the initial state."""
+        from rollingtop.reduction import reduced_integrals
+
+        if self.level is not None and self.level.h is not None:
+            return self.level.h
+        if self.level is not None and self.initial is None:
+            raise ScenarioError("no h: give h in [level] (or --h)")
+        return float(reduced_integrals(self.body, self.require_state())["h"])
 
     def with_overrides(self, **overrides) -> Scenario:
         """A copy with integration options (``t_end, rtol, atol, samples, max_steps``) or the
@@ -169,20 +265,22 @@ class Scenario:
             )
         model = overrides.pop("model", self.model)
         integration = replace(self.integration, **overrides) if overrides else self.integration
-        return Scenario(self.body, get_model(model), self.initial, integration, self.source)
+        return Scenario(self.body, get_model(model), self.initial, integration, self.source,
+                        self.level)  # fmt: skip
 
     @classmethod
     def from_dict(cls, data: dict, source: str | None = None) -> Scenario:
         """Build from the parsed TOML structure (see the module docstring)."""
-        allowed_tables = ("body", "contact", "initial", "integration")
+        allowed_tables = ("body", "contact", "initial", "integration", "level")
         for key, value in data.items():
             if key not in allowed_tables:
                 raise ScenarioError(f"unknown table [{key}] (allowed: {', '.join(allowed_tables)})")
             if not isinstance(value, dict):
                 raise ScenarioError(f"[{key}] must be a table")
-        for required in ("body", "initial"):
-            if required not in data:
-                raise ScenarioError(f"missing table [{required}]")
+        if "body" not in data:
+            raise ScenarioError("missing table [body]")
+        if "initial" not in data and "level" not in data:
+            raise ScenarioError("missing table [initial] (or [level])")
 
         body_t = data["body"]
         _reject_unknown("body", body_t, _BODY_KEYS)
@@ -194,6 +292,20 @@ class Scenario:
         contact_t = data.get("contact", {})
         _reject_unknown("contact", contact_t, ("model",))
         model = get_model(contact_t.get("model", DEFAULT_MODEL))
+
+        level = None
+        if "level" in data:
+            level_t = data["level"]
+            _reject_unknown("level", level_t, _LEVEL_KEYS)
+            missing = [k for k in ("M3", "C1", "C2") if k not in level_t]
+            if missing:
+                raise ScenarioError(f"[level] is missing {', '.join(missing)}")
+            level = LevelSpec(**level_t)
+        integ_t = data.get("integration", {})
+        _reject_unknown("integration", integ_t, tuple(DEFAULTS))
+        integration = IntegrationOptions(**integ_t)
+        if "initial" not in data:
+            return cls(body, model, None, integration, source, level)
 
         init_t = dict(data["initial"])
         free_keys = tuple(model.free_velocity)
@@ -214,10 +326,7 @@ class Scenario:
             v=init_t.get("v"),
             free={k: init_t[k] for k in free_keys if k in init_t},
         )
-        integ_t = data.get("integration", {})
-        _reject_unknown("integration", integ_t, tuple(DEFAULTS))
-        integration = IntegrationOptions(**integ_t)
-        return cls(body, model, initial, integration, source)
+        return cls(body, model, initial, integration, source, level)
 
 
 def _reject_unknown(table: str, values: dict, allowed: tuple[str, ...]) -> None:

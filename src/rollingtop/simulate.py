@@ -52,7 +52,7 @@ def simulate(
     result = integrate(
         scenario.model.code,
         scenario.body.params,
-        scenario.y0,
+        scenario.require_state(),
         opts.t_eval,
         rtol=opts.rtol,
         atol=opts.resolved_atol,

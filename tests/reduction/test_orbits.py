@@ -102,7 +102,8 @@ def test_period_matches_mpmath(fig5, paper_body, h):
         assert o.kind == "periodic" and o.period_error < PERIOD_RTOL * o.period
 
 
-@pytest.mark.parametrize("h", [4.0, 6.0])
+@pytest.mark.parametrize("h", [4.0, 5.5])
+@pytest.mark.filterwarnings("ignore::rollingtop.ContactLostWarning")  # the upper well at 5.5
 def test_period_matches_the_full_simulation(fig5, h):
     for o in orbits(fig5, h):
         traj = simulate_from(fig5, h, o.gamma3_min + 1e-3 * (o.gamma3_max - o.gamma3_min),

@@ -91,7 +91,8 @@ def state_from_level(
     ----------
     level : LevelSet
     h : float
-        Reduced energy ``rho w_tau^2/2 + U``; must be ``>= U(gamma3)``.
+        Reduced energy ``rho w_tau^2/2 + U``; must be ``>= U(gamma3)`` (to 1e-12 relative: a
+        turning point found numerically is accepted, with ``w_tau = 0``).
     gamma3 : float
         Starting ``gamma3`` in ``(-1, 1)``.
     branch : {+1, -1}
@@ -113,13 +114,13 @@ def state_from_level(
         raise LevelSetError(f"branch = {branch!r} must be +1 or -1")
     theta = math.acos(gamma3)
     U = float(level.U(theta))
-    if h < U:
+    if h < U - 1e-12 * max(1.0, abs(U)):
         raise LevelSetError(
             f"h = {h:.12g} is below the effective potential U({gamma3:g}) = {U:.12g}: "
             "no motion passes through this gamma3"
         )
     rho = float(level.rho(theta))
-    w_tau = branch * math.sqrt(2.0 * (h - U) / rho)
+    w_tau = branch * math.sqrt(max(2.0 * (h - U) / rho, 0.0))  # 0 at a turning point
     w_n = float(level.w_n(theta))
     v_tau = float(level.v_tau(theta))
     s = math.sin(theta)
