@@ -47,6 +47,14 @@ def _progress_bar(t_end: float):
     )
 
 
+def _console():
+    """Console on stdout; when stdout is not a terminal, wide enough that no table is cut."""
+    from rich.console import Console
+
+    console = Console()
+    return console if console.is_terminal else Console(width=160)
+
+
 def _integrals_table(summary: dict):
     from rich.table import Table
 
@@ -66,9 +74,7 @@ def _integrals_table(summary: dict):
 
 
 def _print_report(summary: dict) -> None:
-    from rich.console import Console
-
-    console = Console()
+    console = _console()
     console.print(_integrals_table(summary))
     c, r, s = summary["constraints"], summary["reactions"], summary["stats"]
     lost = r["contact_lost_at"]
@@ -132,6 +138,115 @@ def simulate(scenario, t_end, rtol, atol, samples, model, output, as_json):
         _print_report(summary)
         if output is not None:
             click.echo(f"wrote {output}")
+
+
+def _level_of(scenario_path: str):
+    from rollingtop.scenario import load_scenario
+
+    sc = load_scenario(scenario_path)
+    return sc, sc.level_set()
+
+
+def _level_json(level, **extra) -> dict:
+    return {"M3": level.M3, "C1": level.C1, "C2": level.C2, "pole": level.pole, **extra}
+
+
+def _steady_table(level, motions):
+    from rich.table import Table
+
+    spin = level.M3 / level.body.I3
+    table = Table(title=f"steady motions on {level.describe()} (spin w3 = {spin:.7g})")
+    cols = ("gamma3", "U", "type", "omega", "period", "psi'", "|v_CoM|", "CoM radius")
+    for col in cols:
+        table.add_column(col, justify="left" if col == "type" else "right")
+
+    def num(x):
+        return "-" if x is None or x != x else f"{x:.7g}"
+
+    for m in motions:
+        table.add_row(num(m.gamma3), num(m.U), m.type, num(m.frequency), num(m.period),
+                      num(m.precession_rate), num(m.com_speed), num(m.com_radius))  # fmt: skip
+    return table
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
+def equilibria(scenario, as_json):
+    """Steady motions (critical points of U) on the scenario's level set, sorted by gamma3.
+
+    The level set is the scenario's [level] table, else the one of its initial state.
+    """
+    from rollingtop.reduction import steady_motions
+
+    _, level = _level_of(scenario)
+    motions = steady_motions(level)
+    if as_json:
+        click.echo(json.dumps({"level": _level_json(level),
+                               "equilibria": [m.to_dict() for m in motions]}))  # fmt: skip
+    else:
+        _console().print(_steady_table(level, motions))
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("--h", "h", type=float, default=None, help="Reduced energy h (overrides [level]).")
+@click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
+def orbits(scenario, h, as_json):
+    """Orbits on the level set (M3, C1, C2, h): turning points and periods, sorted by gamma3_min."""
+    from rollingtop.reduction import orbits as find_orbits
+
+    sc, level = _level_of(scenario)
+    h = sc.level_h() if h is None else h
+    found = find_orbits(level, h)
+    if as_json:
+        click.echo(json.dumps({"level": _level_json(level, h=h),
+                               "orbits": [o.to_dict() for o in found]}))  # fmt: skip
+        return
+    from rich.table import Table
+
+    table = Table(title=f"orbits on {level.describe()}, h = {h:g}")
+    for col in ("gamma3_min", "gamma3_max", "period", "+-", "kind", "note"):
+        table.add_column(col, justify="left" if col in ("kind", "note") else "right")
+    for o in found:
+        table.add_row(f"{o.gamma3_min:.10g}", f"{o.gamma3_max:.10g}", f"{o.period:.12g}",
+                      f"{o.period_error:.1e}", o.kind, o.note)  # fmt: skip
+    _console().print(table)
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(), required=True, help="FIG.png, .svg or .pdf.")
+@click.option(
+    "--h-levels",
+    type=str,
+    default=None,
+    help="Comma-separated energies h of the orbits drawn (default: a spread from the minimum of "
+    "U to above the saddles, plus the separatrices).",
+)
+@click.option("--no-contact", is_flag=True, help="Do not shade where the normal force is < 0.")
+def portrait(scenario, output, h_levels, no_contact):
+    """Phase portrait (gamma3, w_tau) on the scenario's level set; prints the steady motions."""
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES, phase_portrait, save_figure
+    from rollingtop.reduction import steady_motions
+
+    check_output_path(output, FIGURE_SUFFIXES)
+    levels = None
+    if h_levels is not None:
+        try:
+            levels = [float(x) for x in h_levels.split(",") if x.strip()]
+        except ValueError:
+            raise click.UsageError(
+                f"--h-levels {h_levels!r}: expected comma-separated numbers"
+            ) from None
+        if not levels:
+            raise click.UsageError("--h-levels: no value given")
+    _, level = _level_of(scenario)
+    fig = phase_portrait(level, levels, show_contact=not no_contact)
+    save_figure(fig, output)
+    _console().print(_steady_table(level, steady_motions(level)))
+    click.echo(f"wrote {output}")
 
 
 def main(argv: list[str] | None = None) -> None:

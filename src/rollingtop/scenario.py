@@ -9,7 +9,7 @@ A scenario names a body, a contact model, initial conditions and integration opt
     [integration] t_end, rtol, atol, samples, max_steps            (defaults: DEFAULTS)
     [level]       M3, C1, C2 and optionally h, gamma3, branch, phi, psi: a level set of the
                   meridian model's integrals (paper Sec. 3). With h and no [initial], the
-                  initial state is built on that level (:func:`rollingtop.reduction.state_from_level`)
+                  initial state is built on that level (``reduction.state_from_level``)
 
 Unknown tables and keys are errors, so that a typo never silently falls back to a default.
 """

@@ -1,0 +1,171 @@
+"""Phase portraits of the reduced system in the plane ``(gamma3, w_tau)`` (paper Fig. 5).
+
+Each orbit is drawn from its exact parametrisation, not from a contoured grid: between its
+turning points ``theta = c + d sin(phi)`` and ``w_tau = +-sqrt(2 (h - U) / rho)``, so curves close
+exactly at the turning points and the separatrices pass exactly through the saddles. Where the
+normal reaction of the plane would be negative (the body would jump: the model does not apply)
+the plane is shaded.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from rollingtop.dynamics import _kernel
+from rollingtop.reduction import LevelSet, LevelSetError, orbits, state_from_level, steady_motions
+from rollingtop.reduction.orbits import _gap
+
+__all__ = ["phase_portrait", "default_h_levels"]
+
+
+def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
+    """``count`` energies from just above the lowest steady motion to half again past the highest
+    saddle (or, without saddles, a band above the minimum), plus the saddles' levels."""
+    motions = steady_motions(level)
+    if not motions:
+        raise LevelSetError(f"no steady motion on {level.describe()}: U has no minimum")
+    u_min = min(m.U for m in motions)
+    saddles = [m.U for m in motions if m.type == "saddle"]
+    if saddles:
+        top = max(saddles) + 0.5 * (max(saddles) - u_min)
+    else:
+        grid = np.linspace(*level.theta_domain, 2001)[200:-200]
+        top = u_min + 0.5 * (float(np.median(level.U(grid))) - u_min)
+    levels = u_min + (top - u_min) * (np.arange(1, count + 1) / count) ** 1.5
+    return sorted({*map(float, levels), *saddles})
+
+
+def _orbit_curve(level: LevelSet, h: float, t1: float, t2: float, n: int = 400):
+    phi = np.linspace(-math.pi / 2, math.pi / 2, n)
+    theta = (t1 + t2) / 2 + (t2 - t1) / 2 * np.sin(phi)
+    w = np.sqrt(np.maximum(2 * _gap(level, h, t1, t2, phi) / level.rho(theta), 0.0))
+    g3 = np.cos(theta)
+    return np.concatenate([g3, g3[::-1]]), np.concatenate([w, -w[::-1]])
+
+
+def _normal_force_grid(level: LevelSet, g3: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape (nw, ng)."""
+    states = []
+    for gg in g3:
+        theta = math.acos(gg)
+        U, rho = float(level.U(theta)), float(level.rho(theta))
+        for ww in w:
+            h = U + 0.5 * rho * ww * ww
+            states.append(state_from_level(level, h, gg, branch=1 if ww >= 0 else -1))
+    Y = np.ascontiguousarray(states)
+    out = np.empty((len(Y), 8))
+    _kernel.diagnostics(0, level.body.params, Y, out)
+    return out[:, 0].reshape(len(g3), len(w)).T
+
+
+def phase_portrait(
+    level: LevelSet,
+    h_levels=None,
+    *,
+    show_contact: bool = True,
+    figsize=(7.0, 7.5),
+) -> Figure:
+    """Phase portrait on the level set ``(M3, C1, C2)``: orbits at ``h_levels``, separatrices,
+    steady motions, the effective potential below.
+
+    Parameters
+    ----------
+    level : LevelSet
+    h_levels : sequence of float, optional
+        Energies of the orbits drawn; default :func:`default_h_levels`.
+    show_contact : bool
+        Shade where the normal force of the plane would be negative.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    body = level.body
+    motions = steady_motions(level)
+    levels = default_h_levels(level) if h_levels is None else sorted(map(float, h_levels))
+    saddle_levels = {m.U for m in motions if m.type == "saddle"}
+    fig = Figure(figsize=figsize, layout="constrained")
+    ax, axu = fig.subplots(2, 1, height_ratios=[3, 1.3], sharex=True)
+    cmap = fig.colormaps["viridis"] if hasattr(fig, "colormaps") else None
+    if cmap is None:
+        import matplotlib
+
+        cmap = matplotlib.colormaps["viridis"]
+    lo_h, hi_h = min(levels), max(levels)
+    g_lo, g_hi, w_top = 1.0, -1.0, 0.0
+    drawn_sep = drawn = False
+    for h in levels:
+        try:
+            comps = orbits(level, h)
+        except LevelSetError:
+            continue
+        separatrix = any(abs(h - u) <= 1e-12 * max(1.0, abs(u)) for u in saddle_levels)
+        for o in comps:
+            if o.kind == "steady":
+                continue
+            x, y = _orbit_curve(level, h, o.theta_min, o.theta_max)
+            g_lo, g_hi = min(g_lo, x.min()), max(g_hi, x.max())
+            w_top = max(w_top, float(np.max(np.abs(y))))
+            if separatrix or o.kind == "separatrix":
+                ax.plot(x, y, color="crimson", lw=1.8, zorder=3,
+                        label=None if drawn_sep else "separatrix")  # fmt: skip
+                drawn_sep = True
+            else:
+                frac = (h - lo_h) / (hi_h - lo_h) if hi_h > lo_h else 0.5
+                ax.plot(x, y, color=cmap(0.1 + 0.8 * frac), lw=1.0, zorder=2,
+                        label=None if drawn else "orbits (colour: h)")  # fmt: skip
+                drawn = True
+    if g_lo > g_hi:
+        raise LevelSetError(f"no motion on {level.describe()} at the requested h levels")
+    pad = 0.05 * (g_hi - g_lo) + 1e-3
+    g_lo, g_hi = max(-1.0, g_lo - pad), min(1.0, g_hi + pad)
+    w_top *= 1.1
+    if show_contact:
+        gg = np.linspace(max(g_lo, -0.999), min(g_hi, 0.999), 90)
+        ww = np.linspace(-w_top, w_top, 80)
+        N = _normal_force_grid(level, gg, ww)
+        if np.any(N < 0):
+            ax.contourf(gg, ww, N, levels=[N.min() - 1, 0.0], colors=["#f4c7c3"], zorder=1)
+            ax.plot([], [], color="#f4c7c3", lw=6, label="normal force < 0 (contact lost)")
+    for m in motions:
+        if not g_lo <= m.gamma3 <= g_hi:
+            continue
+        if m.type == "center":
+            ax.plot(m.gamma3, 0, "o", color="black", ms=5, zorder=4)
+        else:
+            ax.plot(m.gamma3, 0, "x", color="crimson", ms=8, mew=2, zorder=4)
+    ax.plot([], [], "o", color="black", ms=5, label="steady motion (centre)")
+    if saddle_levels:
+        ax.plot([], [], "x", color="crimson", ms=8, mew=2, label="steady motion (saddle)")
+    ax.set_xlim(g_lo, g_hi)
+    ax.set_ylim(-w_top, w_top)
+    ax.set_ylabel(r"$\omega_\tau$")
+    ax.axhline(0, color="0.85", lw=0.6, zorder=0)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncols=3, fontsize=8,
+               frameon=False)  # fmt: skip
+    pole = {None: "", "south": ", south pole case", "north": ", north pole case"}[level.pole]
+    ax.set_title(
+        rf"$M_3={level.M3:g},\ C_1={level.C1:g},\ C_2={level.C2:g}${pole}"
+        "\n"
+        rf"$R={body.R:g},\ m={body.m:g},\ g={body.g:g},\ a_3={body.a3:g},\ "
+        rf"I_1={body.I1:g},\ I_3={body.I3:g}$",
+        fontsize=10,
+    )
+    # effective potential with the h levels
+    g = np.linspace(max(g_lo, -0.9999), min(g_hi, 0.9999), 1500)
+    U = level.U_gamma3(g)
+    axu.plot(g, U, color="black", lw=1.2)
+    for h in levels:
+        sep = any(abs(h - u) <= 1e-12 * max(1.0, abs(u)) for u in saddle_levels)
+        frac = (h - lo_h) / (hi_h - lo_h) if hi_h > lo_h else 0.5
+        axu.axhline(h, color="crimson" if sep else cmap(0.1 + 0.8 * frac), lw=0.8)
+    u_min = min((m.U for m in motions), default=float(np.min(U)))
+    axu.set_ylim(u_min - 0.05 * (hi_h - u_min), hi_h + 0.15 * (hi_h - u_min))
+    axu.set_xlabel(r"$\gamma_3$")
+    axu.set_ylabel(r"$U,\ h$")
+    axu.text(0.01, 0.95, r"$U(\gamma_3)$ and the levels $h$", transform=axu.transAxes,
+             va="top", fontsize=8)  # fmt: skip
+    return fig
