@@ -132,3 +132,18 @@ def test_smooth_and_full_velocity(tmp_path):
         "smooth", initial=f"gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nv = [{v}]"
     )
     np.testing.assert_allclose(load_scenario(write(tmp_path, text)).y0, sc.y0, atol=1e-15)
+
+
+def test_level_table_builds_the_initial_state():
+    """examples/fig5.toml has no [initial]: the state starts on its level, at the lowest turning
+    point of the first orbit (w_tau = 0 there)."""
+    from rollingtop.reduction import reduce_state, reduced_integrals
+
+    sc = load_scenario(EXAMPLES / "fig5.toml")
+    ints = reduced_integrals(sc.body, sc.y0)
+    for name, value in (("M3", 1.0), ("C1", 0.5), ("C2", -2.0), ("h", 4.0)):
+        assert float(ints[name]) == pytest.approx(value, abs=1e-12)
+    red = reduce_state(sc.y0)
+    assert float(red["w_tau"]) == pytest.approx(0.0, abs=1e-7)
+    assert float(red["gamma3"]) == pytest.approx(-0.656411968, abs=1e-9)
+    assert sc.level_h() == 4.0 and sc.level_set().C2 == -2.0

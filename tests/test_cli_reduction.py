@@ -1,0 +1,95 @@
+"""Command line for the reduction: equilibria, orbits, portrait (JSON contracts, errors)."""
+
+import json
+
+import pytest
+
+from rollingtop.reduction import LevelSet, orbits, steady_motions
+
+from .conftest import EXAMPLES, scenario_text
+from .test_cli import run_cli
+
+FIG5 = str(EXAMPLES / "fig5.toml")
+
+
+def test_equilibria_json(capsys, paper_body):
+    code, out, err = run_cli(capsys, "equilibria", FIG5, "--json")
+    assert code == 0 and err == ""
+    data = json.loads(out)
+    eq = data["equilibria"]
+    assert [e["type"] for e in eq] == ["center", "saddle", "center"]
+    assert [e["gamma3"] for e in eq] == sorted(e["gamma3"] for e in eq)
+    expected = steady_motions(LevelSet(paper_body, 1.0, 0.5, -2.0))
+    for e, m in zip(eq, expected, strict=True):
+        assert e["U"] == m.U and e["gamma3"] == m.gamma3
+    assert data["level"] == {"M3": 1.0, "C1": 0.5, "C2": -2.0, "pole": None}
+
+
+def test_orbits_json_uses_h_from_level_and_option(capsys, paper_body):
+    code, out, _ = run_cli(capsys, "orbits", FIG5, "--json")
+    data = json.loads(out)
+    assert code == 0 and data["level"]["h"] == 4.0
+    assert len(data["orbits"]) == 2
+    assert data["orbits"][0]["gamma3_min"] < data["orbits"][1]["gamma3_min"]
+    code, out, _ = run_cli(capsys, "orbits", FIG5, "--h", "5.0", "--json")
+    got = json.loads(out)["orbits"]
+    ref = orbits(LevelSet(paper_body, 1.0, 0.5, -2.0), 5.0)
+    assert [o["period"] for o in got] == [o.period for o in ref]
+
+
+def test_orbits_from_initial_state(capsys):
+    """Without [level], the level set and h are those of the initial state."""
+    code, out, _ = run_cli(capsys, "orbits", str(EXAMPLES / "paper.toml"), "--json")
+    data = json.loads(out)
+    assert code == 0 and data["level"]["M3"] == pytest.approx(1.0)
+    assert data["level"]["h"] == pytest.approx(0.4849)
+    (o,) = data["orbits"]
+    assert o["gamma3_min"] < 0.8 < o["gamma3_max"]  # the initial gamma3 lies on the orbit
+
+
+@pytest.mark.parametrize("suffix", [".png", ".svg", ".pdf"])
+def test_portrait_writes_each_format(capsys, tmp_path, suffix):
+    out_file = tmp_path / f"fig5{suffix}"
+    code, out, err = run_cli(capsys, "portrait", FIG5, "-o", str(out_file), "--h-levels",
+                             "3.4,4,5,5.935716542281,6.5", "--no-contact")  # fmt: skip
+    assert code == 0, err
+    head = out_file.read_bytes()[:8]
+    assert {".png": head.startswith(b"\x89PNG"), ".svg": b"<?xml" in head,
+            ".pdf": head.startswith(b"%PDF")}[suffix]  # fmt: skip
+    assert out_file.stat().st_size > 5000
+    assert "saddle" in out and "center" in out
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["orbits", FIG5, "--h", "1.0"], "h is below the minimum of the effective potential"),
+        (["equilibria", str(EXAMPLES / "smooth.toml")], "needs the meridian model"),
+        (["portrait", FIG5, "-o", "x.gif"], "unknown output format '.gif'"),
+        (["portrait", FIG5, "-o", "x.png", "--h-levels", "a,b"], "expected comma-separated"),
+    ],
+)
+def test_reduction_errors(capsys, tmp_path, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, *args)
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and message in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_level_table_errors(capsys, tmp_path):
+    bad = [
+        (scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5"), r"\[level\] is missing C2"),
+        (scenario_text(level="M3 = 1.0\nC1 = 0.5\nC2 = 0.0\nE = 3"), "unknown key level.E"),
+        (scenario_text(level="M3 = 1.0\nC1 = 0.5\nC2 = 0.0\nbranch = 2"), "branch = 2"),
+        (scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5\nC2 = -2.0\nh = 1.0"),
+         "h is below the minimum"),
+    ]  # fmt: skip
+    for text, message in bad:
+        (tmp_path / "s.toml").write_text(text)
+        code, _, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"))
+        assert code == 2 and __import__("re").search(message, err), err
+    (tmp_path / "s.toml").write_text(scenario_text(initial=None,
+                                                   level="M3 = 1.0\nC1 = 0.5\nC2 = -2.0"))  # fmt: skip
+    code, _, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"))
+    assert code == 2 and "no initial state" in err
