@@ -1,6 +1,7 @@
 """Command line for the reduction: equilibria, orbits, portrait (JSON contracts, errors)."""
 
 import json
+import re
 
 import pytest
 
@@ -50,12 +51,23 @@ def test_orbits_from_initial_state(capsys):
 @pytest.mark.parametrize("suffix", [".png", ".svg", ".pdf"])
 def test_portrait_writes_each_format(capsys, tmp_path, suffix):
     out_file = tmp_path / f"fig5{suffix}"
-    code, out, err = run_cli(capsys, "portrait", FIG5, "-o", str(out_file), "--h-levels",
-                             "3.4,4,5,5.935716542281,6.5", "--no-contact")  # fmt: skip
+    code, out, err = run_cli(
+        capsys,
+        "portrait",
+        FIG5,
+        "-o",
+        str(out_file),
+        "--h-levels",
+        "3.4,4,5,5.935716542281,6.5",
+        "--no-contact",
+    )
     assert code == 0, err
     head = out_file.read_bytes()[:8]
-    assert {".png": head.startswith(b"\x89PNG"), ".svg": b"<?xml" in head,
-            ".pdf": head.startswith(b"%PDF")}[suffix]  # fmt: skip
+    assert {
+        ".png": head.startswith(b"\x89PNG"),
+        ".svg": b"<?xml" in head,
+        ".pdf": head.startswith(b"%PDF"),
+    }[suffix]
     assert out_file.stat().st_size > 5000
     assert "saddle" in out and "center" in out
 
@@ -82,14 +94,17 @@ def test_level_table_errors(capsys, tmp_path):
         (scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5"), r"\[level\] is missing C2"),
         (scenario_text(level="M3 = 1.0\nC1 = 0.5\nC2 = 0.0\nE = 3"), "unknown key level.E"),
         (scenario_text(level="M3 = 1.0\nC1 = 0.5\nC2 = 0.0\nbranch = 2"), "branch = 2"),
-        (scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5\nC2 = -2.0\nh = 1.0"),
-         "h is below the minimum"),
-    ]  # fmt: skip
+        (
+            scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5\nC2 = -2.0\nh = 1.0"),
+            "h is below the minimum",
+        ),
+    ]
     for text, message in bad:
         (tmp_path / "s.toml").write_text(text)
         code, _, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"))
-        assert code == 2 and __import__("re").search(message, err), err
-    (tmp_path / "s.toml").write_text(scenario_text(initial=None,
-                                                   level="M3 = 1.0\nC1 = 0.5\nC2 = -2.0"))  # fmt: skip
+        assert code == 2 and re.search(message, err), err
+    (tmp_path / "s.toml").write_text(
+        scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5\nC2 = -2.0")
+    )
     code, _, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"))
     assert code == 2 and "no initial state" in err
