@@ -155,7 +155,8 @@ class LevelSpec:
     """A level set of the meridian model's integrals, as given in a ``[level]`` table.
 
     ``M3, C1, C2`` (Lagrange, area, F6) fix the level set; ``h`` (reduced energy
-    ``E - I3 w3^2/2 - m g R``) an orbit on it. ``gamma3`` (default: the lowest turning point),
+    ``E - I3 w3^2/2 - m g R``) an orbit on it. ``gamma3`` (default: the first orbit's lowest
+    turning point, or its other one when the lowest lies beyond a pole passage),
     ``branch`` (sign of ``w_tau``, default +1), ``phi`` and ``psi`` (Euler angles, default 0)
     place the initial state when the scenario has no ``[initial]`` table.
     """
@@ -220,8 +221,10 @@ class Scenario:
         level = self.level_set()
         spec = self.level
         gamma3 = spec.gamma3
-        if gamma3 is None:
-            gamma3 = orbits(level, spec.h)[0].gamma3_min
+        if gamma3 is None:  # a turning point of the first orbit, on the branch 0 < theta < pi
+            orbit = orbits(level, spec.h)[0]
+            theta = orbit.theta_max if 0 < orbit.theta_max < math.pi else orbit.theta_min
+            gamma3 = math.cos(theta)
         return state_from_level(level, spec.h, gamma3, branch=spec.branch, phi=spec.phi,
                                 psi=spec.psi)  # fmt: skip
 

@@ -7,6 +7,7 @@ import warnings
 from collections.abc import Callable
 
 from rollingtop._errors import ContactLostWarning
+from rollingtop.contact import meridian
 from rollingtop.integrate import integrate
 from rollingtop.scenario import Scenario, load_scenario
 from rollingtop.trajectory import Trajectory
@@ -49,10 +50,14 @@ def simulate(
         scenario = load_scenario(scenario)
     scenario = scenario.with_overrides(**overrides)
     opts = scenario.integration
+    y0 = scenario.require_state()
+    code = scenario.model.code
+    if scenario.model.name == "meridian":
+        code = meridian.kernel_code(scenario.body, y0)  # pole cases carry nu through the pole
     result = integrate(
-        scenario.model.code,
+        code,
         scenario.body.params,
-        scenario.require_state(),
+        y0,
         opts.t_eval,
         rtol=opts.rtol,
         atol=opts.resolved_atol,
@@ -78,6 +83,7 @@ def simulate(
         step_reactions=result.reactions,
         event_t=result.event_t,
         event_y=result.event_y,
+        kernel_code=code,
     )
     lost = traj.contact_lost_at
     if lost is not None:

@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from rollingtop.body import SphericalTop
-from rollingtop.contact import ContactModel
+from rollingtop.contact import ContactModel, meridian
 from rollingtop.dynamics import _kernel
-from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, POSITION, V, W
+from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.io import atomic_write, check_output_path
 
@@ -59,8 +59,9 @@ class Trajectory:
     body : SphericalTop
     model : ContactModel
     t : ndarray, shape (n,)
-    y : ndarray, shape (n, 17)
-        States ``(v, w, alpha, beta, gamma, X, Y)``, body-frame vectors.
+    y : ndarray, shape (n, 18)
+        States ``(v, w, alpha, beta, gamma, X, Y, psi_nu)``, body-frame vectors (see
+        :mod:`rollingtop.dynamics._layout`).
     rtol, atol : float
         Tolerances the motion was integrated with.
     stats : dict
@@ -70,8 +71,11 @@ class Trajectory:
         ``min_normal_force, t_min_normal_force, contact_lost_at, max_friction_ratio, ...``.
     event_t : ndarray, shape (k,)
         Times of the events asked of :func:`rollingtop.simulate` (empty otherwise).
-    event_y : ndarray, shape (k, 17)
+    event_y : ndarray, shape (k, 18)
         States at those events.
+    kernel_code : int, optional
+        Compiled kernel the motion was integrated with (the model's code, or a pole variant of
+        the meridian model); defaults to ``model.code``.
     """
 
     body: SphericalTop
@@ -83,7 +87,17 @@ class Trajectory:
     stats: dict = field(default_factory=dict)
     step_reactions: dict = field(default_factory=dict)
     event_t: np.ndarray = field(default_factory=lambda: np.empty(0))
-    event_y: np.ndarray = field(default_factory=lambda: np.empty((0, 17)))
+    event_y: np.ndarray = field(default_factory=lambda: np.empty((0, N_STATE)))
+    kernel_code: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.kernel_code is None:
+            self.kernel_code = self.model.code
+
+    @property
+    def pole_case(self) -> str | None:
+        """``"south"``/``"north"`` when integrated as a meridian pole case, else ``None``."""
+        return {meridian.SOUTH_CODE: "south", meridian.NORTH_CODE: "north"}.get(self.kernel_code)
 
     # ---- state components -------------------------------------------------------------------
     @property
@@ -129,12 +143,13 @@ class Trajectory:
     @functools.cached_property
     def integrals(self) -> dict[str, np.ndarray]:
         """First integrals of the model and body along the samples, each shape (n,)."""
-        return evaluate(self.body, self.y, self.model.integrals(self.body.symmetric))
+        names = self.model.integrals(self.body.symmetric)
+        return evaluate(self.body, self.y, names, pole=self.pole_case)
 
     @functools.cached_property
     def _diagnostics(self) -> np.ndarray:
         out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
-        _kernel.diagnostics(self.model.code, self.body.params, np.ascontiguousarray(self.y), out)
+        _kernel.diagnostics(self.kernel_code, self.body.params, np.ascontiguousarray(self.y), out)
         return out
 
     @property

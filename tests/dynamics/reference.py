@@ -32,7 +32,11 @@ def directions(model, alpha, beta, gamma, w):
 
 
 def rhs(model, p, y):
-    """``y'`` and the contact force ``F`` (body frame) for state ``y`` of the package's layout."""
+    """``y'`` and the contact force ``F`` (body frame) for state ``y`` of the package's layout.
+
+    Only the 17 physical components are used and returned (the package's 18th, the carried
+    azimuth of ``nu``, is a device of its pole handling and stays constant here).
+    """
     R, m, g, a3, I1, I2, I3 = p
     Iv = np.array([I1, I2, I3])
     v, w = y[0:3], y[3:6]
@@ -58,7 +62,7 @@ def rhs(model, p, y):
     sol = np.linalg.solve(M, b)
     lam = sol[6:]
     force = sum(l * d for l, (d, _) in zip(lam, dirs, strict=True))
-    dy = np.empty(17)
+    dy = np.zeros(len(y))
     dy[0:6] = sol[0:6]
     dy[6:9] = np.cross(alpha, w)
     dy[9:12] = np.cross(beta, w)

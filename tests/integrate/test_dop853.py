@@ -53,7 +53,7 @@ def test_error_decreases_with_tolerance_like_an_eighth_order_method():
     errors, steps = [], []
     for rtol in (1e-6, 1e-8, 1e-10):
         r = integrate(0, sc.body.params, sc.y0, np.array([0.0, 10.0]), rtol=rtol, atol=rtol / 100)
-        errors.append(np.max(np.abs(r.y[-1] - ref)))
+        errors.append(np.max(np.abs(r.y[-1, :17] - ref[:17])))
         steps.append(r.steps)
     assert errors[0] > 10 * errors[1] > 100 * errors[2]
     assert errors[2] < 1e-8
@@ -67,7 +67,7 @@ def test_step_count_close_to_scipy_dop853():
     ws = _kernel.new_workspace()
 
     def f(t, y):
-        dy = np.empty(17)
+        dy = np.empty(18)
         _kernel.rhs(0, sc.body.params, np.ascontiguousarray(y), dy, ws)
         return dy
 

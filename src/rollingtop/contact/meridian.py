@@ -3,6 +3,22 @@
 Kilin & Ivanova (2023), eqs. (2.4)-(2.6): contact is kept, ``f1 = (vp, gamma) = 0``, and the
 contact point does not slip along ``nu = (e3 - gamma3 gamma) / sqrt(1 - gamma3^2)``,
 ``f2 = (vp, nu) = 0``; it slips freely across, along ``tau = e3 x gamma / sqrt(1 - gamma3^2)``.
+
+**Pole cases.** ``nu`` is undefined when the axis is vertical. On the level sets ``C1 = M3``
+(``C1 = -M3``) of the area and Lagrange integrals the south (north) pole can touch the plane
+(paper Sec. 3.3), and the exact motion passes through the pole with ``nu`` continuous in the
+fixed frame: its azimuth ``psi_nu`` turns at the finite rate ``psi' = -w_n / s``, which on these
+level sets is ``M3 / (I1 (1 + gamma3))`` (``-M3 / (I1 (1 - gamma3))``). The direction computed
+from the orientation alone cannot follow it: a numerical trajectory misses the pole by a tiny
+distance, and there ``(e3 - gamma3 gamma)/s`` sweeps through every horizontal direction in a
+tiny time, forcing huge reactions and stalling any integrator. So in a pole case the direction
+is carried as a state variable instead: ``nu = cos(psi_nu) alpha + sin(psi_nu) beta`` with
+``psi_nu' = M3 / (I1 (1 +- gamma3))`` and ``M3 = I3 w3`` from the state -- the limit of the
+constraint direction along the motion, regular at the pole. Away from the pole
+(``s > RESYNC_S``) ``psi_nu`` is re-synchronised to the geometric azimuth modulo ``pi`` after
+every step, so there the constraint is exactly the paper's. After each pole passage
+``psi_nu = psi + pi``: the sign ``sigma = cos(psi_nu - psi)`` tells on which side of the pole the
+motion is, which is what keeps ``F6`` (odd under the passage) continuous in the monitoring.
 """
 
 import math
@@ -14,8 +30,15 @@ from rollingtop.contact._base import ContactModel, contact_arm
 from rollingtop.contact._rows import contact_row, normal_row
 
 CODE = 0
+#: Kernel codes of the pole cases (carried constraint direction), chosen by :func:`kernel_code`.
+SOUTH_CODE = 3
+NORTH_CODE = 4
 #: Below this ``sqrt(gamma1^2 + gamma2^2)`` the axis counts as vertical and ``nu`` is undefined.
 POLE_TOLERANCE = 1e-8
+#: ``|C1 -+ M3|`` at most this times ``max(|M3|, |C1|)`` is a pole case (also for the reduction).
+POLE_CASE_TOLERANCE = 1e-9
+#: Above this ``s`` the carried azimuth is re-synchronised with the geometric one (modulo pi).
+RESYNC_S = 0.05
 
 
 @njit(cache=True, error_model="numpy")
@@ -39,6 +62,50 @@ def rows(p, y, J, bias, dirs):
     nd3 = sd
     contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
     return 2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def psi_nu_rate(p, y, north):
+    """``psi_nu' = M3 / (I1 (1 + gamma3))`` (south) or ``-M3 / (I1 (1 - gamma3))`` (north)."""
+    M3 = p[6] * y[5]
+    if north:
+        return -M3 / (p[4] * (1.0 - y[14]))
+    return M3 / (p[4] * (1.0 + y[14]))
+
+
+@njit(cache=True, error_model="numpy")
+def rows_pole(p, y, J, bias, dirs, north):
+    """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu = cos(psi_nu) alpha +
+    sin(psi_nu) beta``; ``nu' = psi_nu' (gamma x nu) + nu x w``. Returns 2."""
+    normal_row(p, y, 0, J, bias, dirs)
+    c, s = math.cos(y[17]), math.sin(y[17])
+    n1 = c * y[6] + s * y[9]
+    n2 = c * y[7] + s * y[10]
+    n3 = c * y[8] + s * y[11]
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    rate = psi_nu_rate(p, y, north)
+    nd1 = rate * (g2 * n3 - g3 * n2) + (n2 * w3 - n3 * w2)
+    nd2 = rate * (g3 * n1 - g1 * n3) + (n3 * w1 - n1 * w3)
+    nd3 = rate * (g1 * n2 - g2 * n1) + (n1 * w2 - n2 * w1)
+    contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
+    return 2
+
+
+def kernel_code(body, y: np.ndarray) -> int:
+    """Kernel code for a motion from state ``y``: :data:`SOUTH_CODE` / :data:`NORTH_CODE` on the
+    pole level sets ``C1 = +-M3`` of a symmetric body (within :data:`POLE_CASE_TOLERANCE`), else
+    :data:`CODE`."""
+    if not body.symmetric:
+        return CODE
+    M3 = body.I3 * y[5]
+    C1 = float(np.dot(body.inertia * y[3:6], y[12:15]))
+    scale = max(abs(M3), abs(C1), 1e-300)
+    if abs(C1 - M3) <= POLE_CASE_TOLERANCE * scale:
+        return SOUTH_CODE
+    if abs(C1 + M3) <= POLE_CASE_TOLERANCE * scale:
+        return NORTH_CODE
+    return CODE
 
 
 def tau_nu(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -2,10 +2,16 @@
 
 ``W_TAU``: ``s * w_tau = (w, e3 x gamma) = gamma1 w2 - gamma2 w1``, zero exactly when
 ``w_tau = 0`` (for ``s > 0``): the turning points of ``gamma3`` (paper eq. 3.3,
-``gamma3' = s w_tau``).
+``gamma3' = s w_tau``). In the meridian model's pole cases ``s`` vanishes at a pole passage
+while ``w_tau`` does not, so there the event function is ``w_tau = (w, nu x gamma)`` with the
+carried direction ``nu`` (continuous through the pole).
 """
 
+import math
+
 from numba import njit
+
+from rollingtop.contact import meridian
 
 NONE = 0
 W_TAU = 1
@@ -15,8 +21,17 @@ EVENTS = {"w_tau": W_TAU}
 
 
 @njit(cache=True, error_model="numpy")
-def event_value(code, y):
-    """Value of event function ``code`` at state ``y``."""
+def event_value(code, model_code, y):
+    """Value of event function ``code`` at state ``y`` under kernel ``model_code``."""
     if code == W_TAU:
+        if model_code == meridian.SOUTH_CODE or model_code == meridian.NORTH_CODE:
+            c, s = math.cos(y[17]), math.sin(y[17])
+            n1 = c * y[6] + s * y[9]
+            n2 = c * y[7] + s * y[10]
+            n3 = c * y[8] + s * y[11]
+            g1, g2, g3 = y[12], y[13], y[14]
+            return (
+                y[3] * (n2 * g3 - n3 * g2) + y[4] * (n3 * g1 - n1 * g3) + y[5] * (n1 * g2 - n2 * g1)
+            )
         return y[12] * y[4] - y[13] * y[3]
     return 1.0

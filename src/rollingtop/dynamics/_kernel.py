@@ -51,6 +51,10 @@ def constraint_rows(code, p, y, J, bias, dirs):
         return smooth.rows(p, y, J, bias, dirs)
     elif code == rough.CODE:
         return rough.rows(p, y, J, bias, dirs)
+    elif code == meridian.SOUTH_CODE:
+        return meridian.rows_pole(p, y, J, bias, dirs, False)
+    elif code == meridian.NORTH_CODE:
+        return meridian.rows_pole(p, y, J, bias, dirs, True)
     return -1
 
 
@@ -127,6 +131,10 @@ def rhs(code, p, y, dy, ws):
         dy[base + 2] = e1 * w2 - e2 * w1
     dy[15] = v1 * y[6] + v2 * y[7] + v3 * y[8]
     dy[16] = v1 * y[9] + v2 * y[10] + v3 * y[11]
+    if code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE:
+        dy[17] = meridian.psi_nu_rate(p, y, code == meridian.NORTH_CODE)
+    else:
+        dy[17] = 0.0
     return nc
 
 
@@ -148,14 +156,29 @@ def reaction(nc, y, ws):
     return N, math.sqrt(t1 * t1 + t2 * t2 + t3 * t3)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _sync_psi_nu(code, y):
+    """Set ``psi_nu`` to the axis azimuth ``atan2(beta3, alpha3)``: the nearest value modulo
+    ``2 pi`` (continuous), or modulo ``pi`` in a pole case (keeping the side of the pole), where
+    only away from the pole (``s > RESYNC_S``)."""
+    s = math.sqrt(y[8] * y[8] + y[11] * y[11])
+    pole = code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE
+    if s <= (meridian.RESYNC_S if pole else 1e-12):
+        return
+    period = math.pi if pole else 2.0 * math.pi
+    psi = math.atan2(y[11], y[8])
+    y[17] = psi + period * round((y[17] - psi) / period)
+
+
 @njit(cache=True, error_model="numpy")
 def project(code, p, y, ws):
     """Project ``y`` in place onto the constraint manifold.
 
     The frame ``Q = [alpha; beta; gamma]`` goes to its nearest orthogonal matrix by one
     Newton-Schulz step ``Q <- (3 Q - Q Q^T Q) / 2`` (quadratic convergence; the error after an
-    accepted step is at truncation level). The velocity ``u`` then goes to the nearest point, in
-    the kinetic-energy metric, of ``J u = 0``: ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
+    accepted step is at truncation level); ``psi_nu`` is re-synchronised with the axis azimuth
+    (see :mod:`rollingtop.contact.meridian`). The velocity ``u`` then goes to the nearest point,
+    in the kinetic-energy metric, of ``J u = 0``: ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
     """
     J, bias, dirs, A, lam = ws
     # Q Q^T (rows alpha, beta, gamma at offsets 6, 9, 12)
@@ -170,6 +193,7 @@ def project(code, p, y, ws):
         y[6 + c] = 1.5 * a - 0.5 * (G00 * a + G01 * b + G02 * g)
         y[9 + c] = 1.5 * b - 0.5 * (G01 * a + G11 * b + G12 * g)
         y[12 + c] = 1.5 * g - 0.5 * (G02 * a + G12 * b + G22 * g)
+    _sync_psi_nu(code, y)
     nc = constraint_rows(code, p, y, J, bias, dirs)
     m, I1, I2, I3 = p[1], p[4], p[5], p[6]
     minv = (1.0 / m, 1.0 / m, 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3)
@@ -197,7 +221,7 @@ def diagnostics(code, p, Y, out):
 
     Parameters
     ----------
-    Y : ndarray, shape (n, 17)
+    Y : ndarray, shape (n, 18)
         States.
     out : ndarray, shape (n, 4 + 4)
         Filled with: normal force, tangential force, max ``|J_k u|`` over the rows,

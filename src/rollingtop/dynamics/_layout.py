@@ -1,8 +1,14 @@
 """Layout of the state vector shared by every compiled kernel.
 
-``y = (v[3], w[3], alpha[3], beta[3], gamma[3], X, Y)``, shape (17,): body-frame CoM velocity
-and angular velocity, the fixed frame's unit vectors seen in the body frame, and the horizontal
-CoM position in the fixed frame (``MODEL.md``, "Body and frames"). Parameters travel as the
+``y = (v[3], w[3], alpha[3], beta[3], gamma[3], X, Y, psi_nu)``, shape (18,): body-frame CoM
+velocity and angular velocity, the fixed frame's unit vectors seen in the body frame, the
+horizontal CoM position in the fixed frame (``MODEL.md``, "Body and frames"), and ``psi_nu``,
+the azimuth in the fixed frame of the meridian constraint's direction ``nu``.
+
+``psi_nu`` equals the axis azimuth ``psi = atan2(beta3, alpha3)`` (unwrapped) away from the
+poles. In a pole case of the meridian model it is *carried* through the pole, where ``psi`` is
+undefined, and after a pole passage it differs from ``psi`` by ``pi`` (the paper's ``tau, n``
+and ``nu`` change sign there): see :mod:`rollingtop.contact.meridian`. Parameters travel as the
 vector ``p = (R, m, g, a3, I1, I2, I3)`` (:attr:`rollingtop.SphericalTop.params`).
 """
 
@@ -12,6 +18,7 @@ ALPHA = slice(6, 9)
 BETA = slice(9, 12)
 GAMMA = slice(12, 15)
 POSITION = slice(15, 17)
-N_STATE = 17
+PSI_NU = 17
+N_STATE = 18
 #: Largest number of constraint rows a contact model may impose (rubber rolling: 4).
 MAX_ROWS = 4

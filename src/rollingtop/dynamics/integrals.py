@@ -1,6 +1,6 @@
 """First integrals, evaluated on arrays of states (``MODEL.md``, "Energy and first integrals").
 
-Each function takes the body and states ``Y`` of shape ``(..., 17)`` and returns shape ``(...)``.
+Each function takes the body and states ``Y`` of shape ``(..., 18)`` and returns shape ``(...)``.
 Which integrals hold for which model and body is declared by the contact models
 (:meth:`rollingtop.contact.ContactModel.integrals`).
 """
@@ -47,31 +47,62 @@ def area(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
     return np.sum(_Iw(body, Y) * Y[..., GAMMA], axis=-1)
 
 
-def reduced_components(Y: np.ndarray) -> dict[str, np.ndarray]:
-    """``gamma3, s, v_tau, w_n`` of the reduced description (paper Sec. 3.1), shape ``(...)``.
+def reduced_components(Y: np.ndarray, pole: str | None = None) -> dict[str, np.ndarray]:
+    """Reduced variables of states ``Y`` (paper Sec. 3.1), each of shape ``(...)``.
 
-    ``tau = e3 x gamma / s``, ``n = -(gamma1, gamma2, 0) / s``, ``s = sqrt(gamma1^2 + gamma2^2)``.
+    Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``. The basis is the one of the
+    constraint direction ``nu`` carried in the state (``psi_nu``, see
+    :mod:`rollingtop.dynamics._layout`): ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``,
+    ``tau = nu x gamma``, ``n = e3 x tau`` and the signed ``s = (nu, e3)``. Away from a pole
+    passage this is exactly the paper's ``tau = e3 x gamma / s``, ``n = -(gamma1, gamma2, 0) / s``
+    with ``s = sqrt(1 - gamma3^2) > 0``; after a passage of the pole in a pole case ``s, tau, n``
+    and the components along them change sign (the signed convention of
+    :mod:`rollingtop.reduction.level`), and ``theta = atan2(s, gamma3)`` is the signed nutation
+    angle (taken in ``(0, 2 pi)`` for ``pole="north"``). States of 17 components (no
+    ``psi_nu``) use the geometric ``nu``.
     """
+    Y = np.asarray(Y, dtype=float)
     g1, g2, g3 = Y[..., 12], Y[..., 13], Y[..., 14]
-    s = np.hypot(g1, g2)
-    v1, v2 = Y[..., 0], Y[..., 1]
-    w1, w2 = Y[..., 3], Y[..., 4]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        v_tau = (-g2 * v1 + g1 * v2) / s
-        w_n = -(g1 * w1 + g2 * w2) / s
-    return {"gamma3": g3, "s": s, "v_tau": v_tau, "w_n": w_n}
+    if Y.shape[-1] > 17:
+        c, sn = np.cos(Y[..., 17]), np.sin(Y[..., 17])
+        nu = c[..., None] * Y[..., ALPHA] + sn[..., None] * Y[..., BETA]
+    else:
+        h = np.hypot(g1, g2)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nu = np.stack([-g3 * g1 / h, -g3 * g2 / h, h], axis=-1)
+    tau = np.cross(nu, Y[..., GAMMA])
+    n = np.stack([-tau[..., 1], tau[..., 0], np.zeros_like(tau[..., 0])], axis=-1)  # e3 x tau
+    s = nu[..., 2]
+    theta = np.arctan2(s, g3)
+    if pole == "north":
+        theta = np.mod(theta, 2 * np.pi)
+    v, w = Y[..., V], Y[..., W]
+    return {
+        "gamma3": g3,
+        "s": s,
+        "theta": theta,
+        "v_tau": np.sum(v * tau, axis=-1),
+        "w_tau": np.sum(w * tau, axis=-1),
+        "w_n": np.sum(w * n, axis=-1),
+        "v_n": np.sum(v * n, axis=-1),
+        "v3": Y[..., 2],
+        "w3": Y[..., 5],
+    }
 
 
-def F6(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
-    """The paper's new linear integral (symmetric body, meridian model):
+def F6(body: SphericalTop, Y: np.ndarray, pole: str | None = None) -> np.ndarray:
+    """The paper's new linear integral (symmetric body, meridian model, eq. 3.9):
 
-    ``F6 = I1 (v_tau - (R gamma3 + a3) w_n) - M3 (R sqrt(1 - gamma3^2) + a3 arccos(gamma3))``.
+    ``F6 = I1 (v_tau - (R gamma3 + a3) w_n) - M3 (R sqrt(1 - gamma3^2) + a3 arccos(gamma3))``,
+
+    evaluated in the basis of :func:`reduced_components` (``sqrt(1 - gamma3^2)`` and
+    ``arccos(gamma3)`` become the signed ``s`` and ``theta``), so that it stays constant through
+    the pole passages of a pole case, where the paper's unsigned expression changes sign.
     """
-    c = reduced_components(Y)
+    c = reduced_components(Y, pole)
     M3 = body.I3 * Y[..., 5]
-    g3 = np.clip(c["gamma3"], -1.0, 1.0)
-    return body.I1 * (c["v_tau"] - (body.R * g3 + body.a3) * c["w_n"]) - M3 * (
-        body.R * c["s"] + body.a3 * np.arccos(g3)
+    return body.I1 * (c["v_tau"] - (body.R * c["gamma3"] + body.a3) * c["w_n"]) - M3 * (
+        body.R * c["s"] + body.a3 * c["theta"]
     )
 
 
@@ -98,7 +129,9 @@ INTEGRALS = {
 }
 
 
-def evaluate(body: SphericalTop, Y: np.ndarray, names) -> dict[str, np.ndarray]:
-    """Evaluate the integrals ``names`` on states ``Y`` (shape ``(..., 17)``)."""
+def evaluate(body: SphericalTop, Y: np.ndarray, names, pole: str | None = None) -> dict:
+    """Evaluate the integrals ``names`` on states ``Y`` (shape ``(..., 18)``); ``pole`` is the
+    meridian pole case the states belong to, if any (see :func:`F6`)."""
     Y = np.asarray(Y, dtype=float)
-    return {name: INTEGRALS[name](body, Y) for name in names}
+    return {name: F6(body, Y, pole) if name == "F6" else INTEGRALS[name](body, Y)
+            for name in names}  # fmt: skip

@@ -102,8 +102,9 @@ def initial_state(
 
     Returns
     -------
-    y : ndarray, shape (17,)
-        ``(v, w, alpha, beta, gamma, X, Y)`` with ``beta = gamma x alpha``.
+    y : ndarray, shape (18,)
+        ``(v, w, alpha, beta, gamma, X, Y, psi_nu)`` with ``beta = gamma x alpha`` and
+        ``psi_nu = atan2(beta3, alpha3)`` (0 when the axis is vertical).
     """
     model = get_model(model)
     free = dict(free or {})
@@ -137,6 +138,7 @@ def initial_state(
     y[3:6] = omega
     y[6:9], y[9:12], y[12:15] = alpha, beta, gamma
     y[15:17] = position
+    y[17] = math.atan2(beta[2], alpha[2]) if math.hypot(alpha[2], beta[2]) > 0 else 0.0
     if v is not None:
         if free:
             raise InitialStateError(

@@ -157,16 +157,16 @@ def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
 
 
 @njit(cache=True, error_model="numpy")
-def _event_root(ev_code, Fd, y, t, h, ytmp):
+def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
     output (60 halvings: to the resolution of the interpolant)."""
     _dense_eval(Fd, y, 0.0, ytmp)
-    g_lo = event_value(ev_code, ytmp)
+    g_lo = event_value(ev_code, code, ytmp)
     lo, hi = 0.0, 1.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         _dense_eval(Fd, y, mid, ytmp)
-        g = event_value(ev_code, ytmp)
+        g = event_value(ev_code, code, ytmp)
         if (g > 0.0) == (g_lo > 0.0) and g != 0.0:
             lo = mid
         else:
@@ -204,7 +204,7 @@ def run(
         Contact model code.
     p : ndarray, shape (7,)
         Body parameters.
-    y, f : ndarray, shape (17,)
+    y, f : ndarray, shape (18,)
         Current state (projected) and its derivative; updated in place.
     ctrl : ndarray, shape (6,)
         ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``); updated.
@@ -215,17 +215,17 @@ def run(
         Reaction tracking (see :func:`new_track`), updated at every accepted step.
     t_eval : ndarray, shape (n_samples,)
         Increasing sample times within ``[t0, t_end]``.
-    out : ndarray, shape (n_samples, 17)
+    out : ndarray, shape (n_samples, 18)
         Samples, each projected onto the constraints.
     ev_spec : ndarray of int64, shape (2,)
         Event function code (:mod:`rollingtop.dynamics._events`, 0 for none) and direction
         (+1: rising zeros only, -1: falling, 0: both).
-    ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 17)
+    ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 18)
         Times and projected states of the located events.
     budget : int
         Maximum number of accepted steps in this call (the caller resumes for progress output).
     K, ynew, ytmp, y_old, Fd, ws
-        Work arrays: stages ``(16, 17)``, three states, dense-output coefficients ``(7, 17)`` and
+        Work arrays: stages ``(16, 18)``, three states, dense-output coefficients ``(7, 18)`` and
         the kernel workspace.
 
     Returns
@@ -333,7 +333,7 @@ def run(
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
         if ev_spec[EV_CODE] != 0:
-            g_new = event_value(ev_spec[EV_CODE], y)
+            g_new = event_value(ev_spec[EV_CODE], code, y)
             g_old = ctrl[G_OLD]
             crossed = (g_old < 0.0 and g_new >= 0.0) or (g_old > 0.0 and g_new <= 0.0)
             rising = g_new > g_old
@@ -342,7 +342,7 @@ def run(
                     _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
                     counts[NFEV] += 3
                     dense_ready = True
-                x = _event_root(ev_spec[EV_CODE], Fd, y_old, t, h, ytmp)
+                x = _event_root(ev_spec[EV_CODE], code, Fd, y_old, t, h, ytmp)
                 m = counts[N_EVENTS]
                 if m < ev_t.shape[0]:
                     ev_t[m] = t + x * h

@@ -29,7 +29,7 @@ class IntegrationResult:
     Attributes
     ----------
     t : ndarray, shape (n,)
-    y : ndarray, shape (n, 17)
+    y : ndarray, shape (n, 18)
         States at ``t``, each projected onto the constraint manifold.
     steps, rejected_steps, rhs_evals : int
     wall_time_s : float
@@ -42,7 +42,7 @@ class IntegrationResult:
         every accepted step.
     event_t : ndarray, shape (k,)
         Times of the located events (empty without ``events``).
-    event_y : ndarray, shape (k, 17)
+    event_y : ndarray, shape (k, 18)
         States at the events, projected onto the constraints.
     events_dropped : int
         Events found beyond ``max_events`` (not stored).
@@ -86,7 +86,7 @@ def compile_kernels() -> float:
     y = np.zeros(N_STATE)
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
-    for code in (0, 1, 2):
+    for code in (0, 1, 2, 3, 4):
         yy = y.copy()
         _kernel.project(code, p, yy, _kernel.new_workspace())
         _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
@@ -111,7 +111,7 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
     track[dop.LAST_NORMAL] = N0
     t0, t_end = float(t_eval[0]), float(t_eval[-1])
     h0 = dop.initial_step(code, p, y, f, t_end, t0, rtol, atol, w["ytmp"], w["ynew"], w["ws"])
-    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, y)])
+    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y)])
     counts = np.zeros(5, dtype=np.int64)
     counts[dop.NFEV] = 2
     w["out"][0] = y
@@ -186,10 +186,11 @@ def integrate(
     Parameters
     ----------
     code : int
-        Contact model code (``ContactModel.code``).
+        Kernel code: ``ContactModel.code``, or a pole variant of the meridian model
+        (:func:`rollingtop.contact.meridian.kernel_code`).
     params : ndarray, shape (7,)
         ``SphericalTop.params``.
-    y0 : ndarray, shape (17,)
+    y0 : ndarray, shape (18,)
         Constraint-consistent initial state (:func:`rollingtop.dynamics.state.initial_state`).
     t_eval : ndarray, shape (n,)
         Strictly increasing sample times, ``n >= 2``; the integration spans them.

@@ -1,6 +1,6 @@
 """Maps between the full state and the reduced description (paper Sec. 3.1).
 
-Full state ``y`` (17,) -> reduced variables ``(gamma3, v_tau, w_tau, w_n)`` and the integrals
+Full state ``y`` (18,) -> reduced variables ``(gamma3, v_tau, w_tau, w_n)`` and the integrals
 ``(M3, C1, C2, h)``; and back, from a level set, ``h`` and a starting ``gamma3``, to a full,
 constraint-consistent state.
 
@@ -19,46 +19,29 @@ import math
 import numpy as np
 
 from rollingtop.body import SphericalTop
-from rollingtop.dynamics.integrals import F6, area, energy, lagrange
+from rollingtop.dynamics.integrals import F6, area, energy, lagrange, reduced_components
 from rollingtop.reduction.level import LevelSet, LevelSetError
 
 __all__ = ["reduce_state", "reduced_integrals", "euler_angles", "state_from_level"]
 
 
-def reduce_state(Y) -> dict[str, np.ndarray]:
-    """Reduced variables of states ``Y`` (shape ``(..., 17)``), each of shape ``(...)``.
+def reduce_state(Y, pole: str | None = None) -> dict[str, np.ndarray]:
+    """Reduced variables of states ``Y`` (shape ``(..., 18)``), each of shape ``(...)``.
 
-    Returns ``gamma3, s, v_tau, w_tau, w_n, v_n, v3, w3`` with ``s = sqrt(gamma1^2 + gamma2^2)``,
-    ``tau = e3 x gamma / s`` and ``n = -(gamma1, gamma2, 0) / s`` (undefined where ``s = 0``).
+    Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``; see
+    :func:`rollingtop.dynamics.integrals.reduced_components` for the (signed) basis.
     """
-    Y = np.asarray(Y, dtype=float)
-    g1, g2, g3 = Y[..., 12], Y[..., 13], Y[..., 14]
-    s = np.hypot(g1, g2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        tau1, tau2 = -g2 / s, g1 / s
-        n1, n2 = -g1 / s, -g2 / s
-    v1, v2, v3 = Y[..., 0], Y[..., 1], Y[..., 2]
-    w1, w2, w3 = Y[..., 3], Y[..., 4], Y[..., 5]
-    return {
-        "gamma3": g3,
-        "s": s,
-        "v_tau": tau1 * v1 + tau2 * v2,
-        "w_tau": tau1 * w1 + tau2 * w2,
-        "w_n": n1 * w1 + n2 * w2,
-        "v_n": n1 * v1 + n2 * v2,
-        "v3": v3,
-        "w3": w3,
-    }
+    return reduced_components(Y, pole)
 
 
-def reduced_integrals(body: SphericalTop, Y) -> dict[str, np.ndarray]:
+def reduced_integrals(body: SphericalTop, Y, pole: str | None = None) -> dict[str, np.ndarray]:
     """``M3 = I3 w3``, ``C1 = F5``, ``C2 = F6``, ``h = E - I3 w3^2/2 - m g R`` of states ``Y``."""
     Y = np.asarray(Y, dtype=float)
     M3 = lagrange(body, Y)
     return {
         "M3": M3,
         "C1": area(body, Y),
-        "C2": F6(body, Y),
+        "C2": F6(body, Y, pole),
         "h": energy(body, Y) - M3**2 / (2 * body.I3) - body.m * body.g * body.R,
     }
 
@@ -104,7 +87,7 @@ def state_from_level(
 
     Returns
     -------
-    y : ndarray, shape (17,)
+    y : ndarray, shape (18,)
         Satisfies the meridian model's constraints; ``(M3, C1, C2, h)`` as given.
     """
     body = level.body
@@ -133,7 +116,8 @@ def state_from_level(
     beta = math.sin(psi) * nu - math.cos(psi) * tau
     w = w_tau * tau + w_n * n + (level.M3 / body.I3) * e3
     v = v_tau * tau - (body.R * gamma3 + body.a3) * w_tau * n - body.R * s * w_tau * e3
-    y = np.empty(17)
+    y = np.empty(18)
     y[0:3], y[3:6], y[6:9], y[9:12], y[12:15] = v, w, alpha, beta, gamma
     y[15:17] = position
+    y[17] = psi
     return y
