@@ -5,6 +5,10 @@ turning points ``theta = c + d sin(phi)`` and ``w_tau = +-sqrt(2 (h - U) / rho)`
 exactly at the turning points and the separatrices pass exactly through the saddles. Where the
 normal reaction of the plane would be negative (the body would jump: the model does not apply)
 the plane is shaded.
+
+In a pole case (``C1 = +-M3``) orbits pass through the pole, where the paper's ``tau`` and
+``w_tau`` change sign; there the horizontal axis is the signed nutation angle ``theta``
+(``gamma3 = cos theta``, see :mod:`rollingtop.reduction.level`), in which the flow is regular.
 """
 
 from __future__ import annotations
@@ -38,12 +42,17 @@ def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
     return sorted({*map(float, levels), *saddles})
 
 
+def _abscissa(level: LevelSet, theta):
+    """``gamma3 = cos(theta)``, or ``theta`` itself in a pole case."""
+    return np.asarray(theta, dtype=float) if level.pole else np.cos(theta)
+
+
 def _orbit_curve(level: LevelSet, h: float, t1: float, t2: float, n: int = 400):
     phi = np.linspace(-math.pi / 2, math.pi / 2, n)
     theta = (t1 + t2) / 2 + (t2 - t1) / 2 * np.sin(phi)
     w = np.sqrt(np.maximum(2 * _gap(level, h, t1, t2, phi) / level.rho(theta), 0.0))
-    g3 = np.cos(theta)
-    return np.concatenate([g3, g3[::-1]]), np.concatenate([w, -w[::-1]])
+    x = _abscissa(level, theta)
+    return np.concatenate([x, x[::-1]]), np.concatenate([w, -w[::-1]])
 
 
 def _normal_force_grid(level: LevelSet, g3: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -121,9 +130,12 @@ def phase_portrait(
     if g_lo > g_hi:
         raise LevelSetError(f"no motion on {level.describe()} at the requested h levels")
     pad = 0.05 * (g_hi - g_lo) + 1e-3
-    g_lo, g_hi = max(-1.0, g_lo - pad), min(1.0, g_hi + pad)
+    if level.pole:
+        g_lo, g_hi = max(level.theta_domain[0], g_lo - pad), min(level.theta_domain[1], g_hi + pad)
+    else:
+        g_lo, g_hi = max(-1.0, g_lo - pad), min(1.0, g_hi + pad)
     w_top *= 1.1
-    if show_contact:
+    if show_contact and not level.pole:
         gg = np.linspace(max(g_lo, -0.999), min(g_hi, 0.999), 90)
         ww = np.linspace(-w_top, w_top, 80)
         N = _normal_force_grid(level, gg, ww)
@@ -131,12 +143,17 @@ def phase_portrait(
             ax.contourf(gg, ww, N, levels=[N.min() - 1, 0.0], colors=["#f4c7c3"], zorder=1)
             ax.plot([], [], color="#f4c7c3", lw=6, label="normal force < 0 (contact lost)")
     for m in motions:
-        if not g_lo <= m.gamma3 <= g_hi:
+        x = float(_abscissa(level, m.theta))
+        if not g_lo <= x <= g_hi:
             continue
         if m.type == "center":
-            ax.plot(m.gamma3, 0, "o", color="black", ms=5, zorder=4)
+            ax.plot(x, 0, "o", color="black", ms=5, zorder=4)
         else:
-            ax.plot(m.gamma3, 0, "x", color="crimson", ms=8, mew=2, zorder=4)
+            ax.plot(x, 0, "x", color="crimson", ms=8, mew=2, zorder=4)
+    if level.pole:
+        ax.axvline(level.pole_theta, color="0.5", ls="--", lw=0.8, zorder=0)
+        ax.plot([], [], color="0.5", ls="--", lw=0.8, label=f"{level.pole} pole (gamma3 = "
+                f"{'+' if level.pole == 'south' else '-'}1)")  # fmt: skip
     ax.plot([], [], "o", color="black", ms=5, label="steady motion (centre)")
     if saddle_levels:
         ax.plot([], [], "x", color="crimson", ms=8, mew=2, label="steady motion (saddle)")
@@ -155,8 +172,12 @@ def phase_portrait(
         fontsize=10,
     )
     # effective potential with the h levels
-    g = np.linspace(max(g_lo, -0.9999), min(g_hi, 0.9999), 1500)
-    U = level.U_gamma3(g)
+    if level.pole:
+        g = np.linspace(g_lo, g_hi, 1500)
+        U = level.U(g)
+    else:
+        g = np.linspace(max(g_lo, -0.9999), min(g_hi, 0.9999), 1500)
+        U = level.U_gamma3(g)
     axu.plot(g, U, color="black", lw=1.2)
     for h in levels:
         sep = any(abs(h - u) <= 1e-12 * max(1.0, abs(u)) for u in saddle_levels)
@@ -164,8 +185,10 @@ def phase_portrait(
         axu.axhline(h, color="crimson" if sep else cmap(0.1 + 0.8 * frac), lw=0.8)
     u_min = min((m.U for m in motions), default=float(np.min(U)))
     axu.set_ylim(u_min - 0.05 * (hi_h - u_min), hi_h + 0.15 * (hi_h - u_min))
-    axu.set_xlabel(r"$\gamma_3$")
+    axu.set_xlabel(r"$\theta$ (signed nutation angle, $\gamma_3 = \cos\theta$)"
+                   if level.pole else r"$\gamma_3$")  # fmt: skip
     axu.set_ylabel(r"$U,\ h$")
-    axu.text(0.01, 0.95, r"$U(\gamma_3)$ and the levels $h$", transform=axu.transAxes,
+    what = r"$U(\theta)$" if level.pole else r"$U(\gamma_3)$"
+    axu.text(0.01, 0.95, what + r" and the levels $h$", transform=axu.transAxes,
              va="top", fontsize=8)  # fmt: skip
     return fig
