@@ -194,23 +194,67 @@ def equilibria(scenario, as_json):
 @click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
 def orbits(scenario, h, as_json):
     """Orbits on the level set (M3, C1, C2, h): turning points and periods, sorted by gamma3_min."""
+    from rollingtop.absolute import period_map
     from rollingtop.reduction import orbits as find_orbits
 
     sc, level = _level_of(scenario)
     h = sc.level_h() if h is None else h
     found = find_orbits(level, h)
+    maps = [period_map(level, h, o) if o.kind == "periodic" else None for o in found]
     if as_json:
-        click.echo(json.dumps({"level": _level_json(level, h=h),
-                               "orbits": [o.to_dict() for o in found]}))  # fmt: skip
+        rows = []
+        for o, pm in zip(found, maps, strict=True):
+            row = o.to_dict()
+            if pm is not None:
+                row.update(
+                    delta_psi=pm.delta_psi,
+                    motion=pm.motion,
+                    near_resonant=pm.near_resonant,
+                    displacement=list(pm.displacement),
+                )
+                if pm.motion == "bounded":
+                    row.update(center=list(pm.center), radius=pm.radius)
+                else:
+                    row.update(drift_velocity=list(pm.drift_velocity))
+            rows.append(row)
+        click.echo(json.dumps({"level": _level_json(level, h=h), "orbits": rows}))
         return
     from rich.table import Table
 
     table = Table(title=f"orbits on {level.describe()}, h = {h:g}")
-    for col in ("gamma3_min", "gamma3_max", "period", "+-", "kind", "note"):
-        table.add_column(col, justify="left" if col in ("kind", "note") else "right")
-    for o in found:
-        table.add_row(f"{o.gamma3_min:.10g}", f"{o.gamma3_max:.10g}", f"{o.period:.12g}",
-                      f"{o.period_error:.1e}", o.kind, o.note)  # fmt: skip
+    cols = (
+        "gamma3_min",
+        "gamma3_max",
+        "period",
+        "+-",
+        "delta_psi",
+        "motion",
+        "circle / drift",
+        "note",
+    )
+    for col in cols:
+        table.add_column(col, justify="left" if col in ("motion", "note") else "right")
+    for o, pm in zip(found, maps, strict=True):
+        if pm is None:
+            extra = ("-", o.kind, "-")
+        elif pm.motion == "bounded":
+            extra = (
+                f"{pm.delta_psi:.10g}",
+                "bounded" + (" (near-resonant)" if pm.near_resonant else ""),
+                f"r = {pm.radius:.6g} about ({pm.center[0]:.4g}, {pm.center[1]:.4g})",
+            )
+        else:
+            vx, vy = pm.drift_velocity
+            extra = (f"{pm.delta_psi:.10g}", "drifting", f"v = ({vx:.6g}, {vy:.6g})")
+        table.add_row(
+            f"{o.gamma3_min:.10g}",
+            f"{o.gamma3_max:.10g}",
+            f"{o.period:.12g}",
+            f"{o.period_error:.1e}",
+            *extra,
+            o.note,
+        )
+    # fmt: skip
     _console().print(table)
 
 

@@ -114,7 +114,8 @@ def _gap(level: LevelSet, h: float, t1: float, t2: float, phi) -> np.ndarray:
     return out.reshape(shape)
 
 
-def _integrand(level: LevelSet, h: float, t1: float, t2: float):
+def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight=None):
+    """``2 weight(theta) dt/dtheta`` in the variable ``phi`` (``theta = c + d sin phi``)."""
     c, d = (t1 + t2) / 2, (t2 - t1) / 2
 
     def f(phi):
@@ -122,14 +123,18 @@ def _integrand(level: LevelSet, h: float, t1: float, t2: float):
         gap = np.maximum(_gap(level, h, t1, t2, phi), 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * gap)) * d * np.cos(phi)
+            if weight is not None:
+                val = val * weight(theta)
         return np.where(np.isfinite(val), val, 0.0)
 
     return f
 
 
-def _gauss(f, n: int) -> float:
+def _gauss(f, n: int) -> tuple[float, float]:
+    """Gauss-Legendre rule on ``[-pi/2, pi/2]``: the integral of ``f`` and of ``|f|``."""
     x, w = np.polynomial.legendre.leggauss(n)
-    return float(np.sum(w * f(x * (math.pi / 2))) * (math.pi / 2))
+    values = f(x * (math.pi / 2)) * w * (math.pi / 2)
+    return float(np.sum(values)), float(np.sum(np.abs(values)))
 
 
 def _graded_gauss(f, a: float, b: float, points, n: int) -> float:
@@ -153,20 +158,21 @@ def _graded_gauss(f, a: float, b: float, points, n: int) -> float:
 
 
 def period(
-    level: LevelSet, h: float, theta1: float, theta2: float, peaks=()
+    level: LevelSet, h: float, theta1: float, theta2: float, peaks=(), weight=None
 ) -> tuple[float, float]:
     """Period of the orbit between the simple turning points ``theta1 < theta2``.
 
     ``peaks`` are theta values of saddles near the orbit (break points for the graded
-    fallback). Returns ``(period, estimated absolute error)``.
+    fallback). With ``weight`` (a function of theta) the integral over one period of
+    ``weight(theta(t)) dt`` instead. Returns ``(value, estimated absolute error)``.
     """
     c, d = (theta1 + theta2) / 2, (theta2 - theta1) / 2
-    f = _integrand(level, h, theta1, theta2)
-    prev = _gauss(f, 32)
+    f = _integrand(level, h, theta1, theta2, weight)
+    prev, _ = _gauss(f, 32)
     n = 64
     while n <= 2048:
-        cur = _gauss(f, n)
-        if abs(cur - prev) <= PERIOD_RTOL * abs(cur):
+        cur, size = _gauss(f, n)  # relative to the integral of |f|: the weighted one may vanish
+        if abs(cur - prev) <= PERIOD_RTOL * size:
             return cur, abs(cur - prev)
         prev, n = cur, 2 * n
     # Slow convergence: a logarithmic peak near a saddle, inside the orbit or at a turning point

@@ -1,0 +1,201 @@
+"""Motion in absolute space: reconstruction on the plane and the per-period map.
+
+``MODEL.md``, "Motion in absolute space": with ``psi`` the azimuth of the constraint direction
+``nu = (cos psi, sin psi)`` in the fixed frame (the horizontal projection of the axis; carried
+through the pole in a pole case), ``Z = X + i Y`` the CoM position and the signed nutation angle
+``theta`` of :mod:`rollingtop.reduction.level`,
+
+    theta' = -w_tau,    w_tau' = (U'(theta) + rho_theta w_tau^2 / 2) / rho     (from h conserved)
+    psi'   = -w_n / s  (a function of theta on the level set)
+    Z'     = exp(i psi) (-(R + a3 gamma3) w_tau - i v_tau)
+    contact point = Z - a3 s exp(i psi).
+
+Over one period ``T`` of ``theta`` the azimuth advances by ``Delta psi`` and, by the rotational
+symmetry of the plane, the CoM moves by ``exp(i psi0) D`` with ``D`` fixed by the orbit: the map
+``(psi, Z) -> (psi + Delta psi, Z + exp(i psi) D)`` is a rigid motion of the plane. Unless
+``Delta psi`` is a multiple of ``2 pi`` it is a rotation about the centre
+``c = Z0 + exp(i psi0) D / (1 - exp(i Delta psi))``: the once-per-period positions lie on the
+circle of radius ``|D| / (2 |sin(Delta psi / 2)|)`` about it and the motion is bounded. At a
+multiple of ``2 pi`` it is a translation: the CoM drifts with mean velocity ``exp(i psi0) D / T``.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.orbits import Orbit, orbits, period
+
+__all__ = ["PeriodMap", "period_map", "reconstruct", "RESONANCE_TOLERANCE", "NEAR_RESONANT"]
+
+#: ``|Delta psi / 2 pi - k|`` below this: resonant, the CoM drifts.
+RESONANCE_TOLERANCE = 1e-9
+#: A bounded orbit whose circle of once-per-period points is larger than this many radii ``R``
+#: of the sphere is flagged near-resonant.
+NEAR_RESONANT = 100.0
+
+
+def _path_rhs(level: LevelSet):
+    b = level.body
+
+    def f(t, z):
+        theta, w_tau, psi = z[0], z[1], z[2]
+        rho = level.rho(theta)
+        rho_theta = -2 * b.m * b.a3 * b.R * np.sin(theta)
+        k = (b.R + b.a3 * np.cos(theta)) * w_tau
+        v_tau = level.v_tau(theta)
+        c, s = np.cos(psi), np.sin(psi)
+        return [
+            -w_tau,
+            (level.dU(theta) + 0.5 * rho_theta * w_tau**2) / rho,
+            level.psi_dot(theta),
+            -k * c + v_tau * s,
+            -k * s - v_tau * c,
+        ]
+
+    return f
+
+
+def reconstruct(
+    level: LevelSet,
+    t,
+    *,
+    theta0: float,
+    w_tau0: float,
+    psi0: float = 0.0,
+    position0=(0.0, 0.0),
+    rtol: float = 1e-13,
+    atol: float = 1e-14,
+) -> dict[str, np.ndarray]:
+    """Reconstruct the motion on the plane from the reduced one.
+
+    Integrates ``(theta, w_tau)`` of the one-degree-of-freedom system together with the
+    quadratures for ``psi``, ``X`` and ``Y`` (module docstring) with ``solve_ivp`` (DOP853).
+
+    Parameters
+    ----------
+    level : LevelSet
+    t : array_like, shape (n,)
+        Increasing times, starting at the initial time.
+    theta0, w_tau0 : float
+        Initial signed nutation angle and ``w_tau`` (``theta0 = arccos(gamma3)`` off a pole).
+    psi0 : float
+        Initial azimuth of the axis (``atan2(beta3, alpha3)``).
+    position0 : (float, float)
+        Initial CoM position.
+
+    Returns
+    -------
+    dict
+        ``t, theta, gamma3, w_tau, psi, position (n, 2), contact_point (n, 2)``.
+    """
+    t = np.asarray(t, dtype=float)
+    z0 = [theta0, w_tau0, psi0, float(position0[0]), float(position0[1])]
+    sol = solve_ivp(_path_rhs(level), (t[0], t[-1]), z0, method="DOP853", rtol=rtol, atol=atol,
+                    t_eval=t)  # fmt: skip
+    if not sol.success:
+        raise LevelSetError(f"reconstruction failed: {sol.message}")
+    theta, w_tau, psi, X, Y = sol.y
+    s = np.sin(theta)
+    a3 = level.body.a3
+    return {
+        "t": t,
+        "theta": theta,
+        "gamma3": np.cos(theta),
+        "w_tau": w_tau,
+        "psi": psi,
+        "position": np.stack([X, Y], axis=1),
+        "contact_point": np.stack([X - a3 * s * np.cos(psi), Y - a3 * s * np.sin(psi)], axis=1),
+    }
+
+
+@dataclass(frozen=True)
+class PeriodMap:
+    """The rigid motion of the plane after one period of ``gamma3``, and what it implies.
+
+    Positions refer to the canonical start of the orbit: the CoM at the origin at the turning
+    point ``start_theta`` (the lowest ``gamma3`` on the branch ``0 < theta < pi``), with the axis
+    azimuth ``psi = 0`` there. For another start ``(psi0, Z0)`` rotate by ``psi0`` and shift by
+    ``Z0``.
+
+    Attributes
+    ----------
+    period : float
+    delta_psi : float
+        Advance of the azimuth per period (by quadrature, like the period).
+    displacement : (float, float)
+        CoM displacement over one period from the canonical start.
+    motion : {"bounded", "drifting"}
+    center, radius : (float, float) and float, or None
+        Circle on which the once-per-period CoM positions lie (bounded motion).
+    drift_velocity : (float, float) or None
+        Mean CoM velocity (drifting motion).
+    near_resonant : bool
+        Bounded, but the circle is larger than :data:`NEAR_RESONANT` sphere radii.
+    start_theta : float
+    """
+
+    period: float
+    delta_psi: float
+    displacement: tuple[float, float]
+    motion: str
+    center: tuple[float, float] | None
+    radius: float | None
+    drift_velocity: tuple[float, float] | None
+    near_resonant: bool
+    start_theta: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict."""
+        d = asdict(self)
+        for key in ("displacement", "center", "drift_velocity"):
+            if d[key] is not None:
+                d[key] = list(d[key])
+        return d
+
+    def center_from(self, psi0: float, position0) -> tuple[float, float] | None:
+        """Centre of the circle for a motion started at the canonical point with azimuth ``psi0``
+        and CoM position ``position0``."""
+        if self.center is None:
+            return None
+        c = complex(*position0) + cmath.exp(1j * psi0) * complex(*self.center)
+        return (c.real, c.imag)
+
+
+def start_theta(orbit: Orbit) -> float:
+    """The canonical starting turning point of an orbit (see :class:`PeriodMap`)."""
+    return orbit.theta_max if 0 < orbit.theta_max < math.pi else orbit.theta_min
+
+
+def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodMap:
+    """Per-period map of an orbit on ``(M3, C1, C2, h)`` (the first one if ``orbit`` is None).
+
+    ``Delta psi`` comes from the quadrature of ``psi'(theta)`` over one period with the same
+    singularity-free rule as the period; the displacement from integrating the reconstruction
+    over one period (:func:`reconstruct`).
+    """
+    if orbit is None:
+        orbit = orbits(level, h)[0]
+    if orbit.kind != "periodic":
+        raise LevelSetError(f"no per-period map for a {orbit.kind} orbit ({orbit.note})")
+    T = orbit.period
+    peaks = [t for t in (level.pole_theta,) if t is not None]
+    dpsi, _ = period(level, h, orbit.theta_min, orbit.theta_max, peaks=peaks,
+                     weight=level.psi_dot)  # fmt: skip
+    theta0 = start_theta(orbit)
+    path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=0.0)
+    D = complex(*path["position"][-1])
+    turns = dpsi / (2 * math.pi)
+    if abs(turns - round(turns)) < RESONANCE_TOLERANCE:
+        v = D / T
+        return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None, (v.real, v.imag),
+                         False, theta0)  # fmt: skip
+    c = D / (1 - cmath.exp(1j * dpsi))
+    radius = abs(c)
+    return PeriodMap(T, dpsi, (D.real, D.imag), "bounded", (c.real, c.imag), radius, None,
+                     radius > NEAR_RESONANT * level.body.R, theta0)  # fmt: skip
