@@ -20,7 +20,7 @@ from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.dynamics.integrals import INTEGRALS
 from rollingtop.dynamics.state import initial_state
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario, load_scenario
-from rollingtop.simulate import simulate
+from rollingtop.simulate import simulate, simulate_models
 from rollingtop.trajectory import Trajectory
 
 __version__ = "0.1.0"
@@ -47,4 +47,5 @@ __all__ = [
     "initial_state",
     "load_scenario",
     "simulate",
+    "simulate_models",
 ]

@@ -118,17 +118,7 @@ def simulate(scenario, t_end, rtol, atol, samples, model, output, as_json):
     from rollingtop.scenario import load_scenario
 
     sc = load_scenario(scenario).with_overrides(**overrides)
-    bar = _progress_bar(sc.integration.t_end)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", ContactLostWarning)
-        if bar is None:
-            traj = run(sc)
-        else:
-            with bar:
-                task = bar.add_task("integrate", total=sc.integration.t_end)
-                traj = run(sc, progress=lambda t: bar.update(task, completed=t))
-    for w in caught:
-        click.echo(f"rollingtop: warning: {w.message}", err=True)
+    traj = _run_with_progress(run, sc)
     if output is not None:
         traj.save(output)
     summary = traj.summary()
@@ -291,6 +281,172 @@ def portrait(scenario, output, h_levels, no_contact):
     save_figure(fig, output)
     _console().print(_steady_table(level, steady_motions(level)))
     click.echo(f"wrote {output}")
+
+
+def _meridian_map(sc):
+    """The per-period map of the scenario's motion, when it is a meridian orbit (else None)."""
+    from rollingtop.absolute import period_map
+    from rollingtop.reduction import LevelSetError, orbits, reduce_state
+
+    if sc.model.name != "meridian" or not sc.body.symmetric:
+        return None
+    try:
+        level, h = sc.level_set(), sc.level_h()
+        theta = float(reduce_state(sc.require_state())["theta"])
+        found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]
+        if not found or found[0].kind != "periodic":
+            return None
+        return period_map(level, h, found[0])
+    except LevelSetError:
+        return None
+
+
+def _run_with_progress(run, sc, **kwargs):
+    bar = _progress_bar(sc.integration.t_end)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ContactLostWarning)
+        if bar is None:
+            result = run(sc, **kwargs)
+        else:
+            with bar:
+                task = bar.add_task("integrate", total=sc.integration.t_end)
+                result = run(sc, progress=lambda t: bar.update(task, completed=t), **kwargs)
+    for w in caught:
+        click.echo(f"rollingtop: warning: {w.message}", err=True)
+    return result
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(), required=True, help="FIG.png, .svg or .pdf.")
+@click.option(
+    "--periods",
+    type=float,
+    default=30.0,
+    show_default=True,
+    help="Periods of gamma3 to draw (meridian orbits; else the scenario's t_end).",
+)
+@click.option("--t-end", type=float, default=None, help="End time (overrides --periods).")
+def path(scenario, output, periods, t_end):
+    """Contact-point and CoM paths on the plane, with the once-per-period points and, for a
+    meridian orbit, the predicted circle (bounded) or drift."""
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
+    from rollingtop.plot.paths import path_figure
+    from rollingtop.scenario import load_scenario
+    from rollingtop.simulate import simulate as run
+
+    check_output_path(output, FIGURE_SUFFIXES)
+    if periods <= 0:
+        raise click.UsageError(f"--periods {periods:g} must be > 0")
+    sc = load_scenario(scenario)
+    pm = _meridian_map(sc)
+    if t_end is None and pm is not None:
+        t_end = periods * pm.period
+    sc = sc.with_overrides(t_end=t_end, samples=max(2001, int(200 * periods)))
+    traj = _run_with_progress(run, sc, events="w_tau", event_direction=1)
+    save_figure(path_figure(traj, pm), output)
+    click.echo(f"wrote {output}")
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(), required=True, help="FIG.png, .svg or .pdf.")
+@click.option("--t-end", type=float, default=None, help="End time (overrides the scenario).")
+def plot(scenario, output, t_end):
+    """Time series: gamma3, the integrals' drift and the contact reactions."""
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
+    from rollingtop.plot.paths import timeseries_figure
+    from rollingtop.scenario import load_scenario
+    from rollingtop.simulate import simulate as run
+
+    check_output_path(output, FIGURE_SUFFIXES)
+    sc = load_scenario(scenario).with_overrides(t_end=t_end)
+    traj = _run_with_progress(run, sc)
+    save_figure(timeseries_figure(traj), output)
+    click.echo(f"wrote {output}")
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(), required=True, help="FIG.png, .svg or .pdf.")
+@click.option("--t-end", type=float, default=None, help="End time (overrides the scenario).")
+def compare(scenario, output, t_end):
+    """The scenario's initial state under the meridian, smooth and rough models: paths and
+    integrals overlaid (each model's state is the scenario's, projected on its constraints)."""
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
+    from rollingtop.plot.paths import compare_figure
+    from rollingtop.scenario import load_scenario
+    from rollingtop.simulate import simulate_models
+
+    check_output_path(output, FIGURE_SUFFIXES)
+    sc = load_scenario(scenario).with_overrides(t_end=t_end)
+    runs = _run_with_progress(lambda s, **kw: simulate_models(s), sc)
+    save_figure(compare_figure(runs), output)
+    click.echo(f"wrote {output}")
+
+
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(), required=True, help="roll.mp4 or roll.gif.")
+@click.option("--fps", type=click.IntRange(min=1), default=25, show_default=True)
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=0, min_open=True),
+    default=8.0,
+    show_default=True,
+    help="Length of the video in seconds.",
+)
+@click.option(
+    "--speed",
+    type=click.FloatRange(min=0, min_open=True),
+    default=1.0,
+    show_default=True,
+    help="Simulated time per second of video.",
+)
+@click.option(
+    "--camera", type=click.Choice(["follow", "fixed"]), default="follow", show_default=True
+)
+def animate(scenario, output, fps, duration, speed, camera):
+    """3D animation of the rolling sphere (meridians and axis show the spin, contact trail)."""
+    from rollingtop.io import check_output_path
+    from rollingtop.plot.animation import ANIMATION_SUFFIXES
+    from rollingtop.plot.animation import animate as render
+    from rollingtop.scenario import load_scenario
+    from rollingtop.simulate import simulate as run
+
+    check_output_path(output, ANIMATION_SUFFIXES)
+    n_frames = int(round(duration * fps))
+    t_end = (n_frames - 1) / fps * speed if n_frames > 1 else speed / fps
+    sc = load_scenario(scenario).with_overrides(t_end=t_end, samples=max(2, 4 * n_frames))
+    traj = _run_with_progress(run, sc)
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    console = Console(stderr=True)
+    if console.is_terminal:
+        with Progress(
+            TextColumn("rendering"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            console=console,
+            transient=True,
+        ) as bar:
+            task = bar.add_task("render", total=n_frames)
+            render(
+                traj,
+                output,
+                fps=fps,
+                duration=duration,
+                speed=speed,
+                camera=camera,
+                progress=lambda i, n: bar.update(task, completed=i),
+            )
+    else:
+        render(traj, output, fps=fps, duration=duration, speed=speed, camera=camera)
+    click.echo(f"wrote {output} ({n_frames} frames)")
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -38,15 +38,19 @@ def check_output_path(path: str | os.PathLike, suffixes: Iterable[str]) -> Path:
     return path
 
 
-def atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Path:
+def atomic_write(
+    path: str | os.PathLike, write: Callable[[Path], None], *, keep_suffix: bool = False
+) -> Path:
     """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it onto ``path``.
 
     The rename is atomic on POSIX file systems, so readers see either the old file or the
     complete new one. On any exception (``KeyboardInterrupt`` included) the temporary file is
-    removed and the exception propagates.
+    removed and the exception propagates. With ``keep_suffix`` the temporary name ends with
+    ``path``'s suffix (for writers that infer the format from it, such as ffmpeg).
     """
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    suffix = f".tmp{path.suffix}" if keep_suffix else ".tmp"
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent or ".")
     os.close(fd)
     tmp = Path(tmp)
     try:

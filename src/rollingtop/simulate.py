@@ -12,7 +12,7 @@ from rollingtop.integrate import integrate
 from rollingtop.scenario import Scenario, load_scenario
 from rollingtop.trajectory import Trajectory
 
-__all__ = ["simulate"]
+__all__ = ["simulate", "simulate_models"]
 
 
 def simulate(
@@ -95,3 +95,33 @@ def simulate(
             stacklevel=2,
         )
     return traj
+
+
+def simulate_models(
+    scenario: Scenario | str | os.PathLike,
+    models=("meridian", "smooth", "rough"),
+    **overrides,
+) -> dict[str, Trajectory]:
+    """Run the scenario's initial state under several contact models, side by side.
+
+    The scenario's state is projected onto each model's constraints
+    (:func:`rollingtop.dynamics.state.project_state`: orientation and position kept, velocities
+    moved to the nearest admissible ones in the kinetic-energy metric), so each model starts as
+    close as it allows to the same state. Returns ``{model name: Trajectory}``.
+    """
+    from dataclasses import replace
+
+    from rollingtop.dynamics.state import project_state
+    from rollingtop.scenario import InitialConditions
+
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    y0 = scenario.require_state()
+    runs = {}
+    for name in models:
+        y = project_state(scenario.body, name, y0)
+        ic = InitialConditions(gamma=y[12:15], omega=y[3:6], alpha=y[6:9], v=y[0:3],
+                               position=y[15:17])  # fmt: skip
+        sc = replace(scenario, model=name, initial=ic, level=None)
+        runs[name] = simulate(sc, **overrides)
+    return runs

@@ -13,7 +13,7 @@ from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._layout import N_STATE
 
-__all__ = ["initial_state", "constraint_residuals", "UNIT_TOLERANCE"]
+__all__ = ["initial_state", "constraint_residuals", "project_state", "UNIT_TOLERANCE"]
 
 #: Tolerance on the unit length and orthogonality of user-given vectors, and on the constraint
 #: residuals of a user-given velocity.
@@ -165,5 +165,21 @@ def initial_state(
             else:
                 values[name] = _vector(name, raw, length)
         y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
+    _kernel.project(model.code, body.params, y, _kernel.new_workspace())
+    return y
+
+
+def project_state(body: SphericalTop, model: str | ContactModel, y: np.ndarray) -> np.ndarray:
+    """The state nearest to ``y`` that satisfies ``model``'s constraints.
+
+    Orientation, position and ``psi_nu`` are kept; the velocities ``u = (v, w)`` move to the
+    nearest point of the constraint set in the kinetic-energy metric (the velocity projection of
+    the integrator). Used to start several contact models from "the same" state.
+    """
+    model = get_model(model)
+    y = np.array(y, dtype=float)
+    gamma = y[12:15]
+    if model.singular is not None and (why := model.singular(gamma)) is not None:
+        raise InitialStateError(f"model {model.name!r}: {why}")
     _kernel.project(model.code, body.params, y, _kernel.new_workspace())
     return y

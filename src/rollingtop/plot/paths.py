@@ -1,0 +1,144 @@
+"""Figures of a simulated motion: paths on the plane, time series, model comparison."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+__all__ = ["path_figure", "timeseries_figure", "compare_figure"]
+
+_MODEL_COLOURS = {"meridian": "#1f77b4", "smooth": "#2ca02c", "rough": "#d62728"}
+
+
+def _title(traj) -> str:
+    b = traj.body
+    return (
+        f"{traj.model.name} model, t = 0 .. {traj.t[-1]:g}   "
+        rf"($R={b.R:g},\ m={b.m:g},\ g={b.g:g},\ a_3={b.a3:g},\ I_1={b.I1:g},\ I_3={b.I3:g}$)"
+    )
+
+
+def path_figure(traj, period_map=None, *, figsize=(7.0, 7.0)) -> Figure:
+    """Contact-point and CoM paths on the plane.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        If it carries events (rising zeros of ``w_tau``: the minima of ``gamma3``), the CoM's
+        once-per-period positions are marked.
+    period_map : PeriodMap, optional
+        Draws the predicted circle of the once-per-period positions (bounded motion) or the drift
+        direction, anchored at the first event.
+    """
+    fig = Figure(figsize=figsize, layout="constrained")
+    ax = fig.subplots()
+    cp, com = traj.contact_point, traj.position
+    ax.plot(cp[:, 0], cp[:, 1], color="0.55", lw=0.6, label="contact point")
+    ax.plot(com[:, 0], com[:, 1], color="#1f77b4", lw=0.9, label="centre of mass")
+    ax.plot(*com[0], "s", color="black", ms=5, label="start")
+    if len(traj.event_t):
+        P = traj.event_y[:, 15:17]
+        ax.plot(P[:, 0], P[:, 1], "o", color="#ff7f0e", ms=4, zorder=4,
+                label="CoM once per period (min of $\\gamma_3$)")  # fmt: skip
+        if period_map is not None and period_map.motion == "bounded":
+            c = period_map.center_from(traj.event_y[0, 17], P[0])
+            phi = np.linspace(0, 2 * np.pi, 400)
+            ax.plot(c[0] + period_map.radius * np.cos(phi), c[1] + period_map.radius * np.sin(phi),
+                    "--", color="#ff7f0e", lw=0.8, label="predicted circle")  # fmt: skip
+            ax.plot(*c, "+", color="#ff7f0e", ms=10, mew=1.5)
+        elif period_map is not None:
+            vx, vy = period_map.drift_velocity
+            psi0 = traj.event_y[0, 17]
+            v = complex(vx, vy) * np.exp(1j * psi0)
+            span = traj.t[-1] - traj.event_t[0]
+            ax.plot([P[0, 0], P[0, 0] + v.real * span], [P[0, 1], P[0, 1] + v.imag * span], "--",
+                    color="#ff7f0e", lw=0.8, label="predicted drift")  # fmt: skip
+    kind = ""
+    if period_map is not None:
+        kind = (f"\nbounded: circle of radius {period_map.radius:.4g}"
+                + (" (near-resonant)" if period_map.near_resonant else "")
+                if period_map.motion == "bounded"
+                else f"\ndrifting at {np.hypot(*period_map.drift_velocity):.4g}")  # fmt: skip
+        kind += rf", $\Delta\psi = {period_map.delta_psi:.6g}$ per period {period_map.period:.6g}"
+    ax.set_title(_title(traj) + kind, fontsize=9)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("X")
+    ax.set_ylabel("Y")
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def timeseries_figure(traj, *, figsize=(8.0, 8.0)) -> Figure:
+    """``gamma3(t)``, the first integrals' relative drift, and the contact reactions."""
+    fig = Figure(figsize=figsize, layout="constrained")
+    ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
+    t = traj.t
+    ax1.plot(t, traj.gamma[:, 2], color="black", lw=0.9)
+    ax1.set_ylabel(r"$\gamma_3$")
+    ax1.set_title(_title(traj), fontsize=9)
+    for name, values in traj.integrals.items():
+        scale = max(np.max(np.abs(values)), 1e-300)
+        drift = np.abs(values - values[0]) / scale
+        ax2.semilogy(t, np.maximum(drift, 1e-17), lw=0.8, label=name)
+    ax2.set_ylabel("relative drift of\nthe first integrals")
+    ax2.legend(fontsize=7, ncols=3, loc="upper left")
+    ax2.set_ylim(1e-17, None)
+    ax3.plot(t, traj.normal_force, color="#1f77b4", lw=0.9, label="normal force N")
+    ax3.plot(t, traj.tangential_force, color="#d62728", lw=0.9, label="tangential force T")
+    ax3.axhline(0, color="0.6", lw=0.6)
+    lost = traj.contact_lost_at
+    if lost is not None:
+        ax3.axvline(lost, color="black", ls="--", lw=0.8, label=f"contact lost, t = {lost:.4g}")
+    ax3.set_ylabel("reactions")
+    ax3.set_xlabel("t")
+    ax3.legend(fontsize=7, loc="upper left")
+    ratio = np.nanmax(traj.friction_ratio) if np.any(traj.normal_force > 0) else np.nan
+    ax3.set_title(f"friction coefficient needed (max T/N at the samples): {ratio:.4g}",
+                  fontsize=8)  # fmt: skip
+    return fig
+
+
+def compare_figure(runs: dict, *, figsize=(10.0, 8.0)) -> Figure:
+    """Paths and integrals of the same initial state under several contact models.
+
+    ``runs``: ``{model name: Trajectory}`` (:func:`rollingtop.simulate_models`). Left: CoM paths.
+    Right: each integral that some model conserves, relative to its initial value, for every
+    model -- flat exactly where the model conserves it.
+    """
+    from rollingtop.dynamics.integrals import evaluate
+
+    fig = Figure(figsize=figsize, layout="constrained")
+    grid = fig.add_gridspec(4, 2)
+    ax = fig.add_subplot(grid[:, 0])
+    names = []
+    for run in runs.values():
+        names += [n for n in run.integrals if n not in names]
+    shown = [n for n in ("energy", "F6", "momentum_x", "routh") if n in names] or names[:4]
+    axes = [fig.add_subplot(grid[i, 1]) for i in range(len(shown))]
+    for model, run in runs.items():
+        colour = _MODEL_COLOURS.get(model)
+        ax.plot(run.position[:, 0], run.position[:, 1], lw=0.9, color=colour, label=model)
+        ax.plot(*run.position[0], "s", color="black", ms=4)
+        values = evaluate(run.body, run.y, shown, pole=run.pole_case)
+        for a, name in zip(axes, shown, strict=True):
+            v = values[name]
+            scale = max(abs(v[0]), 1e-300)
+            conserved = name in run.integrals
+            a.plot(run.t, (v - v[0]) / scale, color=colour, lw=1.6 if conserved else 0.9,
+                   ls="-" if conserved else "--",
+                   label=f"{model}" + (" (conserved)" if conserved else ""))  # fmt: skip
+    for a, name in zip(axes, shown, strict=True):
+        a.set_ylabel(f"{name}:\n(I - I0)/|I0|", fontsize=8)
+        a.legend(fontsize=7, loc="upper left")
+        a.grid(alpha=0.3)
+    if axes:
+        axes[-1].set_xlabel("t")
+    first = next(iter(runs.values()))
+    ax.set_title("CoM paths, same initial state\n" + _title(first).split("   ")[1], fontsize=9)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("X")
+    ax.set_ylabel("Y")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
