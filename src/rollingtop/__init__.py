@@ -19,6 +19,7 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.dynamics.integrals import INTEGRALS
 from rollingtop.dynamics.state import initial_state
+from rollingtop.ensemble import EnsembleResult, simulate_ensemble
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario, load_scenario
 from rollingtop.simulate import simulate, simulate_models
 from rollingtop.trajectory import Trajectory
@@ -30,6 +31,7 @@ __all__ = [
     "ContactLostWarning",
     "ContactModel",
     "ContactModelError",
+    "EnsembleResult",
     "INTEGRALS",
     "InitialConditions",
     "InitialStateError",
@@ -47,5 +49,6 @@ __all__ = [
     "initial_state",
     "load_scenario",
     "simulate",
+    "simulate_ensemble",
     "simulate_models",
 ]

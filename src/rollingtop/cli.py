@@ -449,6 +449,87 @@ def animate(scenario, output, fps, duration, speed, camera):
     click.echo(f"wrote {output} ({n_frames} frames)")
 
 
+@cli.command()
+@click.argument("scenario", type=click.Path(dir_okay=False))
+@click.option(
+    "--initial",
+    "initial_csv",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="CSV of initial conditions: columns gamma1..3, omega1..3, alpha1..3, "
+    "position1..2, v1..3, the model's free components (v_tau, v_horizontal1..2) or "
+    "theta; missing ones take the scenario's values.",
+)
+@click.option(
+    "--grid",
+    type=str,
+    default=None,
+    help="Cartesian grid instead of a file: 'omega3=1:3:20,v_tau=-0.5:0.5:50'.",
+)
+@click.option("-o", "--output", type=click.Path(), default=None, help="Write OUT.nc.")
+@click.option("--t-end", type=float, default=None, help="End time (overrides the scenario).")
+@click.option("--rtol", type=float, default=None, help="Relative tolerance.")
+@click.option("--atol", type=float, default=None, help="Absolute tolerance.")
+@click.option(
+    "--samples",
+    type=click.IntRange(min=2),
+    default=None,
+    help="Keep this many samples per trajectory in OUT.nc (default: final states).",
+)
+@click.option(
+    "--threads", type=click.IntRange(min=1), default=None, help="Threads (default: all cores)."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
+def ensemble(scenario, initial_csv, grid, output, t_end, rtol, atol, samples, threads, as_json):
+    """Integrate many initial states in parallel (the scenario's body and model)."""
+    from rollingtop.ensemble import ensemble_from_scenario, grid_table, read_table
+    from rollingtop.io import check_output_path
+    from rollingtop.scenario import load_scenario
+
+    if (initial_csv is None) == (grid is None):
+        raise click.UsageError("give exactly one of --initial FILE.csv and --grid SPEC")
+    if output is not None:
+        check_output_path(output, (".nc",))
+    sc = load_scenario(scenario).with_overrides(t_end=t_end, rtol=rtol, atol=atol)
+    columns = read_table(initial_csv) if initial_csv is not None else grid_table(grid)
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    console = Console(stderr=True)
+    kwargs = dict(samples=samples, threads=threads)
+    if console.is_terminal:
+        with Progress(
+            TextColumn("ensemble"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            console=console,
+            transient=True,
+        ) as bar:
+            task = bar.add_task("ensemble", total=len(next(iter(columns.values()))))
+            result = ensemble_from_scenario(
+                sc, columns, progress=lambda i, n: bar.update(task, completed=i), **kwargs
+            )
+    else:
+        result = ensemble_from_scenario(sc, columns, **kwargs)
+    if output is not None:
+        result.to_netcdf(output)
+    summary = result.summary()
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    click.echo(
+        f"{summary['n']} trajectories of the {summary['model']} model to t = {summary['t_end']:g} "
+        f"on {summary['threads']} threads: {summary['wall_time_s']:.3f} s "
+        f"({summary['trajectories_per_second']:.1f} per second, "
+        f"+{summary['compile_time_s']:.2f} s compile/load), {summary['failed']} failed, "
+        f"{summary['contact_lost']} lose contact"
+    )
+    for name, drift in summary["max_rel_drift"].items():
+        click.echo(f"  max relative drift of {name}: {drift:.2e}")
+    if output is not None:
+        click.echo(f"wrote {output}")
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point."""
     try:

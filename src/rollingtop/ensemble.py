@@ -1,0 +1,393 @@
+"""Ensembles of initial states (and optionally bodies): :func:`simulate_ensemble`."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop.body import SphericalTop
+from rollingtop.contact import ContactModel, get_model, meridian
+from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics.integrals import evaluate
+from rollingtop.integrate.driver import compile_kernels
+from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
+from rollingtop.io import atomic_write, check_output_path
+from rollingtop.scenario import InitialConditions, Scenario
+
+__all__ = ["EnsembleResult", "simulate_ensemble", "states_from_table", "grid_table"]
+
+STATUS = {0: "finished", -1: "step size underflow", -2: "non-finite state", 1: "max_steps reached"}
+
+
+@dataclass
+class EnsembleResult:
+    """Per-trajectory results of an ensemble.
+
+    Attributes
+    ----------
+    model : ContactModel
+    bodies : list of SphericalTop
+        One per trajectory (the same object repeated for a single body).
+    initial, final : ndarray, shape (N, 18)
+    t_end : float
+    status : ndarray of int, shape (N,)
+        0 when the trajectory reached ``t_end`` (see :data:`STATUS`).
+    steps, rejected_steps, rhs_evals : ndarray of int, shape (N,)
+    min_normal_force, max_friction_ratio : ndarray, shape (N,)
+        Monitored at every accepted step.
+    integrals : dict of str to dict
+        ``{name: {"initial": (N,), "final": (N,), "drift": (N,)}}`` for the integrals the model
+        and bodies share; ``drift = final - initial``.
+    samples : ndarray, shape (N, n, 18), or None
+        Only when asked for (``samples=n``), with times ``t``.
+    wall_time_s, compile_time_s : float
+    threads : int
+    """
+
+    model: ContactModel
+    bodies: list
+    initial: np.ndarray
+    final: np.ndarray
+    t_end: float
+    status: np.ndarray
+    steps: np.ndarray
+    rejected_steps: np.ndarray
+    rhs_evals: np.ndarray
+    min_normal_force: np.ndarray
+    max_friction_ratio: np.ndarray
+    integrals: dict
+    wall_time_s: float
+    compile_time_s: float
+    threads: int
+    t: np.ndarray | None = None
+    samples: np.ndarray | None = None
+    columns: dict = field(default_factory=dict)
+
+    @property
+    def n(self) -> int:
+        return self.initial.shape[0]
+
+    def summary(self) -> dict:
+        """JSON-ready summary (the output of ``rollingtop ensemble --json``)."""
+        worst, worst_abs = {}, {}
+        ok = self.status == 0
+        for name, d in self.integrals.items():
+            if not ok.any():
+                worst[name] = worst_abs[name] = None
+                continue
+            # relative to each trajectory's value, floored at 1e-8 of the ensemble's largest
+            # (an integral that starts at 0 has no relative drift of its own)
+            size = np.abs(d["initial"][ok])
+            scale = np.maximum(size, 1e-8 * size.max() + 1e-300)
+            worst[name] = float(np.max(np.abs(d["drift"][ok]) / scale))
+            worst_abs[name] = float(np.max(np.abs(d["drift"][ok])))
+        failed = int(np.sum(self.status != 0))
+        return {
+            "model": self.model.name,
+            "n": self.n,
+            "t_end": self.t_end,
+            "threads": self.threads,
+            "failed": failed,
+            "status_counts": {
+                STATUS.get(int(k), str(int(k))): int(v)
+                for k, v in zip(*np.unique(self.status, return_counts=True), strict=True)
+            },  # fmt: skip
+            "wall_time_s": self.wall_time_s,
+            "compile_time_s": self.compile_time_s,
+            "trajectories_per_second": self.n / self.wall_time_s if self.wall_time_s else None,
+            "steps_total": int(np.sum(self.steps)),
+            "max_rel_drift": worst,
+            "max_abs_drift": worst_abs,
+            "min_normal_force": float(np.min(self.min_normal_force)),
+            "contact_lost": int(np.sum(self.min_normal_force < 0)),
+        }
+
+    def to_xarray(self):
+        """Per-trajectory results as an :class:`xarray.Dataset` (samples included if kept)."""
+        import xarray as xr
+
+        comp = [f"{k}{i}" for k in ("v", "omega", "alpha", "beta", "gamma") for i in (1, 2, 3)]
+        comp += ["X", "Y", "psi_nu"]
+        data = {
+            "initial_state": (("trajectory", "state"), self.initial),
+            "final_state": (("trajectory", "state"), self.final),
+            "status": ("trajectory", self.status.astype(np.int32)),
+            "steps": ("trajectory", self.steps.astype(np.int64)),
+            "rejected_steps": ("trajectory", self.rejected_steps.astype(np.int64)),
+            "rhs_evals": ("trajectory", self.rhs_evals.astype(np.int64)),
+            "min_normal_force": ("trajectory", self.min_normal_force),
+            "max_friction_ratio": ("trajectory", self.max_friction_ratio),
+        }
+        for name, d in self.integrals.items():
+            for key, values in d.items():
+                data[f"{name}_{key}"] = ("trajectory", values)
+        for name, values in self.columns.items():
+            data[f"input_{name}"] = ("trajectory", np.asarray(values, dtype=float))
+        coords = {"trajectory": np.arange(self.n), "state": comp}
+        if self.samples is not None:
+            data["samples"] = (("trajectory", "t", "state"), self.samples)
+            coords["t"] = self.t
+        b = self.bodies[0]
+        attrs = {f"body_{k}": v for k, v in b.to_dict().items()}
+        attrs.update(model=self.model.name, t_end=self.t_end,
+                     summary_json=json.dumps(self.summary()), source="rollingtop ensemble",
+                     single_body=int(all(x == b for x in self.bodies)))  # fmt: skip
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    def to_netcdf(self, path) -> Path:
+        """Write :meth:`to_xarray` to NetCDF-4, atomically."""
+        path = check_output_path(path, (".nc",))
+        ds = self.to_xarray()
+        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+
+
+def simulate_ensemble(
+    body: SphericalTop | Sequence[SphericalTop],
+    model: str | ContactModel,
+    states,
+    *,
+    t_end: float,
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    samples: int | None = None,
+    max_steps: int = 10**7,
+    threads: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> EnsembleResult:
+    """Integrate ``N`` initial states in parallel on all cores.
+
+    Parameters
+    ----------
+    body : SphericalTop or sequence of N
+        One body for all, or one per trajectory.
+    model : str or ContactModel
+    states : array_like, shape (N, 18)
+        Constraint-consistent initial states (:func:`rollingtop.initial_state`, or
+        :func:`states_from_table`).
+    t_end : float
+        Integration time (each trajectory starts at 0).
+    rtol, atol : float
+        Tolerances (``atol`` default ``rtol / 100``).
+    samples : int, optional
+        Keep this many equally spaced samples per trajectory (memory ``N * samples * 18``);
+        default: keep only the final states.
+    threads : int, optional
+        Number of threads (default: all cores).
+    progress : callable, optional
+        ``progress(done, N)``.
+    """
+    model = get_model(model)
+    states = np.array(states, dtype=float)
+    if states.ndim != 2 or states.shape[1] != N_STATE:
+        raise ScenarioError(f"states must have shape (N, {N_STATE}), got {states.shape}")
+    N = states.shape[0]
+    if N == 0:
+        raise ScenarioError("the ensemble is empty")
+    bodies = [body] * N if isinstance(body, SphericalTop) else list(body)
+    if len(bodies) != N:
+        raise ScenarioError(f"{len(bodies)} bodies for {N} states")
+    if not (isinstance(t_end, int | float) and math.isfinite(t_end) and t_end > 0):
+        raise ScenarioError(f"t_end = {t_end!r} must be a positive number")
+    if not 1e-15 <= rtol <= 0.1:
+        raise ScenarioError(f"rtol = {rtol:g} must lie in [1e-15, 0.1]")
+    atol = rtol / 100 if atol is None else atol
+    if not atol > 0:
+        raise ScenarioError(f"atol = {atol:g} must be > 0")
+    if samples is not None and samples < 2:
+        raise ScenarioError(f"samples = {samples} must be >= 2")
+    codes = np.full(N, model.code, dtype=np.int64)
+    if model.name == "meridian":
+        codes = np.array([meridian.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)])
+    params = np.array([b.params for b in bodies])
+    t_eval = np.linspace(0.0, t_end, samples) if samples else np.array([0.0, float(t_end)])
+    compile_s = compile_kernels() + compile_ensemble()
+    out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol, atol=atol,
+                                              max_steps=max_steps, threads=threads,
+                                              progress=progress)  # fmt: skip
+    import numba
+
+    used = numba.get_num_threads() if threads is None else int(threads)
+    integrals = _ensemble_integrals(model, bodies, codes, states, final)
+    return EnsembleResult(
+        model=model, bodies=bodies, initial=states, final=final, t_end=float(t_end),
+        status=stats[:, 0].astype(int), steps=stats[:, 1].astype(int),
+        rejected_steps=stats[:, 2].astype(int), rhs_evals=stats[:, 3].astype(int),
+        min_normal_force=stats[:, 4], max_friction_ratio=stats[:, 5], integrals=integrals,
+        wall_time_s=wall, compile_time_s=compile_s, threads=used,
+        t=t_eval if samples else None, samples=out if samples else None,
+    )  # fmt: skip
+
+
+def _ensemble_integrals(model, bodies, codes, initial, final) -> dict:
+    names = None
+    for b in {id(b): b for b in bodies}.values():
+        own = set(model.integrals(b.symmetric))
+        names = own if names is None else names & own
+    names = [n for n in model.integrals(True) if n in names]
+    result = {n: {"initial": np.empty(len(bodies)), "final": np.empty(len(bodies))} for n in names}
+    poles = {meridian.SOUTH_CODE: "south", meridian.NORTH_CODE: "north"}
+    groups: dict = {}
+    for k, (b, c) in enumerate(zip(bodies, codes, strict=True)):
+        groups.setdefault((id(b), int(c)), (b, int(c), []))[2].append(k)
+    for b, c, idx in groups.values():
+        idx = np.array(idx)
+        for key, Y in (("initial", initial[idx]), ("final", final[idx])):
+            for name, values in evaluate(b, Y, names, pole=poles.get(c)).items():
+                result[name][key][idx] = values
+    for d in result.values():
+        d["drift"] = d["final"] - d["initial"]
+    return result
+
+
+# ---- building ensembles from tables ---------------------------------------------------------
+
+_VECTOR_KEYS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3, "v_horizontal": 2}
+
+
+def _column_map(model: ContactModel) -> dict[str, tuple[str, int | None]]:
+    """Column name -> (initial-condition key, component index or None)."""
+    cols = {}
+    for key, n in _VECTOR_KEYS.items():
+        if key == "v_horizontal" and "v_horizontal" not in model.free_velocity:
+            continue
+        for i in range(n):
+            cols[f"{key}{i + 1}"] = (key, i)
+    for key, n in model.free_velocity.items():
+        if n == 1:
+            cols[key] = (key, None)
+    cols["theta"] = ("theta", None)  # gamma = (0, sin theta, cos theta)
+    return cols
+
+
+def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -> np.ndarray:
+    """Initial states from the scenario's initial conditions with some values replaced per row.
+
+    ``columns`` maps names to equal-length sequences: ``gamma1..3, omega1..3, alpha1..3,
+    position1..2, v1..3`` (a full velocity), the model's free components (``v_tau``;
+    ``v_horizontal1..2``), or ``theta`` (``gamma = (0, sin theta, cos theta)``). Every row is
+    validated like a scenario's ``[initial]`` table; errors name the row.
+    """
+    model = scenario.model
+    allowed = _column_map(model)
+    unknown = [c for c in columns if c not in allowed]
+    if unknown:
+        raise ScenarioError(
+            f"unknown column {', '.join(unknown)} for model {model.name!r} (allowed: "
+            f"{', '.join(allowed)})"
+        )
+    lengths = {len(v) for v in columns.values()}
+    if len(lengths) != 1:
+        raise ScenarioError("columns of the ensemble table have different lengths")
+    (n,) = lengths
+    base = scenario.initial
+    if base is None:
+        y0 = scenario.require_state()
+        base = InitialConditions(gamma=y0[12:15], omega=y0[3:6], alpha=y0[6:9], v=y0[0:3],
+                                 position=y0[15:17])  # fmt: skip
+    from rollingtop.dynamics.state import initial_state
+
+    states = np.empty((n, N_STATE))
+    for row in range(n):
+        fields = {
+            "gamma": list(base.gamma), "omega": list(base.omega),
+            "alpha": None if base.alpha is None else list(base.alpha),
+            "position": list(base.position), "v": None if base.v is None else list(base.v),
+        }  # fmt: skip
+        free = {k: (list(v) if np.ndim(v) else v) for k, v in base.free.items()}
+        for name, values in columns.items():
+            key, i = allowed[name]
+            x = float(values[row])
+            if key == "theta":
+                fields["gamma"] = [0.0, math.sin(x), math.cos(x)]
+                if "alpha" not in {allowed[c][0] for c in columns}:
+                    fields["alpha"] = None
+            elif key in model.free_velocity:
+                if i is None:
+                    free[key] = x
+                else:
+                    vec = list(free.get(key, [0.0] * model.free_velocity[key]))
+                    vec[i] = x
+                    free[key] = vec
+            else:
+                if fields[key] is None:
+                    raise ScenarioError(f"row {row + 1}: column {name} needs a base value of {key}")
+                fields[key][i] = x
+        if any(allowed[c][0] == "v" for c in columns):
+            free = {}
+        elif any(allowed[c][0] in model.free_velocity for c in columns):
+            fields["v"] = None
+        try:
+            states[row] = initial_state(scenario.body, model, free=free, **fields)
+        except RollingTopError as exc:  # name the row
+            raise type(exc)(f"ensemble row {row + 1}: {exc}") from None
+    return states
+
+
+_GRID = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*([^:]+):([^:]+):(\d+)\s*$")
+
+
+def grid_table(spec: str) -> dict[str, np.ndarray]:
+    """Columns of a Cartesian grid from ``"name=start:stop:count,name=..."``."""
+    axes = []
+    for part in spec.split(","):
+        m = _GRID.match(part)
+        if not m:
+            raise ScenarioError(f"--grid {part.strip()!r}: expected name=start:stop:count")
+        name, a, b, count = m.groups()
+        try:
+            a, b, count = float(a), float(b), int(count)
+        except ValueError:
+            raise ScenarioError(
+                f"--grid {part.strip()!r}: start and stop must be numbers"
+            ) from None
+        if count < 1:
+            raise ScenarioError(f"--grid {part.strip()!r}: count must be >= 1")
+        axes.append((name, np.linspace(a, b, count)))
+    names = [a[0] for a in axes]
+    if len(set(names)) != len(names):
+        raise ScenarioError("--grid names a column twice")
+    rows = list(itertools.product(*[a[1] for a in axes]))
+    return {name: np.array([r[i] for r in rows]) for i, name in enumerate(names)}
+
+
+def read_table(path) -> dict[str, np.ndarray]:
+    """Columns of a CSV file with a header row (``#`` comment lines allowed)."""
+    path = Path(path)
+    try:
+        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines()
+                 if ln.strip() and not ln.lstrip().startswith("#")]  # fmt: skip
+    except OSError as exc:
+        raise ScenarioError(f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    if len(lines) < 2:
+        raise ScenarioError(f"{path}: expected a header row and at least one data row")
+    header = [h.strip() for h in lines[0].split(",")]
+    data = []
+    for k, line in enumerate(lines[1:], start=2):
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise ScenarioError(f"{path}: line {k} has {len(cells)} values, header {len(header)}")
+        try:
+            data.append([float(c) for c in cells])
+        except ValueError:
+            raise ScenarioError(f"{path}: line {k}: not a number in {line!r}") from None
+    arr = np.array(data)
+    return {h: arr[:, i] for i, h in enumerate(header)}
+
+
+def ensemble_from_scenario(scenario: Scenario, columns: dict, **kwargs) -> EnsembleResult:
+    """Run the scenario's body and model over the initial states of ``columns``."""
+    opts = scenario.integration
+    kwargs.setdefault("t_end", opts.t_end)
+    kwargs.setdefault("rtol", opts.rtol)
+    kwargs.setdefault("atol", opts.resolved_atol if kwargs["rtol"] == opts.rtol else None)
+    states = states_from_table(scenario, columns)
+    result = simulate_ensemble(scenario.body, scenario.model, states, **kwargs)
+    return replace(result, columns=dict(columns))
