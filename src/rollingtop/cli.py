@@ -525,7 +525,10 @@ def ensemble(scenario, initial_csv, grid, output, t_end, rtol, atol, samples, th
         f"{summary['contact_lost']} lose contact"
     )
     for name, drift in summary["max_rel_drift"].items():
-        click.echo(f"  max relative drift of {name}: {drift:.2e}")
+        absolute = summary["max_abs_drift"][name]
+        rel = "-" if drift is None else f"{drift:.2e}"
+        absolute = "-" if absolute is None else f"{absolute:.2e}"
+        click.echo(f"  {name}: max |drift| {absolute}, relative to the largest value {rel}")
     if output is not None:
         click.echo(f"wrote {output}")
 

@@ -76,18 +76,23 @@ class EnsembleResult:
         return self.initial.shape[0]
 
     def summary(self) -> dict:
-        """JSON-ready summary (the output of ``rollingtop ensemble --json``)."""
+        """JSON-ready summary (the output of ``rollingtop ensemble --json``).
+
+        ``max_abs_drift`` is the largest ``|final - initial|`` of each integral over the
+        trajectories that finished; ``max_rel_drift`` the same divided by the largest
+        ``|initial|`` over the ensemble.
+        """
         worst, worst_abs = {}, {}
         ok = self.status == 0
         for name, d in self.integrals.items():
             if not ok.any():
                 worst[name] = worst_abs[name] = None
                 continue
-            # relative to each trajectory's value, floored at 1e-8 of the ensemble's largest
-            # (an integral that starts at 0 has no relative drift of its own)
-            size = np.abs(d["initial"][ok])
-            scale = np.maximum(size, 1e-8 * size.max() + 1e-300)
-            worst[name] = float(np.max(np.abs(d["drift"][ok]) / scale))
+            # relative to the ensemble's largest |initial value| (an integral that starts at 0 in
+            # some trajectory has no relative drift of its own); None if all start at 0
+            size = float(np.max(np.abs(d["initial"][ok])))
+            drift = float(np.max(np.abs(d["drift"][ok])))
+            worst[name] = drift / size if size > 0 else None
             worst_abs[name] = float(np.max(np.abs(d["drift"][ok])))
         failed = int(np.sum(self.status != 0))
         return {
@@ -203,6 +208,17 @@ def simulate_ensemble(
         raise ScenarioError(f"atol = {atol:g} must be > 0")
     if samples is not None and samples < 2:
         raise ScenarioError(f"samples = {samples} must be >= 2")
+    from rollingtop.dynamics.state import constraint_residuals
+
+    for k, (b, y) in enumerate(zip(bodies, states, strict=True)):
+        res = constraint_residuals(b, model, y)
+        bad = np.flatnonzero(np.abs(res) > 1e-9)
+        if bad.size or not np.all(np.isfinite(y)):
+            which = model.constraints[bad[0]] if bad.size else "finite values"
+            raise ScenarioError(
+                f"state {k + 1} violates the constraint {which} of model {model.name!r} "
+                "(build states with rollingtop.initial_state for the same body)"
+            )
     codes = np.full(N, model.code, dtype=np.int64)
     if model.name == "meridian":
         codes = np.array([meridian.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)])

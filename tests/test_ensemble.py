@@ -1,0 +1,131 @@
+"""Ensembles: the parallel kernel gives the single-run results, on any number of threads."""
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from rollingtop import (
+    ScenarioError,
+    SphericalTop,
+    initial_state,
+    load_scenario,
+    simulate,
+    simulate_ensemble,
+)
+from rollingtop.ensemble import grid_table, states_from_table
+from rollingtop.reduction import LevelSet
+from rollingtop.scenario import InitialConditions, IntegrationOptions, LevelSpec, Scenario
+
+from .conftest import EXAMPLES, PAPER_BODY
+from .test_cli import run_cli
+
+SAME_RUN = 1e-12  # the ensemble runs the single-run stepper: identical up to round-off
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario(EXAMPLES / "paper.toml").with_overrides(t_end=20.0, rtol=1e-11)
+
+
+def test_grid_and_table(scenario):
+    cols = grid_table("omega3=1.5:2.5:3,v_tau=-0.2:0.2:2")
+    assert list(cols) == ["omega3", "v_tau"] and len(cols["omega3"]) == 6
+    states = states_from_table(scenario, cols)
+    assert states.shape == (6, 18)
+    np.testing.assert_allclose(states[:, 5], np.repeat([1.5, 2.0, 2.5], 2))
+    with pytest.raises(ScenarioError, match="unknown column foo"):
+        states_from_table(scenario, {"foo": [1.0]})
+    with pytest.raises(ScenarioError, match="expected name=start:stop:count"):
+        grid_table("omega3=1:2")
+    with pytest.raises(Exception, match="ensemble row 2: .*gamma .* is not a unit vector"):
+        states_from_table(scenario, {"gamma3": [0.8, 0.9]})
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_ensemble_equals_single_runs(scenario, threads):
+    cols = grid_table("omega3=1.5:2.5:3,v_tau=-0.2:0.2:3")
+    states = states_from_table(scenario, cols)
+    opts = scenario.integration
+    res = simulate_ensemble(
+        scenario.body,
+        "meridian",
+        states,
+        t_end=opts.t_end,
+        rtol=opts.rtol,
+        atol=opts.resolved_atol,
+        threads=threads,
+    )
+    assert res.samples is None  # memory: only the final states unless asked
+    assert res.threads == threads and np.all(res.status == 0)
+    for k in (0, 4, 8):
+        y = states[k]
+        ic = InitialConditions(gamma=y[12:15], omega=y[3:6], alpha=y[6:9], v=y[0:3])
+        single = simulate(Scenario(scenario.body, "meridian", ic, opts))
+        np.testing.assert_allclose(res.final[k], single.y[-1], rtol=0, atol=SAME_RUN)
+        assert res.steps[k] == single.stats["steps"]
+        assert res.integrals["F6"]["drift"][k] == pytest.approx(
+            single.integrals["F6"][-1] - single.integrals["F6"][0], abs=1e-12
+        )
+    s = res.summary()
+    assert s["n"] == 9 and s["failed"] == 0
+    assert all(v < 1e-9 for v in s["max_rel_drift"].values())
+
+
+def test_samples_bodies_and_pole_cases(paper_body):
+    """Several bodies at once, samples kept on request, and a pole case integrated through the
+    pole inside the parallel kernel."""
+    level = LevelSet(paper_body, 1.0, 1.0, -0.3)
+    pole = Scenario(
+        paper_body,
+        "meridian",
+        None,
+        IntegrationOptions(t_end=10.0),
+        level=LevelSpec(1.0, 1.0, -0.3, h=float(level.U(0.0)) + 0.5),
+    ).y0
+    other = SphericalTop(**(PAPER_BODY | {"a3": 0.2}))
+    plain = initial_state(
+        other, "meridian", gamma=(0, 0.6, 0.8), omega=(0.7, -0.3, 2.0), free={"v_tau": 0.25}
+    )
+    res = simulate_ensemble(
+        [paper_body, other], "meridian", [pole, plain], t_end=10.0, rtol=1e-12, samples=11
+    )
+    assert res.samples.shape == (2, 11, 18) and np.all(res.status == 0)
+    assert 1 - res.samples[0, :, 14].max() < 0.05  # near the pole at some sample
+    assert abs(res.integrals["F6"]["drift"][0]) < 1e-10  # through the pole
+    assert abs(res.integrals["energy"]["drift"][1]) < 1e-10
+    with pytest.raises(ScenarioError, match="2 bodies for 1 states"):
+        simulate_ensemble([paper_body, other], "meridian", [plain], t_end=1.0)
+    with pytest.raises(ScenarioError, match="state 1 violates the constraint contact"):
+        simulate_ensemble(paper_body, "meridian", [plain], t_end=1.0)  # made for another body
+
+
+def test_cli_ensemble(capsys, tmp_path):
+    out = tmp_path / "ens.nc"
+    csv = tmp_path / "ic.csv"
+    csv.write_text("# two states\nomega3,v_tau\n2.0,0.1\n2.2,0.2\n")
+    code, stdout, err = run_cli(
+        capsys,
+        "ensemble",
+        str(EXAMPLES / "paper.toml"),
+        "--initial",
+        str(csv),
+        "--t-end",
+        "5",
+        "--samples",
+        "6",
+        "-o",
+        str(out),
+        "--json",
+    )
+    assert code == 0, err
+    summary = json.loads(stdout)
+    assert summary["n"] == 2 and summary["failed"] == 0
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds["final_state"].shape == (2, 18) and ds["samples"].shape == (2, 6, 18)
+        np.testing.assert_allclose(ds["input_omega3"].values, [2.0, 2.2])
+    code, _, err = run_cli(capsys, "ensemble", str(EXAMPLES / "paper.toml"))
+    assert code == 2 and "exactly one of --initial" in err
+    code, _, err = run_cli(capsys, "ensemble", str(EXAMPLES / "paper.toml"), "--grid", "x=1:2:2")
+    assert code == 2 and "unknown column x" in err
