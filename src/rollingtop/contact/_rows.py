@@ -9,7 +9,7 @@ acceleration equation (``MODEL.md``, "Dynamics").
 from numba import njit
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     """Write row ``k`` for the no-slip condition ``(vp, d) = 0`` of the contact point.
 
@@ -43,7 +43,7 @@ def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     dirs[k, 2] = d3
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def normal_row(p, y, k, J, bias, dirs):
     """Row ``k`` for the contact condition ``f1 = (vp, gamma) = 0`` (paper eq. 2.4)."""
     w1, w2, w3 = y[3], y[4], y[5]

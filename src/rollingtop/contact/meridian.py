@@ -41,7 +41,7 @@ POLE_CASE_TOLERANCE = 1e-9
 RESYNC_S = 0.05
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def rows(p, y, J, bias, dirs):
     """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``); returns their number, 2."""
     normal_row(p, y, 0, J, bias, dirs)
@@ -64,7 +64,7 @@ def rows(p, y, J, bias, dirs):
     return 2
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def psi_nu_rate(p, y, north):
     """``psi_nu' = M3 / (I1 (1 + gamma3))`` (south) or ``-M3 / (I1 (1 - gamma3))`` (north)."""
     M3 = p[6] * y[5]
@@ -73,7 +73,7 @@ def psi_nu_rate(p, y, north):
     return M3 / (p[4] * (1.0 + y[14]))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def rows_pole(p, y, J, bias, dirs, north):
     """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu = cos(psi_nu) alpha +
     sin(psi_nu) beta``; ``nu' = psi_nu' (gamma x nu) + nu x w``. Returns 2."""

@@ -39,7 +39,7 @@ def new_workspace():
     )
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def constraint_rows(code, p, y, J, bias, dirs):
     """Fill the contact model's rows ``J``, their ``bias = J' u`` and force directions ``dirs``.
 
@@ -58,7 +58,7 @@ def constraint_rows(code, p, y, J, bias, dirs):
     return -1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def _solve_spd(n, A, x):
     """Solve ``A z = x`` in place (``x <- z``) for SPD ``A`` given by its lower triangle."""
     for j in range(n):
@@ -84,7 +84,7 @@ def _solve_spd(n, A, x):
         x[i] = s / A[i, i]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def rhs(code, p, y, dy, ws):
     """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
 
@@ -138,7 +138,7 @@ def rhs(code, p, y, dy, ws):
     return nc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def reaction(nc, y, ws):
     """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` (last :func:`rhs`).
 
@@ -156,7 +156,7 @@ def reaction(nc, y, ws):
     return N, math.sqrt(t1 * t1 + t2 * t2 + t3 * t3)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def _sync_psi_nu(code, y):
     """Set ``psi_nu`` to the axis azimuth ``atan2(beta3, alpha3)``: the nearest value modulo
     ``2 pi`` (continuous), or modulo ``pi`` in a pole case (keeping the side of the pole), where
@@ -170,7 +170,7 @@ def _sync_psi_nu(code, y):
     y[17] = psi + period * round((y[17] - psi) / period)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def project(code, p, y, ws):
     """Project ``y`` in place onto the constraint manifold.
 
@@ -215,7 +215,7 @@ def project(code, p, y, ws):
         y[k] -= minv[k] * s
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def diagnostics(code, p, Y, out):
     """Per-sample reactions and constraint errors.
 

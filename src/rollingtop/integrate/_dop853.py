@@ -52,7 +52,7 @@ def new_track():
     return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def update_track(track, t, N, T_force):
     """Fold one evaluation of the contact force into ``track``."""
     if N < track[MIN_NORMAL]:
@@ -67,7 +67,7 @@ def update_track(track, t, N, T_force):
             track[T_MAX_RATIO] = t
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy."""
     n = y.shape[0]
@@ -96,7 +96,7 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
     return min(100.0 * h0, h1, t_end - t0)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _stage(K, s, y, h, ytmp):
     """``ytmp = y + h * sum_{j<s} A[s, j] K[j]``."""
     n = y.shape[0]
@@ -107,7 +107,7 @@ def _stage(K, s, y, h, ytmp):
         ytmp[i] = y[i] + h * acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
     """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
     n = y.shape[0]
@@ -126,7 +126,7 @@ def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
             Fd[3 + r, i] = h * acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _dense_eval(Fd, y, x, out):
     """State at the fraction ``x`` of the step: ``y + sum`` of the interpolant's terms."""
     for i in range(y.shape[0]):
@@ -137,7 +137,7 @@ def _dense_eval(Fd, y, x, out):
         out[i] = y[i] + acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
     """Time in ``[t, t + h]`` where the normal force crosses zero, by bisection on the dense
     output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings."""
@@ -156,7 +156,7 @@ def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
     return t + 0.5 * (lo + hi) * h
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
     output (60 halvings: to the resolution of the interpolant)."""
@@ -174,7 +174,7 @@ def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def run(
     code,
     p,
@@ -267,7 +267,7 @@ def run(
                 for j in range(12):
                     acc += B[j] * K[j, i]
                 ynew[i] = y[i] + h * acc
-            rhs(code, p, ynew, K[12], ws)
+            nc_new = rhs(code, p, ynew, K[12], ws)
             counts[NFEV] += 12
             e5 = 0.0
             e3 = 0.0
@@ -298,6 +298,8 @@ def run(
                 h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
                 counts[REJECTED] += 1
                 rejected = True
+        # Contact reaction at the new point, from the last stage (FSAL), before ws is reused.
+        N, T_force = reaction(nc_new, ynew, ws)
         # Dense output over [t, t_new] for the samples that fall in it.
         dense_ready = False
         k = counts[NEXT_SAMPLE]
@@ -310,18 +312,18 @@ def run(
                 project(code, p, out[k], ws)
                 k += 1
             counts[NEXT_SAMPLE] = k
-        # Accept: project onto the constraints and re-evaluate the derivative there.
+        # Accept: project onto the constraints. The derivative at the new point is the last
+        # stage (first same as last): the projection moves the state by round-off-sized amounts
+        # (truncation error at most), far below what would change the next step.
         for i in range(n):
             y_old[i] = y[i]
             y[i] = ynew[i]
+            f[i] = K[12, i]
         project(code, p, y, ws)
-        nc = rhs(code, p, y, f, ws)
-        counts[NFEV] += 1
         for i in range(n):
             if not math.isfinite(y[i]) or not math.isfinite(f[i]):
                 ctrl[T] = t_new
                 return NOT_FINITE
-        N, T_force = reaction(nc, y, ws)
         if N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and track[LAST_NORMAL] >= 0.0:
             # first loss of contact: locate N = 0 inside the step on the dense output
             if not dense_ready:

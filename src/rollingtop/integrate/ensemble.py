@@ -25,7 +25,7 @@ __all__ = ["integrate_batch", "compile_ensemble"]
 BATCH = 256
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats):
     """Integrate one trajectory; ``out`` (len(t_eval), 18) samples, ``final`` (18,) state,
     ``stats`` (6,): status, steps, rejected, rhs evaluations, min normal force, max friction
@@ -73,7 +73,7 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
     stats[5] = track[dop.MAX_RATIO]
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, parallel=True)
 def _batch(codes, P, Y0, t_eval, rtol, atol, max_steps, out, final, stats):
     for k in prange(Y0.shape[0]):
         _integrate_one(codes[k], P[k], Y0[k], t_eval, rtol, atol, max_steps, out[k], final[k],

@@ -1,0 +1,313 @@
+"""rollingtop benchmarks: side-by-side timings against scipy.integrate.solve_ivp.
+
+Run:  python benchmarks/run_benchmarks.py [--quick] [--out benchmarks/results.json]
+
+W1  one long trajectory (paper's body, examples/paper.toml, t = 1e4, rtol 1e-10, atol 1e-12):
+    rollingtop vs solve_ivp(DOP853) with a plain NumPy right-hand side and with rollingtop's
+    compiled right-hand side; wall time, steps, rhs evaluations, us per step and per evaluation,
+    ratios, and the final-state difference (comparable accuracy).
+W2  ensemble of 1e4 initial states, t = 100: trajectories per second on 1 and 2 threads and the
+    parallel efficiency.
+W3  work-precision: final-state error at t = 100 against a reference solved at rtol 1e-14 by two
+    methods (rollingtop and solve_ivp), for rtol 1e-6 ... 1e-13.
+Cold start: import + compile in a fresh process, with an empty numba cache and with a warm one.
+
+Timings are medians of repeated runs in this one process (the slow baselines run fewer times);
+nothing here is asserted: this is not part of the test suite.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def numpy_rhs_factory(p, model="meridian"):
+    """A plain NumPy right-hand side of the meridian model (MODEL.md, "Dynamics"): the full
+    (v', w', lambda) linear system solved with numpy.linalg.solve -- what a careful user would
+    write without rollingtop."""
+    R, m, g, a3, I1, I2, I3 = p
+    Iv = np.array([I1, I2, I3])
+    e3 = np.array([0.0, 0.0, 1.0])
+    avec = np.array([0.0, 0.0, a3])
+
+    def rhs(t, y):
+        v, w = y[0:3], y[3:6]
+        alpha, beta, gamma = y[6:9], y[9:12], y[12:15]
+        r = -R * gamma - avec
+        gdot = np.cross(gamma, w)
+        rdot = -R * gdot
+        vp = v + np.cross(w, r)
+        g3, g3dot = gamma[2], gdot[2]
+        s = np.sqrt(1.0 - g3 * g3)
+        pvec = e3 - g3 * gamma
+        nu = pvec / s
+        nudot = (-g3dot * gamma - g3 * gdot) / s + pvec * g3 * g3dot / s**3
+        dirs = ((gamma, gdot), (nu, nudot))
+        M = np.zeros((8, 8))
+        b = np.zeros(8)
+        M[0:3, 0:3] = m * np.eye(3)
+        M[3:6, 3:6] = np.diag(Iv)
+        b[0:3] = m * np.cross(v, w) - m * g * gamma
+        b[3:6] = np.cross(Iv * w, w)
+        for i, (d, dd) in enumerate(dirs):
+            rxd = np.cross(r, d)
+            M[0:3, 6 + i] = -d
+            M[3:6, 6 + i] = -rxd
+            M[6 + i, 0:3] = d
+            M[6 + i, 3:6] = rxd
+            b[6 + i] = -np.cross(w, rdot) @ d - vp @ dd
+        sol = np.linalg.solve(M, b)
+        dy = np.zeros_like(y)
+        dy[0:6] = sol[0:6]
+        dy[6:9] = np.cross(alpha, w)
+        dy[9:12] = np.cross(beta, w)
+        dy[12:15] = gdot
+        dy[15] = v @ alpha
+        dy[16] = v @ beta
+        return dy
+
+    return rhs
+
+
+def compiled_rhs_factory(code, p):
+    """solve_ivp calling rollingtop's compiled right-hand side through one compiled function of
+    a single array (``f(t, y) -> dy``), the cheapest call numba offers from Python."""
+    from numba import njit
+
+    from rollingtop.dynamics import _kernel
+
+    @njit
+    def f(y):
+        dy = np.empty(18)
+        ws = (np.empty((4, 6)), np.empty(4), np.empty((4, 3)), np.empty((4, 4)), np.empty(4))
+        _kernel.rhs(code, p, y, dy, ws)
+        return dy
+
+    f(np.ascontiguousarray(np.r_[np.zeros(6), np.eye(3).ravel(), 0.0, 0.0, 0.0]))
+
+    def rhs(t, y):
+        return f(y)
+
+    return rhs
+
+
+def median_time(fn, repeat):
+    times, result = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), times, result
+
+
+def machine() -> dict:
+    import numba
+    import scipy
+
+    cpu = platform.processor()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "numba": numba.__version__,
+    }
+
+
+def w1(t_end, repeat, numpy_repeat):
+    import rollingtop as rt
+
+    sc = rt.load_scenario(ROOT / "examples" / "paper.toml").with_overrides(
+        t_end=t_end, rtol=1e-10, atol=1e-12, samples=2
+    )
+    rt.simulate(sc, t_end=1.0)  # compile / load cache outside the timing
+    wall, times, traj = median_time(lambda: rt.simulate(sc), repeat)
+    ours = {
+        "wall_s": wall,
+        "kernel_wall_s": traj.stats["wall_time_s"],
+        "steps": traj.stats["steps"],
+        "rhs_evals": traj.stats["rhs_evals"],
+        "times": times,
+    }
+    ours["us_per_step"] = 1e6 * wall / ours["steps"]
+    ours["us_per_rhs_eval"] = 1e6 * wall / ours["rhs_evals"]
+    y_ours = traj.y[-1]
+    y0 = sc.y0
+    out = {"t_end": t_end, "rtol": 1e-10, "atol": 1e-12, "rollingtop": ours}
+    for name, factory, rep in (
+        ("solve_ivp_compiled_rhs", lambda: compiled_rhs_factory(0, sc.body.params), repeat),
+        ("solve_ivp_numpy_rhs", lambda: numpy_rhs_factory(sc.body.params), numpy_repeat),
+    ):
+        f = factory()
+
+        def run(f=f):
+            return solve_ivp(f, (0.0, t_end), y0, method="DOP853", rtol=1e-10, atol=1e-12)
+
+        wall, times, sol = median_time(run, rep)
+        steps = len(sol.t) - 1
+        out[name] = {
+            "wall_s": wall,
+            "steps": steps,
+            "rhs_evals": int(sol.nfev),
+            "us_per_step": 1e6 * wall / steps,
+            "us_per_rhs_eval": 1e6 * wall / sol.nfev,
+            "times": times,
+            "final_state_diff_vs_rollingtop": float(np.max(np.abs(sol.y[:17, -1] - y_ours[:17]))),
+            "speedup_of_rollingtop": wall / ours["wall_s"],
+        }
+        print(f"  W1 {name}: {wall:.2f} s, x{wall / ours['wall_s']:.0f}", flush=True)
+    return out
+
+
+def w2(n, t_end):
+    import numba
+
+    import rollingtop as rt
+    from rollingtop.ensemble import grid_table, states_from_table
+
+    sc = rt.load_scenario(ROOT / "examples" / "paper.toml")
+    side = int(round(np.sqrt(n)))
+    cols = grid_table(f"omega3=1.5:2.5:{side},v_tau=-0.4:0.4:{side}")
+    states = states_from_table(sc, cols)
+    rt.simulate_ensemble(sc.body, "meridian", states[:4], t_end=1.0)  # compile outside timing
+    out = {"n": len(states), "t_end": t_end, "rtol": 1e-10, "atol": 1e-12,
+           "threads_available": numba.config.NUMBA_NUM_THREADS}  # fmt: skip
+    for threads in (1, 2):
+        res = rt.simulate_ensemble(sc.body, "meridian", states, t_end=t_end, rtol=1e-10,
+                                   atol=1e-12, threads=threads)  # fmt: skip
+        out[f"threads_{threads}"] = {
+            "wall_s": res.wall_time_s,
+            "trajectories_per_s": len(states) / res.wall_time_s,
+            "steps_total": int(res.steps.sum()),
+            "failed": int(np.sum(res.status != 0)),
+        }
+        print(f"  W2 {threads} thread(s): {res.wall_time_s:.1f} s", flush=True)
+    r1 = out["threads_1"]["trajectories_per_s"]
+    r2 = out["threads_2"]["trajectories_per_s"]
+    out["parallel_efficiency_2"] = r2 / (2 * r1)
+    return out
+
+
+def w3(t_end):
+    import rollingtop as rt
+
+    sc = rt.load_scenario(ROOT / "examples" / "paper.toml").with_overrides(t_end=t_end, samples=2)
+    ref_a = rt.simulate(sc, rtol=1e-14, atol=1e-16).y[-1, :17]
+    sol = solve_ivp(compiled_rhs_factory(0, sc.body.params), (0.0, t_end), sc.y0,
+                    method="DOP853", rtol=1e-14, atol=1e-16)  # fmt: skip
+    ref_b = sol.y[:17, -1]
+    out = {"t_end": t_end, "reference_cross_check": float(np.max(np.abs(ref_a - ref_b))),
+           "points": []}  # fmt: skip
+    for rtol in (1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13):
+        wall, _, traj = median_time(lambda r=rtol: rt.simulate(sc, rtol=r, atol=r / 100), 3)
+        f = compiled_rhs_factory(0, sc.body.params)
+        wall_s, _, s2 = median_time(
+            lambda r=rtol, f=f: solve_ivp(f, (0.0, t_end), sc.y0, method="DOP853", rtol=r,
+                                          atol=r / 100), 1)  # fmt: skip
+        out["points"].append({
+            "rtol": rtol,
+            "rollingtop_s": wall,
+            "rollingtop_error": float(np.max(np.abs(traj.y[-1, :17] - ref_a))),
+            "rollingtop_steps": traj.stats["steps"],
+            "solve_ivp_compiled_s": wall_s,
+            "solve_ivp_error": float(np.max(np.abs(s2.y[:17, -1] - ref_a))),
+        })  # fmt: skip
+    return out
+
+
+def cold_start():
+    code = ("import time; t = time.perf_counter(); import rollingtop; "
+            "from rollingtop.integrate import compile_kernels; compile_kernels(); "
+            "print(time.perf_counter() - t)")  # fmt: skip
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        env = os.environ | {"NUMBA_CACHE_DIR": cache}
+        for label in ("empty_cache_s", "warm_cache_s"):
+            proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                  text=True, check=True)  # fmt: skip
+            out[label] = float(proc.stdout.strip().splitlines()[-1])
+    return out
+
+
+def table(res) -> str:
+    w = res["W1"]
+    o, c, n = w["rollingtop"], w["solve_ivp_compiled_rhs"], w["solve_ivp_numpy_rhs"]
+    rows = [
+        "| W1: t = 1e4, rtol 1e-10 | wall (s) | steps | rhs evals | us/step | us/eval | rollingtop faster by |",
+        "|---|---|---|---|---|---|---|",
+        f"| rollingtop | {o['wall_s']:.3f} | {o['steps']} | {o['rhs_evals']} | {o['us_per_step']:.2f} | {o['us_per_rhs_eval']:.3f} | - |",
+        f"| solve_ivp DOP853, rollingtop's compiled rhs | {c['wall_s']:.2f} | {c['steps']} | {c['rhs_evals']} | {c['us_per_step']:.1f} | {c['us_per_rhs_eval']:.2f} | x{c['speedup_of_rollingtop']:.0f} |",
+        f"| solve_ivp DOP853, NumPy rhs | {n['wall_s']:.1f} | {n['steps']} | {n['rhs_evals']} | {n['us_per_step']:.1f} | {n['us_per_rhs_eval']:.2f} | x{n['speedup_of_rollingtop']:.0f} |",
+    ]  # fmt: skip
+    w2 = res["W2"]
+    rows += [
+        "",
+        f"| W2: {w2['n']} states, t = {w2['t_end']:g} | wall (s) | trajectories/s |",
+        "|---|---|---|",
+        f"| 1 thread | {w2['threads_1']['wall_s']:.1f} | {w2['threads_1']['trajectories_per_s']:.0f} |",
+        f"| 2 threads | {w2['threads_2']['wall_s']:.1f} | {w2['threads_2']['trajectories_per_s']:.0f} |",
+        f"| parallel efficiency | | {100 * w2['parallel_efficiency_2']:.0f} % |",
+    ]  # fmt: skip
+    w3r = res["W3"]
+    rows += [
+        "",
+        f"| W3: rtol (t = {w3r['t_end']:g}) | rollingtop error | rollingtop (s) | solve_ivp error | solve_ivp compiled rhs (s) |",
+        "|---|---|---|---|---|",
+    ]  # fmt: skip
+    for pt in w3r["points"]:
+        rows.append(f"| {pt['rtol']:.0e} | {pt['rollingtop_error']:.1e} | {pt['rollingtop_s']:.4f} | "
+                    f"{pt['solve_ivp_error']:.1e} | {pt['solve_ivp_compiled_s']:.3f} |")  # fmt: skip
+    cs = res["cold_start"]
+    rows += ["", f"Cold start (import + compile): {cs['empty_cache_s']:.1f} s with an empty numba "
+             f"cache, {cs['warm_cache_s']:.1f} s with a warm one."]  # fmt: skip
+    return "\n".join(rows)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smaller sizes, for a smoke test")
+    ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results.json"))
+    args = ap.parse_args()
+    quick = args.quick
+    res = {"machine": machine(), "quick": quick,
+           "date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}  # fmt: skip
+    # W2 first: the parallel measurement wants otherwise idle cores
+    print("W2 ...", flush=True)
+    res["W2"] = w2(400 if quick else 10_000, 100.0)
+    print("W3 ...", flush=True)
+    res["W3"] = w3(20.0 if quick else 100.0)
+    print("cold start ...", flush=True)
+    res["cold_start"] = cold_start()
+    print("W1 ...", flush=True)
+    res["W1"] = w1(1e3 if quick else 1e4, 3 if quick else 5, 1)
+    res["table_markdown"] = table(res)
+    Path(args.out).write_text(json.dumps(res, indent=2))
+    print(res["table_markdown"])
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
