@@ -533,6 +533,43 @@ def ensemble(scenario, initial_csv, grid, output, t_end, rtol, atol, samples, th
         click.echo(f"wrote {output}")
 
 
+@cli.command()
+@click.option(
+    "--model",
+    "models",
+    type=click.Choice(["meridian", "smooth", "rough"]),
+    multiple=True,
+    help="Model(s) to verify (default: all).",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
+def verify(models, as_json):
+    """Machine-check the equations' claims with sympy: first integrals, identities, the reduced
+    system (3.3) and its invariant measure."""
+    try:
+        from rollingtop.symbolic import verify as run_claims
+    except ImportError as exc:  # pragma: no cover - sympy missing
+        raise click.UsageError(
+            f"verify needs sympy ({exc}): pip install rollingtop[symbolic]"
+        ) from None
+    results = run_claims(models or ("meridian", "smooth", "rough"))
+    if as_json:
+        click.echo(json.dumps({"claims": [r.to_dict() for r in results]}))
+    else:
+        from rich.table import Table
+
+        table = Table(title="rollingtop verify")
+        for col in ("claim", "model", "result", "method", "time (s)"):
+            table.add_column(col, justify="right" if col == "time (s)" else "left")
+        for r in results:
+            colour = "green" if r.result == "proved" else "red"
+            table.add_row(
+                r.name, r.model, f"[{colour}]{r.result}[/{colour}]", r.method, f"{r.seconds:.2f}"
+            )
+        _console().print(table)
+    if any(r.result != "proved" for r in results):
+        sys.exit(EXIT_FAILURE)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point."""
     try:

@@ -1,0 +1,266 @@
+"""Machine-checked claims about the models: first integrals, identities, reduction, measure.
+
+A claim is an expression that must vanish on the constraint manifold: the time derivative of a
+first integral along the derived vector field (:mod:`.equations`), an identity, or the difference
+between the full and the reduced equations. It is decided by
+
+1. **exact simplification** when the expression is small enough to simplify quickly: the
+   manifold is parametrised *rationally* (``gamma`` by two rational parameters with
+   ``s = sqrt(1 - gamma3^2)`` itself rational, the velocity by the constraints' free components)
+   and the result cancelled to a normal form -- zero is a proof;
+2. otherwise **exact evaluation at random rational points** (all parameters and variables drawn
+   as rationals, arithmetic in exact rationals): nonzero anywhere disproves the claim, zero at
+   every one of several independent points establishes it with the certainty of polynomial
+   identity testing (a nonzero rational function vanishes on a set of measure zero).
+
+Each result says which method decided it.
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from dataclasses import asdict, dataclass
+from fractions import Fraction
+
+import sympy as sp
+
+from rollingtop.symbolic.equations import SYMBOLS, derive
+
+__all__ = ["Claim", "ClaimResult", "claims_for", "decide", "verify"]
+
+#: Above this many operations the exact route is skipped for the random rational points.
+EXACT_OPS_LIMIT = 4000
+#: Random rational points of the fallback.
+N_POINTS = 4
+
+S = SYMBOLS
+# extra symbols: s = sqrt(gamma1^2 + gamma2^2) and theta = arccos(gamma3) as variables with
+# their own time derivatives (keeps every expression rational)
+s_sym, theta_sym = sp.symbols("s theta", positive=True)
+q, k = sp.symbols("q k", positive=True)  # rational parametrisation of gamma
+j = sp.Symbol("j", real=True)  # azimuth of the fixed x axis, rationally
+free = sp.symbols("c1 c2", real=True)  # free velocity components
+
+
+@dataclass(frozen=True)
+class Claim:
+    """``expr`` must vanish on the manifold of ``model``; ``kind``: "integral" (``expr`` is the
+    integral, its time derivative is tested), "identity" (``expr`` itself) or "given" (an
+    already-built expression of the state and ``s``)."""
+
+    name: str
+    model: str
+    expr: sp.Expr
+    kind: str = "integral"
+    symmetric: bool = True
+
+
+@dataclass(frozen=True)
+class ClaimResult:
+    name: str
+    model: str
+    result: str  # "proved" | "failed"
+    method: str
+    seconds: float
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _time_derivative(expr, field):
+    """``d expr/dt`` along ``field`` (a dict symbol -> derivative), with ``s`` and ``theta``."""
+    g1, g2, g3 = S.gamma
+    extended = dict(field)
+    extended[s_sym] = (g1 * field[g1] + g2 * field[g2]) / s_sym
+    extended[theta_sym] = -field[g3] / s_sym
+    return sum(sp.diff(expr, x) * dx for x, dx in extended.items() if expr.has(x))
+
+
+def _manifold(model: str) -> dict:
+    """Rational parametrisation of the constraint manifold: substitutions for gamma, s, v,
+    alpha, beta in terms of ``q, k`` (gamma), the free components and ``w``."""
+    sq = 2 * q / (1 + q**2)
+    cphi, sphi = (1 - k**2) / (1 + k**2), 2 * k / (1 + k**2)
+    gamma = sp.Matrix([sq * cphi, sq * sphi, (1 - q**2) / (1 + q**2)])
+    e3 = sp.Matrix([0, 0, 1])
+    tau = e3.cross(gamma) / sq  # unit, rational
+    r = -S.R * gamma - sp.Matrix([0, 0, S.a3])
+    wxr = S.w.cross(r)
+    if model == "meridian":
+        v = -wxr + free[0] * tau  # contact velocity along tau only
+    elif model == "smooth":
+        v = -wxr + free[0] * tau + free[1] * gamma.cross(tau)  # contact velocity horizontal
+    elif model == "rough":
+        v = -wxr
+    else:
+        raise ValueError(model)
+    nu = (e3 - gamma[2] * gamma) / sq  # unit, rational
+    alpha = ((1 - j**2) * tau + 2 * j * nu) / (1 + j**2)  # generic horizontal unit vector
+    beta = gamma.cross(alpha)
+    subs = {s_sym: sq}
+    for i in range(3):
+        subs[S.gamma[i]] = gamma[i]
+        subs[S.v[i]] = v[i]
+        subs[S.alpha[i]] = alpha[i]
+        subs[S.beta[i]] = beta[i]
+    return subs
+
+
+def _random_rational(rng, lo=-3, hi=3):
+    return sp.Rational(Fraction(rng.randint(lo * 97, hi * 97), rng.randint(1, 97)))
+
+
+def decide(expr, model: str, symmetric: bool = True, seed: int = 1) -> tuple[bool, str]:
+    """Does ``expr`` (a function of the state, ``s``, ``theta`` and the parameters) vanish on
+    the manifold of ``model``? Returns ``(holds, method)``."""
+    subs = _manifold(model)
+    on = sp.sympify(expr).xreplace(subs)
+    if symmetric:
+        on = on.xreplace({S.I2: S.I1})
+    if sp.count_ops(on, visual=False) <= EXACT_OPS_LIMIT:
+        normal = sp.cancel(sp.together(on))
+        return normal == 0, "exact simplification"
+    rng = random.Random(seed)
+    symbols = sorted(on.free_symbols, key=lambda x: x.name)
+    for _ in range(N_POINTS):
+        values = {}
+        for x in symbols:
+            if x in (q, k):
+                values[x] = sp.Rational(rng.randint(1, 50), rng.randint(51, 120))  # in (0, 1)
+            elif x in (S.m, S.I1, S.I2, S.I3, S.R):
+                values[x] = sp.Rational(rng.randint(20, 200), rng.randint(20, 100))
+            else:
+                values[x] = _random_rational(rng)
+        if not symmetric:  # keep the triangle inequality and I1 != I2
+            values[S.I3] = min(values[S.I3], values[S.I1] + values.get(S.I2, values[S.I1]))
+        val = on.xreplace(values)
+        val = sp.nsimplify(val) if val.has(sp.Float) else sp.simplify(val)
+        if val != 0:
+            return False, f"exact evaluation: nonzero ({sp.N(val, 6)}) at a random rational point"
+    return True, f"exact evaluation at {N_POINTS} random rational points"
+
+
+def _integrals():
+    I = sp.diag(S.I1, S.I2, S.I3)
+    Iw = I * S.w
+    r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
+    g1, g2, g3 = S.gamma
+    v_tau = (-g2 * S.v[0] + g1 * S.v[1]) / s_sym
+    w_n = -(g1 * S.w[0] + g2 * S.w[1]) / s_sym
+    M3 = S.I3 * S.w[2]
+    F6 = S.I1 * (v_tau - (S.R * g3 + S.a3) * w_n) - M3 * (S.R * s_sym + S.a3 * theta_sym)
+    Q = S.I1 * S.I3 + S.m * S.I1 * (r[0] ** 2 + r[1] ** 2) + S.m * S.I3 * r[2] ** 2
+    return {
+        "energy": S.m * S.v.dot(S.v) / 2 + S.w.dot(Iw) / 2 - S.m * S.g * r.dot(S.gamma),
+        "lagrange": M3,
+        "jellett": Iw.dot(r),
+        "area": Iw.dot(S.gamma),
+        "F6": F6,
+        "routh^2": S.w[2] ** 2 * Q,  # Routh's integral w3 sqrt(Q), squared: rational
+        "momentum_x": S.m * S.v.dot(S.alpha),
+        "momentum_y": S.m * S.v.dot(S.beta),
+    }
+
+
+def _reduced_claims():
+    """The reduced system (3.3) follows from the full one: d/dt of (gamma3, v_tau, w_n, w_tau)
+    along the full field minus the right-hand sides of (3.3)."""
+    g1, g2, g3 = S.gamma
+    s = s_sym
+    v_tau = (-g2 * S.v[0] + g1 * S.v[1]) / s
+    w_tau = (-g2 * S.w[0] + g1 * S.w[1]) / s
+    w_n = -(g1 * S.w[0] + g2 * S.w[1]) / s
+    M3 = S.I3 * S.w[2]
+    rho = S.I1 + S.m * (S.a3**2 + S.R**2 + 2 * S.a3 * S.R * g3)
+    k_ = S.R + S.a3 * g3
+    rhs = {
+        "gamma3": (g3, s * w_tau),
+        "v_tau": (v_tau, w_tau * w_n * k_ / s),
+        "w_n": (w_n, w_tau * (M3 / S.I1 + g3 * w_n / s)),
+        "w_tau": (w_tau, -(S.m * S.a3 * s * (S.g + S.R * w_tau**2) + M3 * w_n
+                          + S.I1 * g3 * w_n**2 / s + S.m * v_tau * w_n * k_ / s) / rho),
+    }  # fmt: skip
+    return rhs
+
+
+def invariant_measure_claim() -> tuple[bool, str]:
+    """div(rho * field) of the reduced system (3.3) vanishes identically (exact)."""
+    G, vt, wn, wt, M3 = sp.symbols("gamma3 v_tau w_n w_tau M3", real=True)
+    R, m, g, a3, I1 = S.R, S.m, S.g, S.a3, S.I1
+    s = sp.sqrt(1 - G**2)
+    rho = I1 + m * (a3**2 + R**2 + 2 * a3 * R * G)
+    k_ = R + a3 * G
+    field = [
+        s * wt,
+        wt * wn * k_ / s,
+        wt * (M3 / I1 + G * wn / s),
+        -(m * a3 * s * (g + R * wt**2) + M3 * wn + I1 * G * wn**2 / s + m * vt * wn * k_ / s) / rho,
+    ]
+    div = sum(sp.diff(rho * f, x) for f, x in zip(field, (G, vt, wn, wt), strict=True))
+    # gamma3 = (1 - q^2)/(1 + q^2) makes s = 2q/(1 + q^2) rational (q > 0)
+    div = div.subs(G, (1 - q**2) / (1 + q**2))
+    return sp.cancel(sp.together(sp.powdenest(sp.simplify(div), force=True))) == 0, (
+        "exact simplification"
+    )
+
+
+def claims_for(model: str) -> list[Claim]:
+    """The claims checked for ``model``."""
+    F = _integrals()
+    out = []
+    names = {
+        "meridian": ("energy", "lagrange", "jellett", "area", "F6"),
+        "smooth": ("energy", "lagrange", "jellett", "area", "momentum_x", "momentum_y"),
+        "rough": ("energy", "jellett", "routh^2"),
+    }[model]
+    for name in names:
+        label = "routh integral conserved (its square)" if name == "routh^2" else (
+            f"{name} integral conserved")  # fmt: skip
+        out.append(Claim(label, model, F[name]))
+    out.append(Claim("energy integral conserved, general body (I1 != I2)", model, F["energy"],
+                     symmetric=False))  # fmt: skip
+    if model == "meridian":
+        out.append(
+            Claim(
+                "identity jellett + a3 lagrange + R area = 0",
+                model,
+                F["jellett"] + S.a3 * F["lagrange"] + S.R * F["area"],
+                "identity",
+            )
+        )
+        for var, (expr, rhs) in _reduced_claims().items():
+            out.append(Claim(f"reduced system (3.3): {var}' follows from the full equations",
+                             model, (expr, rhs), "reduced"))  # fmt: skip
+    return out
+
+
+def check(claim: Claim, seed: int = 1) -> ClaimResult:
+    """Decide one claim."""
+    start = time.perf_counter()
+    d = derive(claim.model, claim.symmetric)
+    if claim.kind == "integral":
+        expr = _time_derivative(claim.expr, d.field)
+    elif claim.kind == "reduced":
+        lhs, rhs = claim.expr
+        expr = _time_derivative(lhs, d.field) - rhs
+    else:
+        expr = claim.expr
+    holds, method = decide(expr, claim.model, claim.symmetric, seed=seed)
+    return ClaimResult(claim.name, claim.model, "proved" if holds else "failed", method,
+                       time.perf_counter() - start)  # fmt: skip
+
+
+def verify(models=("meridian", "smooth", "rough")) -> list[ClaimResult]:
+    """Check every claim of ``models`` (and the invariant measure with the meridian model)."""
+    results = []
+    for model in models:
+        for claim in claims_for(model):
+            results.append(check(claim))
+        if model == "meridian":
+            start = time.perf_counter()
+            holds, method = invariant_measure_claim()
+            results.append(ClaimResult("invariant measure rho(gamma3) of the reduced system",
+                                       model, "proved" if holds else "failed", method,
+                                       time.perf_counter() - start))  # fmt: skip
+    return results

@@ -1,0 +1,114 @@
+"""Symbolic layer: the derived equations equal the compiled kernel; the claims are proved; a wrong
+claim fails; the discovery helper finds F6."""
+
+import json
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from rollingtop.dynamics import _kernel
+from rollingtop.symbolic import check, claims_for, discover_linear_integrals, rhs_function, verify
+from rollingtop.symbolic.claims import Claim, _integrals, s_sym, theta_sym
+from rollingtop.symbolic.equations import SYMBOLS
+
+from ..dynamics.test_kernel import random_body, random_state
+from ..test_cli import run_cli
+
+AGREE_RTOL = 1e-12  # issue 6: symbolic right-hand side vs compiled kernel
+CODES = {"meridian": 0, "smooth": 1, "rough": 2}
+
+
+@pytest.mark.parametrize("model", ["meridian", "smooth", "rough"])
+def test_derived_equations_match_the_kernel(model, rng):
+    general = rhs_function(model, symmetric=False)
+    symmetric = rhs_function(model, symmetric=True)
+    dy = np.empty(18)
+    ws = _kernel.new_workspace()
+    for _ in range(40):
+        body = random_body(rng)
+        y = random_state(rng, body, model)
+        _kernel.rhs(CODES[model], body.params, y, dy, ws)
+        got = np.array(general(body.params, y), dtype=float)
+        scale = np.max(np.abs(dy[:15]))
+        np.testing.assert_allclose(got, dy[:15], rtol=0, atol=AGREE_RTOL * scale)
+        # the symmetric derivation is the general one with I2 = I1
+        p = body.params.copy()
+        p[4] = p[5] = max(p[4], p[5])  # symmetric, triangle inequality kept
+        sym_body = type(body)(R=p[0], m=p[1], g=p[2], a3=p[3], I1=p[4], I3=p[6])
+        y = random_state(rng, sym_body, model)
+        _kernel.rhs(CODES[model], p, y, dy, ws)
+        got = np.array(symmetric(p, y), dtype=float)
+        np.testing.assert_allclose(got, dy[:15], rtol=0, atol=AGREE_RTOL * np.abs(dy).max())
+
+
+def test_every_claim_is_proved():
+    results = verify()
+    assert results and all(r.result == "proved" for r in results), [
+        r for r in results if r.result != "proved"
+    ]
+    names = " ".join(r.name for r in results)
+    for word in ("energy", "lagrange", "jellett", "area", "F6", "routh", "momentum_x",
+                 "momentum_y", "invariant measure"):  # fmt: skip
+        assert word in names
+
+
+def test_wrong_claims_fail():
+    F = _integrals()
+    S = SYMBOLS
+    perturbed = F["F6"] + sp.Rational(1, 10) * S.a3 * S.I3 * S.w[2] * theta_sym
+    for claim in (
+        Claim("F6 perturbed (a3 -> 1.1 a3 in its arccos term)", "meridian", perturbed),
+        Claim("lagrange integral, general body", "meridian", F["lagrange"], symmetric=False),
+        Claim("momentum_x integral on the meridian model", "meridian", F["momentum_x"]),
+        Claim("F6 integral on the rough model", "rough", F["F6"]),
+        Claim("identity with a wrong sign", "meridian",
+              F["jellett"] - S.a3 * F["lagrange"] + S.R * F["area"], "identity"),
+    ):  # fmt: skip
+        result = check(claim)
+        assert result.result == "failed", claim.name
+        assert result.method  # says which method decided
+
+
+def test_claims_are_not_vacuous_on_the_manifold():
+    """The manifold parametrisation keeps s = |e3 x gamma| consistent (rational, exact)."""
+    from rollingtop.symbolic.claims import _manifold
+
+    sub = _manifold("meridian")
+    g = [sub[x] for x in SYMBOLS.gamma]
+    assert sp.simplify(g[0] ** 2 + g[1] ** 2 + g[2] ** 2 - 1) == 0
+    assert sp.simplify(sub[s_sym] ** 2 - g[0] ** 2 - g[1] ** 2) == 0
+
+
+def test_discovery_finds_F6(rng):
+    found = discover_linear_integrals()
+    assert len(found.constants) == 3  # F6, the area integral and the Lagrange integral
+    assert found.coefficients["C"] == 0  # gravity forbids a w_tau term
+    f = sp.lambdify([found.q, *sp.symbols("v_tau w_n w_tau w3"), *SYMBOLS.params,
+                     *found.constants], found.integral)  # fmt: skip
+    for _ in range(5):
+        q = rng.uniform(0.1, 3)
+        theta = 2 * np.arctan(q)
+        g3, s = np.cos(theta), np.sin(theta)
+        vt, wn, wt, w3 = rng.normal(size=4)
+        R, m, g, a3, I1, I2, I3 = 1.2, 1.1, 0.9, 0.13, 0.3, 0.3, 0.5
+        F6 = I1 * (vt - (R * g3 + a3) * wn) - I3 * w3 * (R * s + a3 * theta)
+        got = complex(f(q, vt, wn, wt, w3, R, m, g, a3, I1, I2, I3, 1, 0, 0))
+        # C1 = 1 gives F6 / I1 up to a multiple of the Lagrange integral (a3 pi M3 / I1)
+        assert got.imag == pytest.approx(0, abs=1e-12)
+        assert got.real == pytest.approx(F6 / I1 + np.pi * a3 * I3 * w3 / I1, rel=1e-12)
+        area = g3 * I3 * w3 - I1 * s * wn
+        got2 = complex(f(q, vt, wn, wt, w3, R, m, g, a3, I1, I2, I3, 0, 1, 0)).real
+        assert got2 == pytest.approx(-(area + I3 * w3) / (2 * I1), rel=1e-12)
+
+
+def test_cli_verify(capsys):
+    code, out, err = run_cli(capsys, "verify", "--model", "rough", "--json")
+    assert code == 0, err
+    claims = json.loads(out)["claims"]
+    assert {c["model"] for c in claims} == {"rough"}
+    for c in claims:
+        assert set(c) == {"name", "model", "result", "method", "seconds"}
+        assert c["result"] == "proved"
+    assert any("routh" in c["name"] for c in claims)
+    assert len(claims_for("rough")) == len(claims)
