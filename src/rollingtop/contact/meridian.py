@@ -41,27 +41,25 @@ POLE_CASE_TOLERANCE = 1e-9
 RESYNC_S = 0.05
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def rows(p, y, J, bias, dirs):
-    """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``); returns their number, 2."""
-    normal_row(p, y, 0, J, bias, dirs)
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def nu_geometric(y):
+    """``nu = (e3 - gamma3 gamma)/s`` and its time derivative along the motion.
+
+    ``s = sqrt(gamma1^2 + gamma2^2)`` (free of cancellation near the poles) and
+    ``nu = (-gamma3 gamma1 / s, -gamma3 gamma2 / s, s)`` for ``|gamma| = 1``.
+    """
     w1, w2, w3 = y[3], y[4], y[5]
     g1, g2, g3 = y[12], y[13], y[14]
     gd1 = g2 * w3 - g3 * w2
     gd2 = g3 * w1 - g1 * w3
     gd3 = g1 * w2 - g2 * w1
-    # s = |horizontal part of e3| = sqrt(gamma1^2 + gamma2^2), free of cancellation near the poles;
-    # nu = (e3 - gamma3 gamma) / s = (-gamma3 gamma1 / s, -gamma3 gamma2 / s, s) for |gamma| = 1.
     s = math.sqrt(g1 * g1 + g2 * g2)
     sd = (g1 * gd1 + g2 * gd2) / s
     n1 = -g3 * g1 / s
     n2 = -g3 * g2 / s
-    n3 = s
     nd1 = -(gd3 * g1 + g3 * gd1) / s - n1 * sd / s
     nd2 = -(gd3 * g2 + g3 * gd2) / s - n2 * sd / s
-    nd3 = sd
-    contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
-    return 2
+    return n1, n2, s, nd1, nd2, sd
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
@@ -73,11 +71,10 @@ def psi_nu_rate(p, y, north):
     return M3 / (p[4] * (1.0 + y[14]))
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def rows_pole(p, y, J, bias, dirs, north):
-    """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu = cos(psi_nu) alpha +
-    sin(psi_nu) beta``; ``nu' = psi_nu' (gamma x nu) + nu x w``. Returns 2."""
-    normal_row(p, y, 0, J, bias, dirs)
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def nu_carried(p, y, north):
+    """Carried ``nu = cos(psi_nu) alpha + sin(psi_nu) beta`` (pole cases) and
+    ``nu' = psi_nu' (gamma x nu) + nu x w``."""
     c, s = math.cos(y[17]), math.sin(y[17])
     n1 = c * y[6] + s * y[9]
     n2 = c * y[7] + s * y[10]
@@ -88,6 +85,31 @@ def rows_pole(p, y, J, bias, dirs, north):
     nd1 = rate * (g2 * n3 - g3 * n2) + (n2 * w3 - n3 * w2)
     nd2 = rate * (g3 * n1 - g1 * n3) + (n3 * w1 - n1 * w3)
     nd3 = rate * (g1 * n2 - g2 * n1) + (n1 * w2 - n2 * w1)
+    return n1, n2, n3, nd1, nd2, nd3
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def nu_of(p, y, code):
+    """The constraint direction and its derivative for kernel ``code`` (geometric or carried)."""
+    if code == CODE:
+        return nu_geometric(y)
+    return nu_carried(p, y, code == NORTH_CODE)
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
+def rows(p, y, J, bias, dirs):
+    """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``); returns their number, 2."""
+    normal_row(p, y, 0, J, bias, dirs)
+    n1, n2, n3, nd1, nd2, nd3 = nu_geometric(y)
+    contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
+    return 2
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
+def rows_pole(p, y, J, bias, dirs, north):
+    """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu`` (:func:`nu_carried`). Returns 2."""
+    normal_row(p, y, 0, J, bias, dirs)
+    n1, n2, n3, nd1, nd2, nd3 = nu_carried(p, y, north)
     contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
     return 2
 

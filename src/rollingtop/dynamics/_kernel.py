@@ -11,6 +11,9 @@ and the constraint rows ``J u = 0`` of the contact model, differentiated along t
     (J M^-1 J^T) lambda = -bias - J M^-1 f
 
 (at most 4x4), solved here by an unrolled Cholesky factorisation: no allocation, no LAPACK call.
+For the models with one or two contact rows (smooth, meridian and its pole variants) the same
+equations are also written out in closed form (:func:`_rhs_contact`, a 1x1 or 2x2 solve in
+scalars), several times faster; the general row-based path serves every other model.
 Kinematics: ``alpha' = alpha x w``, ``beta' = beta x w``, ``gamma' = gamma x w``,
 ``X' = (v, alpha)``, ``Y' = (v, beta)`` (eq. 2.1).
 
@@ -84,6 +87,83 @@ def _solve_spd(n, A, x):
         x[i] = s / A[i, i]
 
 
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
+    """Closed form of :func:`rhs` for the normal row ``(vp, gamma) = 0`` plus, if ``two``, the
+    row ``(vp, n) = 0`` with ``n' = nd`` (meridian models): the same equations as the general
+    path, written out in scalars (a 1x1 or 2x2 solve), several times faster."""
+    R, m, g, a3, I1, I2, I3 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    v1, v2, v3 = y[0], y[1], y[2]
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
+    gd1 = g2 * w3 - g3 * w2
+    gd2 = g3 * w1 - g1 * w3
+    gd3 = g1 * w2 - g2 * w1
+    rd1, rd2, rd3 = -R * gd1, -R * gd2, -R * gd3
+    im, i1, i2, i3 = 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3
+    f1 = m * (v2 * w3 - v3 * w2) - m * g * g1
+    f2 = m * (v3 * w1 - v1 * w3) - m * g * g2
+    f3 = m * (v1 * w2 - v2 * w1) - m * g * g3
+    f4 = (I2 - I3) * w2 * w3
+    f5 = (I3 - I1) * w3 * w1
+    f6 = (I1 - I2) * w1 * w2
+    # row 1: d = gamma: J = (gamma, r x gamma), bias = (gamma', v) + (r' x gamma + r x gamma', w)
+    a1, a2, a3_ = r2 * g3 - r3 * g2, r3 * g1 - r1 * g3, r1 * g2 - r2 * g1
+    q1 = rd2 * g3 - rd3 * g2 + r2 * gd3 - r3 * gd2
+    q2 = rd3 * g1 - rd1 * g3 + r3 * gd1 - r1 * gd3
+    q3 = rd1 * g2 - rd2 * g1 + r1 * gd2 - r2 * gd1
+    bias1 = gd1 * v1 + gd2 * v2 + gd3 * v3 + q1 * w1 + q2 * w2 + q3 * w3
+    A11 = (g1 * g1 + g2 * g2 + g3 * g3) * im + a1 * a1 * i1 + a2 * a2 * i2 + a3_ * a3_ * i3
+    c1 = -bias1 - (g1 * f1 + g2 * f2 + g3 * f3) * im - (a1 * f4 * i1 + a2 * f5 * i2
+                                                        + a3_ * f6 * i3)  # fmt: skip
+    l2 = 0.0
+    b1 = b2 = b3 = 0.0
+    if two:
+        b1, b2, b3 = r2 * n3 - r3 * n2, r3 * n1 - r1 * n3, r1 * n2 - r2 * n1
+        q1 = rd2 * n3 - rd3 * n2 + r2 * nd3 - r3 * nd2
+        q2 = rd3 * n1 - rd1 * n3 + r3 * nd1 - r1 * nd3
+        q3 = rd1 * n2 - rd2 * n1 + r1 * nd2 - r2 * nd1
+        bias2 = nd1 * v1 + nd2 * v2 + nd3 * v3 + q1 * w1 + q2 * w2 + q3 * w3
+        A12 = (g1 * n1 + g2 * n2 + g3 * n3) * im + a1 * b1 * i1 + a2 * b2 * i2 + a3_ * b3 * i3
+        A22 = (n1 * n1 + n2 * n2 + n3 * n3) * im + b1 * b1 * i1 + b2 * b2 * i2 + b3 * b3 * i3
+        c2 = -bias2 - (n1 * f1 + n2 * f2 + n3 * f3) * im - (b1 * f4 * i1 + b2 * f5 * i2
+                                                            + b3 * f6 * i3)  # fmt: skip
+        det = A11 * A22 - A12 * A12
+        l1 = (c1 * A22 - c2 * A12) / det
+        l2 = (A11 * c2 - A12 * c1) / det
+    else:
+        l1 = c1 / A11
+    dy[0] = (f1 + l1 * g1 + l2 * n1) * im
+    dy[1] = (f2 + l1 * g2 + l2 * n2) * im
+    dy[2] = (f3 + l1 * g3 + l2 * n3) * im
+    dy[3] = (f4 + l1 * a1 + l2 * b1) * i1
+    dy[4] = (f5 + l1 * a2 + l2 * b2) * i2
+    dy[5] = (f6 + l1 * a3_ + l2 * b3) * i3
+    # what reaction() needs: force directions and multipliers
+    dirs, lam = ws[2], ws[4]
+    dirs[0, 0], dirs[0, 1], dirs[0, 2] = g1, g2, g3
+    dirs[1, 0], dirs[1, 1], dirs[1, 2] = n1, n2, n3
+    lam[0], lam[1] = l1, l2
+    return 2 if two else 1
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _kinematics(code, p, y, dy):
+    w1, w2, w3 = y[3], y[4], y[5]
+    for base in (6, 9, 12):
+        e1, e2, e3 = y[base], y[base + 1], y[base + 2]
+        dy[base] = e2 * w3 - e3 * w2
+        dy[base + 1] = e3 * w1 - e1 * w3
+        dy[base + 2] = e1 * w2 - e2 * w1
+    dy[15] = y[0] * y[6] + y[1] * y[7] + y[2] * y[8]
+    dy[16] = y[0] * y[9] + y[1] * y[10] + y[2] * y[11]
+    if code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE:
+        dy[17] = meridian.psi_nu_rate(p, y, code == meridian.NORTH_CODE)
+    else:
+        dy[17] = 0.0
+
+
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
 def rhs(code, p, y, dy, ws):
     """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
@@ -91,6 +171,17 @@ def rhs(code, p, y, dy, ws):
     After the call ``ws[4][:nrows]`` holds the multipliers ``lambda`` and ``ws[2]`` the force
     directions, from which :func:`reaction` forms the contact force.
     """
+    # closed forms for the models with one or two contact rows (the general path below serves
+    # any model and is what a new model needs; a closed form is an optional speed-up)
+    if code == smooth.CODE:
+        nc = _rhs_contact(p, y, dy, ws, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        _kinematics(code, p, y, dy)
+        return nc
+    if code == meridian.CODE or code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE:
+        n1, n2, n3, nd1, nd2, nd3 = meridian.nu_of(p, y, code)
+        nc = _rhs_contact(p, y, dy, ws, True, n1, n2, n3, nd1, nd2, nd3)
+        _kinematics(code, p, y, dy)
+        return nc
     J, bias, dirs, A, lam = ws
     nc = constraint_rows(code, p, y, J, bias, dirs)
     m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
@@ -123,18 +214,7 @@ def rhs(code, p, y, dy, ws):
         for i in range(nc):
             s += J[i, k] * lam[i]
         dy[k] = minv[k] * s
-    # frame kinematics: e' = e x w for e = alpha, beta, gamma
-    for base in (6, 9, 12):
-        e1, e2, e3 = y[base], y[base + 1], y[base + 2]
-        dy[base] = e2 * w3 - e3 * w2
-        dy[base + 1] = e3 * w1 - e1 * w3
-        dy[base + 2] = e1 * w2 - e2 * w1
-    dy[15] = v1 * y[6] + v2 * y[7] + v3 * y[8]
-    dy[16] = v1 * y[9] + v2 * y[10] + v3 * y[11]
-    if code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE:
-        dy[17] = meridian.psi_nu_rate(p, y, code == meridian.NORTH_CODE)
-    else:
-        dy[17] = 0.0
+    _kinematics(code, p, y, dy)
     return nc
 
 
@@ -242,6 +322,7 @@ def diagnostics(code, p, Y, out):
         out[n, 0] = N
         out[n, 1] = T
         J = ws[0]
+        constraint_rows(code, p, y, J, ws[1], ws[2])  # the closed-form rhs leaves J unset
         worst = 0.0
         for i in range(MAX_ROWS):
             r = 0.0

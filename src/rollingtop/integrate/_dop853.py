@@ -98,13 +98,15 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
 def _stage(K, s, y, h, ytmp):
-    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]``."""
+    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` (rows of K contiguous; zeros of A skipped)."""
     n = y.shape[0]
     for i in range(n):
-        acc = 0.0
-        for j in range(s):
-            acc += A[s, j] * K[j, i]
-        ytmp[i] = y[i] + h * acc
+        ytmp[i] = y[i]
+    for j in range(s):
+        c = h * A[s, j]
+        if c != 0.0:
+            for i in range(n):
+                ytmp[i] += c * K[j, i]
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
@@ -263,23 +265,31 @@ def run(
                 _stage(K, s, y, h, ytmp)
                 rhs(code, p, ytmp, K[s], ws)
             for i in range(n):
-                acc = 0.0
-                for j in range(12):
-                    acc += B[j] * K[j, i]
-                ynew[i] = y[i] + h * acc
+                ynew[i] = y[i]
+            for j in range(12):
+                c = h * B[j]
+                if c != 0.0:
+                    for i in range(n):
+                        ynew[i] += c * K[j, i]
             nc_new = rhs(code, p, ynew, K[12], ws)
             counts[NFEV] += 12
+            # error estimates sum_j E[j] K[j], accumulated row by row in Fd[0], Fd[1] (free
+            # until the dense output of an accepted step is prepared)
+            err5, err3 = Fd[0], Fd[1]
+            for i in range(n):
+                err5[i] = 0.0
+                err3[i] = 0.0
+            for j in range(13):
+                c5, c3 = E5[j], E3[j]
+                for i in range(n):
+                    err5[i] += c5 * K[j, i]
+                    err3[i] += c3 * K[j, i]
             e5 = 0.0
             e3 = 0.0
             for i in range(n):
                 sc = atol + max(abs(y[i]), abs(ynew[i])) * rtol
-                a5 = 0.0
-                a3 = 0.0
-                for j in range(13):
-                    a5 += E5[j] * K[j, i]
-                    a3 += E3[j] * K[j, i]
-                e5 += (a5 / sc) ** 2
-                e3 += (a3 / sc) ** 2
+                e5 += (err5[i] / sc) ** 2
+                e3 += (err3[i] / sc) ** 2
             if e5 == 0.0 and e3 == 0.0:
                 err = 0.0
             else:
