@@ -316,6 +316,23 @@ def _run_with_progress(run, sc, **kwargs):
     return result
 
 
+def _figure_scenario(scenario: str, output: str, **overrides):
+    """Check the figure's output path first (nothing runs for an unwritable one), then load."""
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES
+    from rollingtop.scenario import load_scenario
+
+    check_output_path(output, FIGURE_SUFFIXES)
+    return load_scenario(scenario).with_overrides(**overrides)
+
+
+def _save_figure(fig, output: str) -> None:
+    from rollingtop.plot import save_figure
+
+    save_figure(fig, output)
+    click.echo(f"wrote {output}")
+
+
 @cli.command()
 @click.argument("scenario", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", type=click.Path(), required=True, help="FIG.png, .svg or .pdf.")
@@ -330,23 +347,18 @@ def _run_with_progress(run, sc, **kwargs):
 def path(scenario, output, periods, t_end):
     """Contact-point and CoM paths on the plane, with the once-per-period points and, for a
     meridian orbit, the predicted circle (bounded) or drift."""
-    from rollingtop.io import check_output_path
-    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
     from rollingtop.plot.paths import path_figure
-    from rollingtop.scenario import load_scenario
     from rollingtop.simulate import simulate as run
 
-    check_output_path(output, FIGURE_SUFFIXES)
     if periods <= 0:
         raise click.UsageError(f"--periods {periods:g} must be > 0")
-    sc = load_scenario(scenario)
+    sc = _figure_scenario(scenario, output)
     pm = _meridian_map(sc)
     if t_end is None and pm is not None:
         t_end = periods * pm.period
     sc = sc.with_overrides(t_end=t_end, samples=max(2001, int(200 * periods)))
     traj = _run_with_progress(run, sc, events="w_tau", event_direction=1)
-    save_figure(path_figure(traj, pm), output)
-    click.echo(f"wrote {output}")
+    _save_figure(path_figure(traj, pm), output)
 
 
 @cli.command()
@@ -355,17 +367,11 @@ def path(scenario, output, periods, t_end):
 @click.option("--t-end", type=float, default=None, help="End time (overrides the scenario).")
 def plot(scenario, output, t_end):
     """Time series: gamma3, the integrals' drift and the contact reactions."""
-    from rollingtop.io import check_output_path
-    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
     from rollingtop.plot.paths import timeseries_figure
-    from rollingtop.scenario import load_scenario
     from rollingtop.simulate import simulate as run
 
-    check_output_path(output, FIGURE_SUFFIXES)
-    sc = load_scenario(scenario).with_overrides(t_end=t_end)
-    traj = _run_with_progress(run, sc)
-    save_figure(timeseries_figure(traj), output)
-    click.echo(f"wrote {output}")
+    sc = _figure_scenario(scenario, output, t_end=t_end)
+    _save_figure(timeseries_figure(_run_with_progress(run, sc)), output)
 
 
 @cli.command()
@@ -375,17 +381,12 @@ def plot(scenario, output, t_end):
 def compare(scenario, output, t_end):
     """The scenario's initial state under the meridian, smooth and rough models: paths and
     integrals overlaid (each model's state is the scenario's, projected on its constraints)."""
-    from rollingtop.io import check_output_path
-    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
     from rollingtop.plot.paths import compare_figure
-    from rollingtop.scenario import load_scenario
     from rollingtop.simulate import simulate_models
 
-    check_output_path(output, FIGURE_SUFFIXES)
-    sc = load_scenario(scenario).with_overrides(t_end=t_end)
+    sc = _figure_scenario(scenario, output, t_end=t_end)
     runs = _run_with_progress(lambda s, **kw: simulate_models(s), sc)
-    save_figure(compare_figure(runs), output)
-    click.echo(f"wrote {output}")
+    _save_figure(compare_figure(runs), output)
 
 
 @cli.command()

@@ -305,9 +305,7 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
     (n,) = lengths
     base = scenario.initial
     if base is None:
-        y0 = scenario.require_state()
-        base = InitialConditions(gamma=y0[12:15], omega=y0[3:6], alpha=y0[6:9], v=y0[0:3],
-                                 position=y0[15:17])  # fmt: skip
+        base = InitialConditions.from_state(scenario.require_state())
     from rollingtop.dynamics.state import initial_state
 
     states = np.empty((n, N_STATE))

@@ -136,6 +136,13 @@ class InitialConditions:
     v: tuple | None = None
     free: dict = field(default_factory=dict)
 
+    @classmethod
+    def from_state(cls, y) -> InitialConditions:
+        """The initial conditions that rebuild the state ``y`` (full velocity given)."""
+        y = np.asarray(y, dtype=float)
+        return cls(gamma=tuple(y[12:15]), omega=tuple(y[3:6]), alpha=tuple(y[6:9]),
+                   position=tuple(y[15:17]), v=tuple(y[0:3]))  # fmt: skip
+
     def state(self, body: SphericalTop, model: ContactModel) -> np.ndarray:
         """The constraint-consistent state vector, shape (17,)."""
         return initial_state(

@@ -119,9 +119,7 @@ def simulate_models(
     y0 = scenario.require_state()
     runs = {}
     for name in models:
-        y = project_state(scenario.body, name, y0)
-        ic = InitialConditions(gamma=y[12:15], omega=y[3:6], alpha=y[6:9], v=y[0:3],
-                               position=y[15:17])  # fmt: skip
+        ic = InitialConditions.from_state(project_state(scenario.body, name, y0))
         sc = replace(scenario, model=name, initial=ic, level=None)
         runs[name] = simulate(sc, **overrides)
     return runs

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import functools
 import json
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from rollingtop._json import finite_or_none
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, meridian
 from rollingtop.dynamics import _kernel
@@ -43,11 +43,6 @@ _UNITS = {
     "momentum_y": "M L T-1",
     "routh": "M L2 T-1",
 }
-
-
-def _finite_or_none(x: float) -> float | None:
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 @dataclass
@@ -236,8 +231,8 @@ class Trajectory:
                 "orthonormality_max_error": float(np.max(self.orthonormality_error)),
             },
             "reactions": {
-                "min_normal_force": _finite_or_none(min_normal),
-                "max_friction_ratio": _finite_or_none(max_ratio),
+                "min_normal_force": finite_or_none(min_normal),
+                "max_friction_ratio": finite_or_none(max_ratio),
                 "contact_lost_at": self.contact_lost_at,
             },
             "stats": {

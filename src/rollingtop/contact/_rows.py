@@ -10,6 +10,15 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def row_bias(y, r1, r2, r3, rd1, rd2, rd3, d1, d2, d3, dd1, dd2, dd3):
+    """``J' u = (d', v) + (r' x d + r x d', w)`` of the contact row along ``d``."""
+    q1 = rd2 * d3 - rd3 * d2 + r2 * dd3 - r3 * dd2
+    q2 = rd3 * d1 - rd1 * d3 + r3 * dd1 - r1 * dd3
+    q3 = rd1 * d2 - rd2 * d1 + r1 * dd2 - r2 * dd1
+    return dd1 * y[0] + dd2 * y[1] + dd3 * y[2] + q1 * y[3] + q2 * y[4] + q3 * y[5]
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     """Write row ``k`` for the no-slip condition ``(vp, d) = 0`` of the contact point.
 
@@ -19,7 +28,6 @@ def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     """
     R = p[0]
     a3 = p[3]
-    v1, v2, v3 = y[0], y[1], y[2]
     w1, w2, w3 = y[3], y[4], y[5]
     g1, g2, g3 = y[12], y[13], y[14]
     r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
@@ -33,11 +41,7 @@ def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     J[k, 3] = r2 * d3 - r3 * d2
     J[k, 4] = r3 * d1 - r1 * d3
     J[k, 5] = r1 * d2 - r2 * d1
-    # (r x d)' = r' x d + r x d'
-    q1 = rd2 * d3 - rd3 * d2 + r2 * dd3 - r3 * dd2
-    q2 = rd3 * d1 - rd1 * d3 + r3 * dd1 - r1 * dd3
-    q3 = rd1 * d2 - rd2 * d1 + r1 * dd2 - r2 * dd1
-    bias[k] = dd1 * v1 + dd2 * v2 + dd3 * v3 + q1 * w1 + q2 * w2 + q3 * w3
+    bias[k] = row_bias(y, r1, r2, r3, rd1, rd2, rd3, d1, d2, d3, dd1, dd2, dd3)
     dirs[k, 0] = d1
     dirs[k, 1] = d2
     dirs[k, 2] = d3

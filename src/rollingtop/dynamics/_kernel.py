@@ -28,11 +28,14 @@ import numpy as np
 from numba import njit
 
 from rollingtop.contact import meridian, rough, smooth
+from rollingtop.contact._rows import row_bias
 from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
 
 
+@njit(cache=True)
 def new_workspace():
-    """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels."""
+    """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels (callable from
+    Python and from compiled code)."""
     return (
         np.zeros((MAX_ROWS, 6)),
         np.zeros(MAX_ROWS),
@@ -110,10 +113,7 @@ def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
     f6 = (I1 - I2) * w1 * w2
     # row 1: d = gamma: J = (gamma, r x gamma), bias = (gamma', v) + (r' x gamma + r x gamma', w)
     a1, a2, a3_ = r2 * g3 - r3 * g2, r3 * g1 - r1 * g3, r1 * g2 - r2 * g1
-    q1 = rd2 * g3 - rd3 * g2 + r2 * gd3 - r3 * gd2
-    q2 = rd3 * g1 - rd1 * g3 + r3 * gd1 - r1 * gd3
-    q3 = rd1 * g2 - rd2 * g1 + r1 * gd2 - r2 * gd1
-    bias1 = gd1 * v1 + gd2 * v2 + gd3 * v3 + q1 * w1 + q2 * w2 + q3 * w3
+    bias1 = row_bias(y, r1, r2, r3, rd1, rd2, rd3, g1, g2, g3, gd1, gd2, gd3)
     A11 = (g1 * g1 + g2 * g2 + g3 * g3) * im + a1 * a1 * i1 + a2 * a2 * i2 + a3_ * a3_ * i3
     c1 = -bias1 - (g1 * f1 + g2 * f2 + g3 * f3) * im - (a1 * f4 * i1 + a2 * f5 * i2
                                                         + a3_ * f6 * i3)  # fmt: skip
@@ -121,10 +121,7 @@ def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
     b1 = b2 = b3 = 0.0
     if two:
         b1, b2, b3 = r2 * n3 - r3 * n2, r3 * n1 - r1 * n3, r1 * n2 - r2 * n1
-        q1 = rd2 * n3 - rd3 * n2 + r2 * nd3 - r3 * nd2
-        q2 = rd3 * n1 - rd1 * n3 + r3 * nd1 - r1 * nd3
-        q3 = rd1 * n2 - rd2 * n1 + r1 * nd2 - r2 * nd1
-        bias2 = nd1 * v1 + nd2 * v2 + nd3 * v3 + q1 * w1 + q2 * w2 + q3 * w3
+        bias2 = row_bias(y, r1, r2, r3, rd1, rd2, rd3, n1, n2, n3, nd1, nd2, nd3)
         A12 = (g1 * n1 + g2 * n2 + g3 * n3) * im + a1 * b1 * i1 + a2 * b2 * i2 + a3_ * b3 * i3
         A22 = (n1 * n1 + n2 * n2 + n3 * n3) * im + b1 * b1 * i1 + b2 * b2 * i2 + b3 * b3 * i3
         c2 = -bias2 - (n1 * f1 + n2 * f2 + n3 * f3) * im - (b1 * f4 * i1 + b2 * f5 * i2
@@ -307,13 +304,7 @@ def diagnostics(code, p, Y, out):
         Filled with: normal force, tangential force, max ``|J_k u|`` over the rows,
         max ``|Q Q^T - 1|``, then each row's residual ``J_k u`` (zero-padded to 4).
     """
-    ws = (
-        np.zeros((MAX_ROWS, 6)),
-        np.zeros(MAX_ROWS),
-        np.zeros((MAX_ROWS, 3)),
-        np.zeros((MAX_ROWS, MAX_ROWS)),
-        np.zeros(MAX_ROWS),
-    )
+    ws = new_workspace()
     dy = np.empty(N_STATE)
     for n in range(Y.shape[0]):
         y = Y[n]

@@ -15,8 +15,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from rollingtop.dynamics._kernel import reaction, rhs
-from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
+from rollingtop.dynamics._kernel import new_workspace, reaction, rhs
+from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
 
 __all__ = ["integrate_batch", "compile_ensemble"]
@@ -36,13 +36,7 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
     ytmp = np.zeros(n)
     y_old = np.zeros(n)
     Fd = np.zeros((7, n))
-    ws = (
-        np.zeros((MAX_ROWS, 6)),
-        np.zeros(MAX_ROWS),
-        np.zeros((MAX_ROWS, 3)),
-        np.zeros((MAX_ROWS, MAX_ROWS)),
-        np.zeros(MAX_ROWS),
-    )
+    ws = new_workspace()
     y = y0.copy()
     f = np.zeros(n)
     nc = rhs(code, p, y, f, ws)

@@ -24,6 +24,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from rollingtop._json import json_ready
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.steady import critical_points, steady_motion
 
@@ -72,11 +73,8 @@ class Orbit:
     note: str = ""
 
     def to_dict(self) -> dict:
-        """JSON-ready dict (``inf``/NaN become ``None``)."""
-        return {
-            k: (v if not isinstance(v, float) or math.isfinite(v) else None)
-            for k, v in asdict(self).items()
-        }
+        """JSON-ready dict (non-finite values become ``None``)."""
+        return json_ready(asdict(self))
 
 
 #: Gauss-Legendre rule for the energy gap near the turning points (see :func:`_gap`).

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from rollingtop._json import json_ready
 from rollingtop.reduction.level import LevelSet
 
 __all__ = ["SteadyMotion", "steady_motions", "critical_points"]
@@ -70,10 +71,7 @@ class SteadyMotion:
 
     def to_dict(self) -> dict:
         """JSON-ready dict (non-finite values become ``None``)."""
-        return {
-            k: (v if not isinstance(v, float) or math.isfinite(v) else None)
-            for k, v in asdict(self).items()
-        }
+        return json_ready(asdict(self))
 
 
 def _grid(level: LevelSet) -> np.ndarray:
