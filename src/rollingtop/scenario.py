@@ -144,7 +144,7 @@ class InitialConditions:
                    position=tuple(y[15:17]), v=tuple(y[0:3]))  # fmt: skip
 
     def state(self, body: SphericalTop, model: ContactModel) -> np.ndarray:
-        """The constraint-consistent state vector, shape (17,)."""
+        """The constraint-consistent state vector, shape (18,)."""
         return initial_state(
             body,
             model,
