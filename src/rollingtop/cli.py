@@ -29,7 +29,7 @@ def cli() -> None:
     """Rolling spherical tops under nonholonomic constraints (Kilin & Ivanova 2023)."""
 
 
-def _progress_bar(t_end: float):
+def _progress_bar():
     """A rich progress bar on stderr when it is a terminal, else ``None``."""
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -302,7 +302,7 @@ def _meridian_map(sc):
 
 
 def _run_with_progress(run, sc, **kwargs):
-    bar = _progress_bar(sc.integration.t_end)
+    bar = _progress_bar()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ContactLostWarning)
         if bar is None:

@@ -46,6 +46,7 @@ EV_CODE, EV_DIRECTION = 0, 1
 MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 0, 1, 2, 3, 4, 5
 
 
+@njit(cache=True)
 def new_track():
     """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
     the normal force at the last accepted step."""
@@ -94,6 +95,26 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
     else:
         h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, t_end - t0)
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"})
+def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
+    """Prepare a run from ``y`` at ``t_eval[0]``: derivative ``f``, reaction tracking, initial
+    step, the first sample ``out[0]``. Returns ``(ctrl, counts, track)`` for :func:`run`."""
+    nc = rhs(code, p, y, f, ws)
+    track = new_track()
+    N0, T0 = reaction(nc, y, ws)
+    update_track(track, t_eval[0], N0, T0)
+    track[LAST_NORMAL] = N0
+    t0, t_end = t_eval[0], t_eval[-1]
+    h0 = initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ynew, ws)
+    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y)])
+    counts = np.zeros(5, dtype=np.int64)
+    counts[NFEV] = 2
+    for i in range(y.shape[0]):
+        out[0, i] = y[i]
+    counts[NEXT_SAMPLE] = 1
+    return ctrl, counts, track
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})

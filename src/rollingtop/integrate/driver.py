@@ -10,7 +10,7 @@ import numpy as np
 
 from rollingtop._errors import IntegrationError
 from rollingtop.dynamics import _kernel
-from rollingtop.dynamics._events import EVENTS, event_value
+from rollingtop.dynamics._events import EVENTS
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
 
@@ -104,18 +104,9 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
     ev_y = np.full((capacity, N_STATE), np.nan)
     y = y0.copy()
     f = np.zeros(N_STATE)
-    nc = _kernel.rhs(code, p, y, f, w["ws"])
-    track = dop.new_track()
-    N0, T0 = _kernel.reaction(nc, y, w["ws"])
-    dop.update_track(track, t_eval[0], N0, T0)
-    track[dop.LAST_NORMAL] = N0
-    t0, t_end = float(t_eval[0]), float(t_eval[-1])
-    h0 = dop.initial_step(code, p, y, f, t_end, t0, rtol, atol, w["ytmp"], w["ynew"], w["ws"])
-    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y)])
-    counts = np.zeros(5, dtype=np.int64)
-    counts[dop.NFEV] = 2
-    w["out"][0] = y
-    counts[dop.NEXT_SAMPLE] = 1
+    ctrl, counts, track = dop.start(code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
+                                    w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
+    t_end = float(t_eval[-1])
     budget = PROGRESS_CHUNK if progress is not None else (max_steps or 2**62)
     start = time.perf_counter()
     while True:

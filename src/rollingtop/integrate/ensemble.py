@@ -7,7 +7,6 @@ when asked for.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 
@@ -15,7 +14,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from rollingtop.dynamics._kernel import new_workspace, reaction, rhs
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
 
@@ -39,19 +38,7 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
     ws = new_workspace()
     y = y0.copy()
     f = np.zeros(n)
-    nc = rhs(code, p, y, f, ws)
-    track = np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
-    N0, T0 = reaction(nc, y, ws)
-    dop.update_track(track, t_eval[0], N0, T0)
-    track[dop.LAST_NORMAL] = N0
-    t0, t_end = t_eval[0], t_eval[-1]
-    h0 = dop.initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ynew, ws)
-    ctrl = np.array([t0, h0, t_end, rtol, atol, 1.0])
-    counts = np.zeros(5, dtype=np.int64)
-    counts[dop.NFEV] = 2
-    for i in range(n):
-        out[0, i] = y[i]
-    counts[dop.NEXT_SAMPLE] = 1
+    ctrl, counts, track = dop.start(code, p, y, f, t_eval, rtol, atol, 0, out, ytmp, ynew, ws)
     ev_spec = np.zeros(2, dtype=np.int64)
     ev_t = np.zeros(1)
     ev_y = np.zeros((1, n))
@@ -154,6 +141,4 @@ def integrate_batch(
         wall = time.perf_counter() - start
     finally:
         numba.set_num_threads(previous)
-    if not math.isfinite(wall):  # pragma: no cover - defensive
-        wall = float("nan")
     return out, final, stats, wall
