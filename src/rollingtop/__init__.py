@@ -5,6 +5,7 @@ Dynamically Symmetric Spherical Top with One Nonholonomic Constraint", Russian J
 Nonlinear Dynamics 19(1), 2023, 3-17 (doi:10.20537/nd221205), and its neighbour contact models.
 """
 
+from rollingtop import _kernel_cache  # noqa: F401  (first: refreshes numba's kernel cache)
 from rollingtop._errors import (
     BodyError,
     ContactLostWarning,

@@ -96,7 +96,7 @@ def nu_of(p, y, code):
     return nu_carried(p, y, code == NORTH_CODE)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def rows(p, y, J, bias, dirs):
     """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``); returns their number, 2."""
     normal_row(p, y, 0, J, bias, dirs)
@@ -105,7 +105,7 @@ def rows(p, y, J, bias, dirs):
     return 2
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def rows_pole(p, y, J, bias, dirs, north):
     """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu`` (:func:`nu_carried`). Returns 2."""
     normal_row(p, y, 0, J, bias, dirs)

@@ -13,7 +13,7 @@ from rollingtop.contact._rows import contact_row
 CODE = 2
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def rows(p, y, J, bias, dirs):
     """Constraint rows ``(vp, e1) = (vp, e2) = (vp, e3) = 0``; returns 3."""
     contact_row(p, y, 0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, J, bias, dirs)

@@ -9,7 +9,7 @@ from rollingtop.contact._rows import normal_row
 CODE = 1
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def rows(p, y, J, bias, dirs):
     """Constraint row ``f1``; returns 1."""
     normal_row(p, y, 0, J, bias, dirs)

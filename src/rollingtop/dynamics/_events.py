@@ -20,7 +20,7 @@ W_TAU = 1
 EVENTS = {"w_tau": W_TAU}
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def event_value(code, model_code, y):
     """Value of event function ``code`` at state ``y`` under kernel ``model_code``."""
     if code == W_TAU:

@@ -20,6 +20,12 @@ Kinematics: ``alpha' = alpha x w``, ``beta' = beta x w``, ``gamma' = gamma x w``
 All functions take bare arrays (state ``y`` of :mod:`._layout`, parameters
 ``p = (R, m, g, a3, I1, I2, I3)``) and preallocated work arrays ``ws = (J, bias, dirs, A, lam)``
 of shapes ``(4, 6), (4,), (4, 3), (4, 4), (4,)``.
+
+The kernels called at every stage allocate nothing and are compiled with ``_nrt=False`` (numba's
+flag, used the same way in numba's own string kernels): with numba's reference counting on,
+every call increments and decrements each array argument's count atomically, which cost more
+than the arithmetic -- the whole stepper ran about twice as slow (``benchmarks/``). Such a
+function must not allocate or return arrays; the test suite compiles each of them.
 """
 
 import math
@@ -45,7 +51,7 @@ def new_workspace():
     )
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def constraint_rows(code, p, y, J, bias, dirs):
     """Fill the contact model's rows ``J``, their ``bias = J' u`` and force directions ``dirs``.
 
@@ -161,7 +167,7 @@ def _kinematics(code, p, y, dy):
         dy[17] = 0.0
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def rhs(code, p, y, dy, ws):
     """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
 
@@ -215,7 +221,7 @@ def rhs(code, p, y, dy, ws):
     return nc
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def reaction(nc, y, ws):
     """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` (last :func:`rhs`).
 
@@ -247,7 +253,39 @@ def _sync_psi_nu(code, y):
     y[17] = psi + period * round((y[17] - psi) / period)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _project_contact(p, y, two, n1, n2, n3):
+    """Closed form of the velocity projection of :func:`project` for the normal row and, if
+    ``two``, the row along ``n`` (the rows of :func:`_rhs_contact`; a 1x1 or 2x2 solve)."""
+    R, m, a3, I1, I2, I3 = p[0], p[1], p[3], p[4], p[5], p[6]
+    im, i1, i2, i3 = 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3
+    v1, v2, v3, w1, w2, w3 = y[0], y[1], y[2], y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
+    a1, a2, a3_ = r2 * g3 - r3 * g2, r3 * g1 - r1 * g3, r1 * g2 - r2 * g1
+    c1 = g1 * v1 + g2 * v2 + g3 * v3 + a1 * w1 + a2 * w2 + a3_ * w3
+    A11 = (g1 * g1 + g2 * g2 + g3 * g3) * im + a1 * a1 * i1 + a2 * a2 * i2 + a3_ * a3_ * i3
+    l2 = 0.0
+    b1 = b2 = b3 = 0.0
+    if two:
+        b1, b2, b3 = r2 * n3 - r3 * n2, r3 * n1 - r1 * n3, r1 * n2 - r2 * n1
+        c2 = n1 * v1 + n2 * v2 + n3 * v3 + b1 * w1 + b2 * w2 + b3 * w3
+        A12 = (g1 * n1 + g2 * n2 + g3 * n3) * im + a1 * b1 * i1 + a2 * b2 * i2 + a3_ * b3 * i3
+        A22 = (n1 * n1 + n2 * n2 + n3 * n3) * im + b1 * b1 * i1 + b2 * b2 * i2 + b3 * b3 * i3
+        det = A11 * A22 - A12 * A12
+        l1 = (c1 * A22 - c2 * A12) / det
+        l2 = (A11 * c2 - A12 * c1) / det
+    else:
+        l1 = c1 / A11
+    y[0] = v1 - (l1 * g1 + l2 * n1) * im
+    y[1] = v2 - (l1 * g2 + l2 * n2) * im
+    y[2] = v3 - (l1 * g3 + l2 * n3) * im
+    y[3] = w1 - (l1 * a1 + l2 * b1) * i1
+    y[4] = w2 - (l1 * a2 + l2 * b2) * i2
+    y[5] = w3 - (l1 * a3_ + l2 * b3) * i3
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def project(code, p, y, ws):
     """Project ``y`` in place onto the constraint manifold.
 
@@ -271,6 +309,13 @@ def project(code, p, y, ws):
         y[9 + c] = 1.5 * b - 0.5 * (G01 * a + G11 * b + G12 * g)
         y[12 + c] = 1.5 * g - 0.5 * (G02 * a + G12 * b + G22 * g)
     _sync_psi_nu(code, y)
+    if code == smooth.CODE:
+        _project_contact(p, y, False, 0.0, 0.0, 0.0)
+        return
+    if code == meridian.CODE or code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE:
+        n1, n2, n3, _, _, _ = meridian.nu_of(p, y, code)
+        _project_contact(p, y, True, n1, n2, n3)
+        return
     nc = constraint_rows(code, p, y, J, bias, dirs)
     m, I1, I2, I3 = p[1], p[4], p[5], p[6]
     minv = (1.0 / m, 1.0 / m, 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3)

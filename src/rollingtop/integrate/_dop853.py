@@ -13,7 +13,10 @@ stepper per thread in parallel ensembles. Neither library exposes an after-step 
 numbalsoda's LSODA/DOP853 wrappers offer no dense output or events; the method itself is short.
 
 Everything here takes bare arrays and runs in numba's nopython mode; see
-:func:`rollingtop.integrate.driver.integrate` for the validated entry point.
+:func:`rollingtop.integrate.driver.integrate` for the validated entry point. The stepping
+functions allocate nothing and are compiled without reference counting (``_nrt=False``; see
+:mod:`rollingtop.dynamics._kernel` for why); the stages come from generated code
+(:mod:`._dop853_stages`).
 """
 
 import math
@@ -23,7 +26,8 @@ from numba import njit
 
 from rollingtop.dynamics._events import event_value
 from rollingtop.dynamics._kernel import project, reaction, rhs
-from rollingtop.integrate._dop853_tableau import E3, E5, A, B, D
+from rollingtop.integrate._dop853_stages import stage
+from rollingtop.integrate._dop853_tableau import E3, E5, B, D
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -53,7 +57,7 @@ def new_track():
     return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def update_track(track, t, N, T_force):
     """Fold one evaluation of the contact force into ``track``."""
     if N < track[MIN_NORMAL]:
@@ -117,25 +121,12 @@ def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
     return ctrl, counts, track
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _stage(K, s, y, h, ytmp):
-    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` (rows of K contiguous; zeros of A skipped)."""
-    n = y.shape[0]
-    for i in range(n):
-        ytmp[i] = y[i]
-    for j in range(s):
-        c = h * A[s, j]
-        if c != 0.0:
-            for i in range(n):
-                ytmp[i] += c * K[j, i]
-
-
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
     """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
     n = y.shape[0]
     for s in range(13, 16):
-        _stage(K, s, y, h, ytmp)
+        stage(K, s, y, h, ytmp)
         rhs(code, p, ytmp, K[s], ws)
     for i in range(n):
         dlt = ynew[i] - y[i]
@@ -149,7 +140,7 @@ def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
             Fd[3 + r, i] = h * acc
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def _dense_eval(Fd, y, x, out):
     """State at the fraction ``x`` of the step: ``y + sum`` of the interpolant's terms."""
     for i in range(y.shape[0]):
@@ -160,11 +151,11 @@ def _dense_eval(Fd, y, x, out):
         out[i] = y[i] + acc
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+def _normal_root(code, p, Fd, y, t, h, ytmp, dy, ws):
     """Time in ``[t, t + h]`` where the normal force crosses zero, by bisection on the dense
-    output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings."""
-    dy = np.empty(y.shape[0])
+    output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings.
+    ``ytmp`` and ``dy`` are scratch."""
     lo, hi = 0.0, 1.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
@@ -179,7 +170,7 @@ def _normal_root(code, p, Fd, y, t, h, ytmp, ws):
     return t + 0.5 * (lo + hi) * h
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
     output (60 halvings: to the resolution of the interpolant)."""
@@ -197,7 +188,7 @@ def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def run(
     code,
     p,
@@ -283,34 +274,28 @@ def run(
             for i in range(n):
                 K[0, i] = f[i]
             for s in range(1, 12):
-                _stage(K, s, y, h, ytmp)
+                stage(K, s, y, h, ytmp)
                 rhs(code, p, ytmp, K[s], ws)
+            # new point (needs K[0..11]) ...
             for i in range(n):
-                ynew[i] = y[i]
-            for j in range(12):
-                c = h * B[j]
-                if c != 0.0:
-                    for i in range(n):
-                        ynew[i] += c * K[j, i]
+                acc = 0.0
+                for j in range(12):
+                    acc += B[j] * K[j, i]
+                ynew[i] = y[i] + h * acc
             nc_new = rhs(code, p, ynew, K[12], ws)
             counts[NFEV] += 12
-            # error estimates sum_j E[j] K[j], accumulated row by row in Fd[0], Fd[1] (free
-            # until the dense output of an accepted step is prepared)
-            err5, err3 = Fd[0], Fd[1]
-            for i in range(n):
-                err5[i] = 0.0
-                err3[i] = 0.0
-            for j in range(13):
-                c5, c3 = E5[j], E3[j]
-                for i in range(n):
-                    err5[i] += c5 * K[j, i]
-                    err3[i] += c3 * K[j, i]
+            # ... and the 5th- and 3rd-order error estimates sum_j E[j] K[j] (K[12] included)
             e5 = 0.0
             e3 = 0.0
             for i in range(n):
+                a5 = 0.0
+                a3 = 0.0
+                for j in range(13):
+                    a5 += E5[j] * K[j, i]
+                    a3 += E3[j] * K[j, i]
                 sc = atol + max(abs(y[i]), abs(ynew[i])) * rtol
-                e5 += (err5[i] / sc) ** 2
-                e3 += (err3[i] / sc) ** 2
+                e5 += (a5 / sc) ** 2
+                e3 += (a3 / sc) ** 2
             if e5 == 0.0 and e3 == 0.0:
                 err = 0.0
             else:
@@ -361,7 +346,7 @@ def run(
                 _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
                 counts[NFEV] += 3
                 dense_ready = True
-            track[T_CONTACT_LOST] = _normal_root(code, p, Fd, y_old, t, h, ytmp, ws)
+            track[T_CONTACT_LOST] = _normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
             counts[NFEV] += 60
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)

@@ -1,0 +1,77 @@
+"""Keep numba's on-disk cache of the compiled kernels in step with their sources.
+
+numba invalidates a cached function when *its own* source file changes, not when a compiled
+function it calls from another module does: after an edit of ``dynamics/_kernel.py`` alone, the
+cached stepper of ``integrate/_dop853.py`` would go on running the old right-hand side, silently.
+An installed copy is safe (installing rewrites every file, so every cache entry goes stale), but
+an editable install is not. So on import a digest of every kernel source is compared with the
+one stored beside the cache, and on a mismatch all cached kernels are dropped (they are
+recompiled on first use, about 20 s).
+
+numba offers no hook for this (its cache locators stamp one file each), hence this module.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent
+#: Subpackages whose modules are compiled into (or frozen as constants into) the kernels.
+KERNEL_PACKAGES = ("contact", "dynamics", "integrate")
+STAMP_NAME = "rollingtop-kernels.sha256"
+
+
+def sources_digest(root: Path = ROOT) -> str:
+    """SHA-256 over the relative paths and contents of every kernel source file."""
+    digest = hashlib.sha256()
+    for package in KERNEL_PACKAGES:
+        for path in sorted((root / package).rglob("*.py")):
+            digest.update(path.relative_to(root).as_posix().encode())
+            digest.update(b"\0")
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _cache_dirs(root: Path) -> list[Path]:
+    """Where numba keeps the kernels' cache files: ``__pycache__`` beside each source, or under
+    ``NUMBA_CACHE_DIR`` (mirroring the source path) when that is set."""
+    sources = [root / package for package in KERNEL_PACKAGES]
+    sources += [d for s in list(sources) for d in s.rglob("*") if d.is_dir()]
+    dirs = [d / "__pycache__" for d in sources if d.name != "__pycache__"]
+    user_dir = os.environ.get("NUMBA_CACHE_DIR")
+    if user_dir:
+        dirs += [Path(user_dir) / d.relative_to(d.anchor) for d in sources]
+    return dirs
+
+
+def refresh(root: Path = ROOT) -> bool:
+    """Drop the cached kernels if any kernel source changed since they were cached.
+
+    Returns True when cache files were dropped. Never raises for file-system reasons (a
+    read-only install leaves everything as it is: numba then keeps its cache elsewhere and an
+    installed copy does not change).
+    """
+    try:
+        digest = sources_digest(root)
+        stamp = root / "__pycache__" / STAMP_NAME
+        if stamp.is_file() and stamp.read_text().strip() == digest:
+            return False
+        dropped = False
+        for directory in _cache_dirs(root):
+            if directory.is_dir():
+                for entry in directory.iterdir():
+                    if entry.suffix in (".nbi", ".nbc"):
+                        entry.unlink(missing_ok=True)
+                        dropped = True
+        stamp.parent.mkdir(exist_ok=True)
+        tmp = stamp.with_name(f"{STAMP_NAME}.{os.getpid()}.tmp")
+        tmp.write_text(digest + "\n")
+        os.replace(tmp, stamp)
+        return dropped
+    except OSError:
+        return False
+
+
+refresh()  # on import of the package, before any kernel is loaded from the cache

@@ -1,0 +1,62 @@
+"""Stale numba cache entries are dropped when any kernel source changes."""
+
+from rollingtop import _kernel_cache
+
+
+def _tree(tmp_path):
+    for package in _kernel_cache.KERNEL_PACKAGES:
+        (tmp_path / package / "__pycache__").mkdir(parents=True)
+        (tmp_path / package / "mod.py").write_text(f"# {package}\n")
+    (tmp_path / "cli.py").write_text("# not a kernel\n")
+    return tmp_path
+
+
+def _cache_files(root):
+    return sorted(p.name for p in root.rglob("*") if p.suffix in (".nbi", ".nbc"))
+
+
+def _fill_cache(root):
+    for package in _kernel_cache.KERNEL_PACKAGES:
+        (root / package / "__pycache__" / "mod.run-10.py311.nbi").write_bytes(b"index")
+        (root / package / "__pycache__" / "mod.run-10.py311.1.nbc").write_bytes(b"code")
+        (root / package / "__pycache__" / "mod.cpython-311.pyc").write_bytes(b"pyc")
+
+
+def test_cache_kept_while_sources_unchanged_and_dropped_after_an_edit(tmp_path, monkeypatch):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    root = _tree(tmp_path)
+    _kernel_cache.refresh(root)  # first run: writes the stamp
+    _fill_cache(root)
+    assert not _kernel_cache.refresh(root)
+    assert len(_cache_files(root)) == 6
+    # an edit outside the kernels keeps the cache ...
+    (root / "cli.py").write_text("# edited\n")
+    assert not _kernel_cache.refresh(root)
+    assert len(_cache_files(root)) == 6
+    # ... an edit of any kernel module drops every cached kernel, not only that module's
+    (root / "dynamics" / "mod.py").write_text("# dynamics, edited\n")
+    assert _kernel_cache.refresh(root)
+    assert _cache_files(root) == []
+    assert (root / "integrate" / "__pycache__" / "mod.cpython-311.pyc").is_file()
+    _fill_cache(root)
+    assert not _kernel_cache.refresh(root)
+
+
+def test_user_cache_dir_is_cleaned_too(tmp_path, monkeypatch):
+    root = _tree(tmp_path / "pkg")
+    user = tmp_path / "numba-cache"
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(user))
+    _kernel_cache.refresh(root)
+    mirrored = user / (root / "integrate").relative_to((root / "integrate").anchor)
+    mirrored.mkdir(parents=True)
+    (mirrored / "mod.run-10.py311.nbi").write_bytes(b"index")
+    (root / "contact" / "mod.py").write_text("# edited\n")
+    assert _kernel_cache.refresh(root)
+    assert not any(mirrored.iterdir())
+
+
+def test_digest_covers_paths_and_contents(tmp_path):
+    root = _tree(tmp_path)
+    first = _kernel_cache.sources_digest(root)
+    (root / "contact" / "mod.py").rename(root / "contact" / "other.py")
+    assert _kernel_cache.sources_digest(root) != first
