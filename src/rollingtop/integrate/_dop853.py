@@ -26,8 +26,8 @@ from numba import njit
 
 from rollingtop.dynamics._events import event_value
 from rollingtop.dynamics._kernel import project, reaction, rhs
-from rollingtop.integrate._dop853_stages import stage
-from rollingtop.integrate._dop853_tableau import E3, E5, B, D
+from rollingtop.integrate._dop853_stages import scaled_errors, stage
+from rollingtop.integrate._dop853_tableau import D
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -276,26 +276,19 @@ def run(
             for s in range(1, 12):
                 stage(K, s, y, h, ytmp)
                 rhs(code, p, ytmp, K[s], ws)
-            # new point (needs K[0..11]) ...
-            for i in range(n):
-                acc = 0.0
-                for j in range(12):
-                    acc += B[j] * K[j, i]
-                ynew[i] = y[i] + h * acc
+            # new point: the 13th stage's combination is the solution's (first same as last)
+            stage(K, 12, y, h, ynew)
             nc_new = rhs(code, p, ynew, K[12], ws)
             counts[NFEV] += 12
-            # ... and the 5th- and 3rd-order error estimates sum_j E[j] K[j] (K[12] included)
+            # 5th- and 3rd-order error estimates, in Fd[0] and Fd[1] (free until the dense output
+            # of an accepted step is prepared)
+            err5, err3 = Fd[0], Fd[1]
+            scaled_errors(K, y, ynew, rtol, atol, err5, err3)
             e5 = 0.0
             e3 = 0.0
             for i in range(n):
-                a5 = 0.0
-                a3 = 0.0
-                for j in range(13):
-                    a5 += E5[j] * K[j, i]
-                    a3 += E3[j] * K[j, i]
-                sc = atol + max(abs(y[i]), abs(ynew[i])) * rtol
-                e5 += (a5 / sc) ** 2
-                e3 += (a3 / sc) ** 2
+                e5 += err5[i] * err5[i]
+                e3 += err3[i] * err3[i]
             if e5 == 0.0 and e3 == 0.0:
                 err = 0.0
             else:

@@ -12,12 +12,12 @@ this generator and the tableau.
 
 from pathlib import Path
 
-from rollingtop.integrate._dop853_tableau import N_STAGES_EXTENDED, A
+from rollingtop.integrate._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A
 
 TARGET = Path(__file__).with_name("_dop853_stages.py")
 LINE_LENGTH = 100
 
-HEADER = '''"""DOP853 stages with their coefficients spelled out (GENERATED: do not edit).
+HEADER = '''"""DOP853 stages and error estimates, coefficients spelled out (GENERATED: do not edit).
 
 Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 :mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
@@ -26,7 +26,7 @@ Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 from numba import njit
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def stage(K, s, y, h, ytmp):
     """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
 
@@ -47,25 +47,57 @@ def stage(K, s, y, h, ytmp):
 '''
 
 
+ERROR_FUNCTION = '''
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+def scaled_errors(K, y, ynew, rtol, atol, err5, err3):
+    """``sum_j E[j] K[j]`` (the 5th- and 3rd-order error estimates over the step size) divided
+    by the scale ``atol + max(|y|, |ynew|) rtol``, component by component.
+
+    Parameters
+    ----------
+    K : ndarray, shape (16, n)
+        Stage derivatives; rows ``0 .. 11`` are read.
+    y, ynew : ndarray, shape (n,)
+        State at the start and at the end of the step.
+    rtol, atol : float
+        Tolerances.
+    err5, err3 : ndarray, shape (n,)
+        Output.
+    """
+    for i in range(y.shape[0]):
+        sc = atol + max(abs(y[i]), abs(ynew[i])) * rtol
+'''
+
+
+def _combination(coefficients, lhs: str, head: str, tail: str) -> list[str]:
+    """``lhs = head(c0 * K[0, i] + ...)tail`` with zero terms left out, laid out as
+    ``ruff format`` would lay it out."""
+    parts = []
+    for j, c in enumerate(coefficients):
+        c = float(c)
+        if c == 0.0:
+            continue
+        sign = ("- " if c < 0 else "+ ") if parts else ("-" if c < 0 else "")
+        parts.append(f"{sign}{abs(c)!r} * K[{j}, i]")
+    one_line = f"{lhs} = {head}{' '.join(parts)}){tail}"
+    if len(one_line) <= LINE_LENGTH:
+        return [one_line]
+    indent = " " * (len(lhs) - len(lhs.lstrip()) + 4)
+    return [f"{lhs} = {head}", *(indent + part for part in parts), f"{indent[:-4]}){tail}"]
+
+
 def render() -> str:
     """Source of the generated module."""
     lines = [HEADER.rstrip("\n")]
     for s in range(1, N_STAGES_EXTENDED):
-        terms = [(float(A[s, j]), j) for j in range(s) if A[s, j] != 0.0]
         keyword = "if" if s == 1 else "elif"
         lines.append(f"    {keyword} s == {s}:")
         lines.append("        for i in range(n):")
-        parts = []
-        for k, (a, j) in enumerate(terms):
-            sign = ("- " if a < 0 else "+ ") if k else ("-" if a < 0 else "")
-            parts.append(f"{sign}{abs(a)!r} * K[{j}, i]")
-        one_line = f"            ytmp[i] = y[i] + h * ({' '.join(parts)})"
-        if len(one_line) <= LINE_LENGTH:  # the layout ``ruff format`` would choose
-            lines.append(one_line)
-        else:
-            lines.append("            ytmp[i] = y[i] + h * (")
-            lines.extend(f"                {part}" for part in parts)
-            lines.append("            )")
+        lines += _combination(A[s, :s], "            ytmp[i]", "y[i] + h * (", "")
+    lines += ERROR_FUNCTION.rstrip("\n").split("\n")
+    lines += _combination(E5, "        err5[i]", "(", " / sc")
+    lines += _combination(E3, "        err3[i]", "(", " / sc")
     return "\n".join(lines) + "\n"
 
 

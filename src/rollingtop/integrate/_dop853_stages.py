@@ -1,4 +1,4 @@
-"""DOP853 stages with their coefficients spelled out (GENERATED: do not edit).
+"""DOP853 stages and error estimates, coefficients spelled out (GENERATED: do not edit).
 
 Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 :mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
@@ -7,7 +7,7 @@ Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 from numba import njit
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def stage(K, s, y, h, ytmp):
     """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
 
@@ -159,3 +159,43 @@ def stage(K, s, y, h, ytmp):
                 + 2.9475147891527724 * K[13, i]
                 - 9.15095847217987 * K[14, i]
             )
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+def scaled_errors(K, y, ynew, rtol, atol, err5, err3):
+    """``sum_j E[j] K[j]`` (the 5th- and 3rd-order error estimates over the step size) divided
+    by the scale ``atol + max(|y|, |ynew|) rtol``, component by component.
+
+    Parameters
+    ----------
+    K : ndarray, shape (16, n)
+        Stage derivatives; rows ``0 .. 11`` are read.
+    y, ynew : ndarray, shape (n,)
+        State at the start and at the end of the step.
+    rtol, atol : float
+        Tolerances.
+    err5, err3 : ndarray, shape (n,)
+        Output.
+    """
+    for i in range(y.shape[0]):
+        sc = atol + max(abs(y[i]), abs(ynew[i])) * rtol
+        err5[i] = (
+            0.01312004499419488 * K[0, i]
+            - 1.2251564463762044 * K[5, i]
+            - 0.4957589496572502 * K[6, i]
+            + 1.6643771824549864 * K[7, i]
+            - 0.35032884874997366 * K[8, i]
+            + 0.3341791187130175 * K[9, i]
+            + 0.08192320648511571 * K[10, i]
+            - 0.022355307863886294 * K[11, i]
+        ) / sc
+        err3[i] = (
+            -0.18980075407240762 * K[0, i]
+            + 4.450312892752409 * K[5, i]
+            + 1.8915178993145003 * K[6, i]
+            - 5.801203960010585 * K[7, i]
+            - 0.4226823213237919 * K[8, i]
+            - 0.1521609496625161 * K[9, i]
+            + 0.20136540080403034 * K[10, i]
+            + 0.02265179219836082 * K[11, i]
+        ) / sc
