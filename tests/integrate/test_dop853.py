@@ -170,3 +170,19 @@ def test_events_on_w_tau_are_turning_points_of_gamma3():
     np.testing.assert_allclose(traj.event_t, sol.t_events[0], rtol=0, atol=1e-9)
     both = simulate(sc, events="w_tau")
     assert len(both.event_t) in (19, 20, 21)
+
+
+def test_event_capacity_keeps_the_first_events_and_counts_the_rest():
+    sc = scenario(t_end=30.0, rtol=1e-10)
+    p = sc.body.params
+    t_eval = np.array([0.0, 30.0])
+    full = integrate(0, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau", event_direction=1)
+    assert len(full.event_t) == 10 and full.events_dropped == 0
+    capped = integrate(0, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau",
+                       event_direction=1, max_events=3)  # fmt: skip
+    assert capped.events_dropped == 7
+    np.testing.assert_array_equal(capped.event_t, full.event_t[:3])
+    np.testing.assert_array_equal(capped.event_y, full.event_y[:3])
+    none = integrate(0, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12)
+    assert none.event_t.shape == (0,) and none.event_y.shape == (0, 18)
+    assert none.events_dropped == 0

@@ -100,8 +100,9 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
     w = _workspace(n)
     ev_code, ev_direction, capacity = event
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
-    ev_t = np.full(capacity, np.nan)
-    ev_y = np.full((capacity, N_STATE), np.nan)
+    # np.empty: the pages of a large capacity are touched only by events actually found
+    ev_t = np.empty(capacity)
+    ev_y = np.empty((capacity, N_STATE))
     y = y0.copy()
     f = np.zeros(N_STATE)
     ctrl, counts, track = dop.start(code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
@@ -155,7 +156,7 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
         )
     found = int(counts[dop.N_EVENTS])
     kept = min(found, capacity)
-    return w["out"], counts, track, wall, (ev_t[:kept], ev_y[:kept], found - kept)
+    return w["out"], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
 
 
 def integrate(
@@ -210,7 +211,7 @@ def integrate(
         raise ValueError(f"unknown event {events!r} (known: {', '.join(EVENTS)})")
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
-    event = (EVENTS[events] if events else 0, event_direction, max(int(max_events), 1))
+    event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
     compile_s = compile_kernels()
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
