@@ -1,6 +1,7 @@
 """rollingtop benchmarks: side-by-side timings against scipy.integrate.solve_ivp.
 
-Run:  python benchmarks/run_benchmarks.py [--quick] [--out benchmarks/results.json]
+Run:  python benchmarks/run_benchmarks.py [--quick] [--readme] [--only W1,W2,W3,cold_start]
+                                          [--out benchmarks/results.json]
 
 W1  one long trajectory (paper's body, examples/paper.toml, t = 1e4, rtol 1e-10, atol 1e-12):
     rollingtop vs solve_ivp(DOP853) with a plain NumPy right-hand side and with rollingtop's
@@ -183,8 +184,10 @@ def w1(t_end, repeat, numpy_repeat):
 
 
 def w2(n, t_end, repeat):
-    """1- and 2-thread runs alternate (this VM's speed drifts by tens of per cent over minutes:
-    alternating exposes both to the same drift); medians of ``repeat`` runs each."""
+    """1- and 2-thread runs alternate and the efficiency is the median over those pairs: this VM's
+    speed drifts by tens of per cent over minutes, and adjacent runs see the same drift. The
+    process CPU time tells idle threads (load imbalance: CPU time well below threads x wall) from
+    threads that were busy but ran slower (a host that shares or down-clocks its cores)."""
     import numba
 
     import rollingtop as rt
@@ -198,24 +201,29 @@ def w2(n, t_end, repeat):
     out = {"n": len(states), "t_end": t_end, "rtol": 1e-10, "atol": 1e-12,
            "threads_available": numba.config.NUMBA_NUM_THREADS, "repeat": repeat}  # fmt: skip
     times = {1: [], 2: []}
+    busy = {1: [], 2: []}
     for _ in range(repeat):
         for threads in (1, 2):
+            cpu = time.process_time()
             res = rt.simulate_ensemble(sc.body, "meridian", states, t_end=t_end, rtol=1e-10,
                                        atol=1e-12, threads=threads)  # fmt: skip
+            cpu = time.process_time() - cpu
             times[threads].append(res.wall_time_s)
+            busy[threads].append(cpu / (threads * res.wall_time_s))
             print(f"  W2 {threads} thread(s): {res.wall_time_s:.1f} s", flush=True)
     for threads in (1, 2):
         wall = statistics.median(times[threads])
         out[f"threads_{threads}"] = {
             "wall_s": wall,
             "times": times[threads],
+            "busy_fraction": statistics.median(busy[threads]),
             "trajectories_per_s": len(states) / wall,
             "steps_total": int(res.steps.sum()),
             "failed": int(np.sum(res.status != 0)),
         }
-    r1 = out["threads_1"]["trajectories_per_s"]
-    r2 = out["threads_2"]["trajectories_per_s"]
-    out["parallel_efficiency_2"] = r2 / (2 * r1)
+    pairs = [a / (2 * b) for a, b in zip(times[1], times[2], strict=True)]
+    out["parallel_efficiency_pairs"] = pairs
+    out["parallel_efficiency_2"] = statistics.median(pairs)
     return out
 
 
@@ -277,7 +285,10 @@ def table(res) -> str:
         "|---|---|---|",
         f"| 1 thread | {w2['threads_1']['wall_s']:.1f} | {w2['threads_1']['trajectories_per_s']:.0f} |",
         f"| 2 threads | {w2['threads_2']['wall_s']:.1f} | {w2['threads_2']['trajectories_per_s']:.0f} |",
-        f"| parallel efficiency | | {100 * w2['parallel_efficiency_2']:.0f} % |",
+        f"| parallel efficiency (median of {len(w2['parallel_efficiency_pairs'])} paired runs; range) | | "
+        f"{100 * w2['parallel_efficiency_2']:.0f} % ({100 * min(w2['parallel_efficiency_pairs']):.0f}-"
+        f"{100 * max(w2['parallel_efficiency_pairs']):.0f} %) |",
+        f"| 2 threads busy (process CPU time / (2 x wall)) | | {100 * w2['threads_2']['busy_fraction']:.0f} % |",
     ]  # fmt: skip
     w3r = res["W3"]
     rows += [
@@ -334,6 +345,11 @@ def main() -> None:
         metavar="FILE",
         help="do not measure: (re)write the README block from saved results",
     )
+    ap.add_argument(
+        "--only",
+        metavar="PARTS",
+        help="comma-separated subset of W1,W2,W3,cold_start to measure; the rest is kept from --out",
+    )
     args = ap.parse_args()
     if args.from_json:
         res = json.loads(Path(args.from_json).read_text())
@@ -341,17 +357,28 @@ def main() -> None:
         write_readme(res, ROOT / "README.md")
         return
     quick = args.quick
-    res = {"machine": machine(), "quick": quick,
-           "date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}  # fmt: skip
+    parts = {"W2", "W3", "cold_start", "W1"}
+    only = set(args.only.split(",")) if args.only else parts
+    if only - parts:
+        raise SystemExit(f"--only: unknown part(s) {', '.join(sorted(only - parts))}")
+    res = {}
+    if only != parts:  # keep the other parts of the saved results
+        res = json.loads(Path(args.out).read_text())
+    res |= {"machine": machine(), "quick": quick,
+            "date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}  # fmt: skip
     # W2 first: the parallel measurement wants otherwise idle cores
-    print("W2 ...", flush=True)
-    res["W2"] = w2(400 if quick else 10_000, 100.0, 1 if quick else 3)
-    print("W3 ...", flush=True)
-    res["W3"] = w3(20.0 if quick else 100.0)
-    print("cold start ...", flush=True)
-    res["cold_start"] = cold_start()
-    print("W1 ...", flush=True)
-    res["W1"] = w1(1e3 if quick else 1e4, 3 if quick else 5, 1)
+    if "W2" in only:
+        print("W2 ...", flush=True)
+        res["W2"] = w2(400 if quick else 10_000, 100.0, 1 if quick else 5)
+    if "W3" in only:
+        print("W3 ...", flush=True)
+        res["W3"] = w3(20.0 if quick else 100.0)
+    if "cold_start" in only:
+        print("cold start ...", flush=True)
+        res["cold_start"] = cold_start()
+    if "W1" in only:
+        print("W1 ...", flush=True)
+        res["W1"] = w1(1e3 if quick else 1e4, 3 if quick else 5, 1)
     res["table_markdown"] = table(res)
     Path(args.out).write_text(json.dumps(res, indent=2))
     print(res["table_markdown"])
