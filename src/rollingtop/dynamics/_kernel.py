@@ -10,10 +10,12 @@ and the constraint rows ``J u = 0`` of the contact model, differentiated along t
 
     (J M^-1 J^T) lambda = -bias - J M^-1 f
 
-(at most 4x4), solved here by an unrolled Cholesky factorisation: no allocation, no LAPACK call.
-For the models with one or two contact rows (smooth, meridian and its pole variants) the same
-equations are also written out in closed form (:func:`_rhs_contact`, a 1x1 or 2x2 solve in
-scalars), several times faster; the general row-based path serves every other model.
+(at most 4x4). The general path (:func:`rhs_rows`) fills the model's rows and solves it by a
+small Cholesky factorisation: no allocation, no LAPACK call; it serves any model and is what a
+new model needs. Every present model also has the same equations written out in closed form,
+several times faster: smooth and meridian (with its pole variants) in :func:`_rhs_contact` (a
+1x1 or 2x2 solve in scalars), rough in :func:`_rhs_rough` (3x3); the tests hold each closed
+form, and the closed-form projections, to the general path.
 Kinematics: ``alpha' = alpha x w``, ``beta' = beta x w``, ``gamma' = gamma x w``,
 ``X' = (v, alpha)``, ``Y' = (v, beta)`` (eq. 2.1).
 
@@ -152,6 +154,82 @@ def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _rough_matrix(p, r1, r2, r3):
+    """``A = J M^-1 J^T`` of the rough model's rows ``J_k = (e_k, r x e_k)`` (lower triangle):
+    ``A = 1/m + sum_j (r x e_k)_j (r x e_l)_j / I_j`` with ``r x e1 = (0, r3, -r2)``,
+    ``r x e2 = (-r3, 0, r1)``, ``r x e3 = (r2, -r1, 0)``."""
+    im, i1, i2, i3 = 1.0 / p[1], 1.0 / p[4], 1.0 / p[5], 1.0 / p[6]
+    A11 = im + r3 * r3 * i2 + r2 * r2 * i3
+    A22 = im + r3 * r3 * i1 + r1 * r1 * i3
+    A33 = im + r2 * r2 * i1 + r1 * r1 * i2
+    A21 = -r1 * r2 * i3
+    A31 = -r1 * r3 * i2
+    A32 = -r2 * r3 * i1
+    return A11, A21, A22, A31, A32, A33
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _solve3(A11, A21, A22, A31, A32, A33, b1, b2, b3):
+    """``A^-1 b`` for a 3x3 SPD ``A`` (lower triangle) by Cholesky, in scalars."""
+    L11 = math.sqrt(A11)
+    L21 = A21 / L11
+    L31 = A31 / L11
+    L22 = math.sqrt(A22 - L21 * L21)
+    L32 = (A32 - L31 * L21) / L22
+    L33 = math.sqrt(A33 - L31 * L31 - L32 * L32)
+    z1 = b1 / L11
+    z2 = (b2 - L21 * z1) / L22
+    z3 = (b3 - L31 * z1 - L32 * z2) / L33
+    x3 = z3 / L33
+    x2 = (z2 - L32 * x3) / L22
+    x1 = (z1 - L21 * x2 - L31 * x3) / L11
+    return x1, x2, x3
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _rhs_rough(p, y, dy, ws):
+    """Closed form of :func:`rhs` for the rough model (rows ``(vp, e_k) = 0``, see
+    :mod:`rollingtop.contact.rough`): with ``J u = vp = v + w x r`` the multipliers are the
+    contact force ``lambda`` itself, ``A lambda = -w x r' - f_v / m - (I^-1 f_w) x r`` (the
+    bias of row ``k`` is ``(r' x e_k, w) = (w x r')_k``), then ``m v' = f_v + lambda`` and
+    ``I w' = f_w + r x lambda``."""
+    R, m, g, a3, I1, I2, I3 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    v1, v2, v3 = y[0], y[1], y[2]
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
+    rd1 = -R * (g2 * w3 - g3 * w2)
+    rd2 = -R * (g3 * w1 - g1 * w3)
+    rd3 = -R * (g1 * w2 - g2 * w1)
+    im, i1, i2, i3 = 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3
+    f1 = m * (v2 * w3 - v3 * w2) - m * g * g1
+    f2 = m * (v3 * w1 - v1 * w3) - m * g * g2
+    f3 = m * (v1 * w2 - v2 * w1) - m * g * g3
+    f4 = (I2 - I3) * w2 * w3
+    f5 = (I3 - I1) * w3 * w1
+    f6 = (I1 - I2) * w1 * w2
+    q1, q2, q3 = f4 * i1, f5 * i2, f6 * i3  # I^-1 f_w
+    c1 = -(w2 * rd3 - w3 * rd2) - f1 * im - (q2 * r3 - q3 * r2)
+    c2 = -(w3 * rd1 - w1 * rd3) - f2 * im - (q3 * r1 - q1 * r3)
+    c3 = -(w1 * rd2 - w2 * rd1) - f3 * im - (q1 * r2 - q2 * r1)
+    A11, A21, A22, A31, A32, A33 = _rough_matrix(p, r1, r2, r3)
+    l1, l2, l3 = _solve3(A11, A21, A22, A31, A32, A33, c1, c2, c3)
+    dy[0] = (f1 + l1) * im
+    dy[1] = (f2 + l2) * im
+    dy[2] = (f3 + l3) * im
+    dy[3] = (f4 + r2 * l3 - r3 * l2) * i1
+    dy[4] = (f5 + r3 * l1 - r1 * l3) * i2
+    dy[5] = (f6 + r1 * l2 - r2 * l1) * i3
+    # what reaction() needs: the force directions are the body axes
+    dirs, lam = ws[2], ws[4]
+    for k in range(3):
+        for c in range(3):
+            dirs[k, c] = 1.0 if k == c else 0.0
+    lam[0], lam[1], lam[2] = l1, l2, l3
+    return 3
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def _kinematics(code, p, y, dy):
     w1, w2, w3 = y[3], y[4], y[5]
     for base in (6, 9, 12):
@@ -174,8 +252,8 @@ def rhs(code, p, y, dy, ws):
     After the call ``ws[4][:nrows]`` holds the multipliers ``lambda`` and ``ws[2]`` the force
     directions, from which :func:`reaction` forms the contact force.
     """
-    # closed forms for the models with one or two contact rows (the general path below serves
-    # any model and is what a new model needs; a closed form is an optional speed-up)
+    # closed forms of every model (the general path, rhs_rows, serves any model and is what a
+    # new model needs; a closed form is an optional speed-up)
     if code == smooth.CODE:
         nc = _rhs_contact(p, y, dy, ws, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         _kinematics(code, p, y, dy)
@@ -185,6 +263,18 @@ def rhs(code, p, y, dy, ws):
         nc = _rhs_contact(p, y, dy, ws, True, n1, n2, n3, nd1, nd2, nd3)
         _kinematics(code, p, y, dy)
         return nc
+    if code == rough.CODE:
+        nc = _rhs_rough(p, y, dy, ws)
+        _kinematics(code, p, y, dy)
+        return nc
+    return rhs_rows(code, p, y, dy, ws)
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+def rhs_rows(code, p, y, dy, ws):
+    """:func:`rhs` by the general path: the model's rows from :func:`constraint_rows` and the
+    small SPD system solved by Cholesky. Every model has it; the tests hold the closed forms of
+    :func:`rhs` to it."""
     J, bias, dirs, A, lam = ws
     nc = constraint_rows(code, p, y, J, bias, dirs)
     m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
@@ -285,6 +375,27 @@ def _project_contact(p, y, two, n1, n2, n3):
     y[5] = w3 - (l1 * a3_ + l2 * b3) * i3
 
 
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _project_rough(p, y):
+    """Closed form of the velocity projection of :func:`project` for the rough model:
+    ``lambda = A^-1 vp``, ``v <- v - lambda / m``, ``w <- w - I^-1 (r x lambda)``."""
+    R, m, a3 = p[0], p[1], p[3]
+    g1, g2, g3 = y[12], y[13], y[14]
+    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
+    w1, w2, w3 = y[3], y[4], y[5]
+    c1 = y[0] + w2 * r3 - w3 * r2
+    c2 = y[1] + w3 * r1 - w1 * r3
+    c3 = y[2] + w1 * r2 - w2 * r1
+    A11, A21, A22, A31, A32, A33 = _rough_matrix(p, r1, r2, r3)
+    l1, l2, l3 = _solve3(A11, A21, A22, A31, A32, A33, c1, c2, c3)
+    y[0] -= l1 / m
+    y[1] -= l2 / m
+    y[2] -= l3 / m
+    y[3] -= (r2 * l3 - r3 * l2) / p[4]
+    y[4] -= (r3 * l1 - r1 * l3) / p[5]
+    y[5] -= (r1 * l2 - r2 * l1) / p[6]
+
+
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
 def project(code, p, y, ws):
     """Project ``y`` in place onto the constraint manifold.
@@ -295,7 +406,6 @@ def project(code, p, y, ws):
     (see :mod:`rollingtop.contact.meridian`). The velocity ``u`` then goes to the nearest point,
     in the kinetic-energy metric, of ``J u = 0``: ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
     """
-    J, bias, dirs, A, lam = ws
     # Q Q^T (rows alpha, beta, gamma at offsets 6, 9, 12)
     G00 = y[6] * y[6] + y[7] * y[7] + y[8] * y[8]
     G11 = y[9] * y[9] + y[10] * y[10] + y[11] * y[11]
@@ -316,6 +426,17 @@ def project(code, p, y, ws):
         n1, n2, n3, _, _, _ = meridian.nu_of(p, y, code)
         _project_contact(p, y, True, n1, n2, n3)
         return
+    if code == rough.CODE:
+        _project_rough(p, y)
+        return
+    project_velocity_rows(code, p, y, ws)
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+def project_velocity_rows(code, p, y, ws):
+    """The velocity part of :func:`project` by the general path (rows and a Cholesky solve);
+    the tests hold the closed forms to it."""
+    J, bias, dirs, A, lam = ws
     nc = constraint_rows(code, p, y, J, bias, dirs)
     m, I1, I2, I3 = p[1], p[4], p[5], p[6]
     minv = (1.0 / m, 1.0 / m, 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3)
