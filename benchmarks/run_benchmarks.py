@@ -312,10 +312,15 @@ README_END = "<!-- benchmark-results:end -->"
 def readme_block(res) -> str:
     """The machine, the date and the tables, for the README."""
     m = res["machine"]
+    dates = res.get("dates", {})
+    if len(set(dates.values())) > 1:
+        when = "measured " + ", ".join(f"{part} {dates[part]}" for part in sorted(dates))
+    else:
+        when = res["date"]
     return (
         f"Measured on {m['cpu']}, {m['cores']} cores, Python {m['python']}, numpy {m['numpy']}, "
-        f"scipy {m['scipy']}, numba {m['numba']}, {res['date']} (medians of repeated runs; the "
-        "NumPy baseline runs once):\n\n" + res["table_markdown"]
+        f"scipy {m['scipy']}, numba {m['numba']}; {when} (medians of repeated runs; the NumPy "
+        "baseline runs once):\n\n" + res["table_markdown"]
     )
 
 
@@ -364,8 +369,9 @@ def main() -> None:
     res = {}
     if only != parts:  # keep the other parts of the saved results
         res = json.loads(Path(args.out).read_text())
-    res |= {"machine": machine(), "quick": quick,
-            "date": time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())}  # fmt: skip
+    now = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())
+    res |= {"machine": machine(), "quick": quick, "date": now}
+    res.setdefault("dates", {}).update({part: now for part in only})
     # W2 first: the parallel measurement wants otherwise idle cores
     if "W2" in only:
         print("W2 ...", flush=True)
