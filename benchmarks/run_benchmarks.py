@@ -314,7 +314,7 @@ def readme_block(res) -> str:
     m = res["machine"]
     dates = res.get("dates", {})
     if len(set(dates.values())) > 1:
-        when = "measured " + ", ".join(f"{part} {dates[part]}" for part in sorted(dates))
+        when = ", ".join(f"{part} measured {dates[part]}" for part in sorted(dates))
     else:
         when = res["date"]
     return (

@@ -19,6 +19,23 @@ def row_bias(y, r1, r2, r3, rd1, rd2, rd3, d1, d2, d3, dd1, dd2, dd3):
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def contact_arm_rate(p, y):
+    """Contact arm ``r = -R gamma - a`` and its rate ``r' = -R gamma'``, ``gamma' = gamma x w``
+    (paper eq. 2.1), as six scalars."""
+    R, a3 = p[0], p[3]
+    w1, w2, w3 = y[3], y[4], y[5]
+    g1, g2, g3 = y[12], y[13], y[14]
+    return (
+        -R * g1,
+        -R * g2,
+        -R * g3 - a3,
+        -R * (g2 * w3 - g3 * w2),
+        -R * (g3 * w1 - g1 * w3),
+        -R * (g1 * w2 - g2 * w1),
+    )
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     """Write row ``k`` for the no-slip condition ``(vp, d) = 0`` of the contact point.
 
@@ -26,15 +43,7 @@ def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     force ``lambda d`` applied at the contact point. ``(dd1, dd2, dd3)`` is ``d'`` along the
     motion; ``r' = -R gamma'`` and ``gamma' = gamma x w`` (paper eq. 2.1).
     """
-    R = p[0]
-    a3 = p[3]
-    w1, w2, w3 = y[3], y[4], y[5]
-    g1, g2, g3 = y[12], y[13], y[14]
-    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
-    # r' = -R (gamma x w)
-    rd1 = -R * (g2 * w3 - g3 * w2)
-    rd2 = -R * (g3 * w1 - g1 * w3)
-    rd3 = -R * (g1 * w2 - g2 * w1)
+    r1, r2, r3, rd1, rd2, rd3 = contact_arm_rate(p, y)
     J[k, 0] = d1
     J[k, 1] = d2
     J[k, 2] = d3

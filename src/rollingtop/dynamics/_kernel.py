@@ -36,7 +36,7 @@ import numpy as np
 from numba import njit
 
 from rollingtop.contact import meridian, rough, smooth
-from rollingtop.contact._rows import row_bias
+from rollingtop.contact._rows import contact_arm_rate, row_bias
 from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
 
 
@@ -99,26 +99,34 @@ def _solve_spd(n, A, x):
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+def _free_forces(p, y):
+    """The free forces ``f = (m v x w - m g gamma, (I w) x w)`` as six scalars."""
+    m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
+    v1, v2, v3 = y[0], y[1], y[2]
+    w1, w2, w3 = y[3], y[4], y[5]
+    return (
+        m * (v2 * w3 - v3 * w2) - m * g * y[12],
+        m * (v3 * w1 - v1 * w3) - m * g * y[13],
+        m * (v1 * w2 - v2 * w1) - m * g * y[14],
+        (I2 - I3) * w2 * w3,
+        (I3 - I1) * w3 * w1,
+        (I1 - I2) * w1 * w2,
+    )
+
+
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
     """Closed form of :func:`rhs` for the normal row ``(vp, gamma) = 0`` plus, if ``two``, the
     row ``(vp, n) = 0`` with ``n' = nd`` (meridian models): the same equations as the general
     path, written out in scalars (a 1x1 or 2x2 solve), several times faster."""
-    R, m, g, a3, I1, I2, I3 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
-    v1, v2, v3 = y[0], y[1], y[2]
     w1, w2, w3 = y[3], y[4], y[5]
     g1, g2, g3 = y[12], y[13], y[14]
-    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
     gd1 = g2 * w3 - g3 * w2
     gd2 = g3 * w1 - g1 * w3
     gd3 = g1 * w2 - g2 * w1
-    rd1, rd2, rd3 = -R * gd1, -R * gd2, -R * gd3
-    im, i1, i2, i3 = 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3
-    f1 = m * (v2 * w3 - v3 * w2) - m * g * g1
-    f2 = m * (v3 * w1 - v1 * w3) - m * g * g2
-    f3 = m * (v1 * w2 - v2 * w1) - m * g * g3
-    f4 = (I2 - I3) * w2 * w3
-    f5 = (I3 - I1) * w3 * w1
-    f6 = (I1 - I2) * w1 * w2
+    r1, r2, r3, rd1, rd2, rd3 = contact_arm_rate(p, y)
+    im, i1, i2, i3 = 1.0 / p[1], 1.0 / p[4], 1.0 / p[5], 1.0 / p[6]
+    f1, f2, f3, f4, f5, f6 = _free_forces(p, y)
     # row 1: d = gamma: J = (gamma, r x gamma), bias = (gamma', v) + (r' x gamma + r x gamma', w)
     a1, a2, a3_ = r2 * g3 - r3 * g2, r3 * g1 - r1 * g3, r1 * g2 - r2 * g1
     bias1 = row_bias(y, r1, r2, r3, rd1, rd2, rd3, g1, g2, g3, gd1, gd2, gd3)
@@ -193,21 +201,10 @@ def _rhs_rough(p, y, dy, ws):
     contact force ``lambda`` itself, ``A lambda = -w x r' - f_v / m - (I^-1 f_w) x r`` (the
     bias of row ``k`` is ``(r' x e_k, w) = (w x r')_k``), then ``m v' = f_v + lambda`` and
     ``I w' = f_w + r x lambda``."""
-    R, m, g, a3, I1, I2, I3 = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
-    v1, v2, v3 = y[0], y[1], y[2]
     w1, w2, w3 = y[3], y[4], y[5]
-    g1, g2, g3 = y[12], y[13], y[14]
-    r1, r2, r3 = -R * g1, -R * g2, -R * g3 - a3
-    rd1 = -R * (g2 * w3 - g3 * w2)
-    rd2 = -R * (g3 * w1 - g1 * w3)
-    rd3 = -R * (g1 * w2 - g2 * w1)
-    im, i1, i2, i3 = 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3
-    f1 = m * (v2 * w3 - v3 * w2) - m * g * g1
-    f2 = m * (v3 * w1 - v1 * w3) - m * g * g2
-    f3 = m * (v1 * w2 - v2 * w1) - m * g * g3
-    f4 = (I2 - I3) * w2 * w3
-    f5 = (I3 - I1) * w3 * w1
-    f6 = (I1 - I2) * w1 * w2
+    r1, r2, r3, rd1, rd2, rd3 = contact_arm_rate(p, y)
+    im, i1, i2, i3 = 1.0 / p[1], 1.0 / p[4], 1.0 / p[5], 1.0 / p[6]
+    f1, f2, f3, f4, f5, f6 = _free_forces(p, y)
     q1, q2, q3 = f4 * i1, f5 * i2, f6 * i3  # I^-1 f_w
     c1 = -(w2 * rd3 - w3 * rd2) - f1 * im - (q2 * r3 - q3 * r2)
     c2 = -(w3 * rd1 - w1 * rd3) - f2 * im - (q3 * r1 - q1 * r3)
@@ -277,19 +274,8 @@ def rhs_rows(code, p, y, dy, ws):
     :func:`rhs` to it."""
     J, bias, dirs, A, lam = ws
     nc = constraint_rows(code, p, y, J, bias, dirs)
-    m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
-    v1, v2, v3 = y[0], y[1], y[2]
-    w1, w2, w3 = y[3], y[4], y[5]
-    g1, g2, g3 = y[12], y[13], y[14]
-    # free forces: m v x w - m g gamma and (I w) x w
-    f = (
-        m * (v2 * w3 - v3 * w2) - m * g * g1,
-        m * (v3 * w1 - v1 * w3) - m * g * g2,
-        m * (v1 * w2 - v2 * w1) - m * g * g3,
-        (I2 - I3) * w2 * w3,
-        (I3 - I1) * w3 * w1,
-        (I1 - I2) * w1 * w2,
-    )
+    m, I1, I2, I3 = p[1], p[4], p[5], p[6]
+    f = _free_forces(p, y)
     minv = (1.0 / m, 1.0 / m, 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3)
     for i in range(nc):
         s = -bias[i]
