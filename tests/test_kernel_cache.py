@@ -47,12 +47,21 @@ def test_user_cache_dir_is_cleaned_too(tmp_path, monkeypatch):
     user = tmp_path / "numba-cache"
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(user))
     _kernel_cache.refresh(root)
-    mirrored = user / (root / "integrate").relative_to((root / "integrate").anchor)
-    mirrored.mkdir(parents=True)
-    (mirrored / "mod.run-10.py311.nbi").write_bytes(b"index")
+    elsewhere = user / _kernel_cache.numba_subpath(root / "integrate")
+    elsewhere.mkdir(parents=True)
+    (elsewhere / "mod.run-10.py311.nbi").write_bytes(b"index")
     (root / "contact" / "mod.py").write_text("# edited\n")
     assert _kernel_cache.refresh(root)
-    assert not any(mirrored.iterdir())
+    assert not any(elsewhere.iterdir())
+
+
+def test_subpath_is_numbas():
+    """Our copy of numba's rule for cache folders outside the source tree."""
+    from numba.core.caching import _CacheLocator
+
+    source = _kernel_cache.ROOT / "integrate" / "_dop853.py"
+    expected = _CacheLocator.get_suitable_cache_subpath(str(source))
+    assert _kernel_cache.numba_subpath(source.parent) == expected
 
 
 def test_digest_covers_paths_and_contents(tmp_path):

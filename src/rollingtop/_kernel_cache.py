@@ -17,7 +17,7 @@ import hashlib
 import os
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent
+ROOT = Path(os.path.abspath(__file__)).parent  # as numba names the sources (not resolved)
 #: Subpackages whose modules are compiled into (or frozen as constants into) the kernels.
 KERNEL_PACKAGES = ("contact", "dynamics", "integrate")
 STAMP_NAME = "rollingtop-kernels.sha256"
@@ -34,15 +34,31 @@ def sources_digest(root: Path = ROOT) -> str:
     return digest.hexdigest()
 
 
+def numba_subpath(directory: Path) -> str:
+    """The folder name numba gives a source folder's cache outside the source tree:
+    ``<folder name>_<sha1 of its absolute path>`` (``_CacheLocator.get_suitable_cache_subpath``
+    in ``numba/core/caching.py``; a test holds this copy to it)."""
+    path = os.path.abspath(directory)
+    return f"{os.path.basename(path)}_{hashlib.sha1(path.encode()).hexdigest()}"
+
+
 def _cache_dirs(root: Path) -> list[Path]:
-    """Where numba keeps the kernels' cache files: ``__pycache__`` beside each source, or under
-    ``NUMBA_CACHE_DIR`` (mirroring the source path) when that is set."""
+    """Where numba may keep the kernels' cache files: ``__pycache__`` beside each source,
+    ``NUMBA_CACHE_DIR`` when that is set, or the user-wide cache when the tree is read-only."""
     sources = [root / package for package in KERNEL_PACKAGES]
     sources += [d for s in list(sources) for d in s.rglob("*") if d.is_dir()]
-    dirs = [d / "__pycache__" for d in sources if d.name != "__pycache__"]
-    user_dir = os.environ.get("NUMBA_CACHE_DIR")
-    if user_dir:
-        dirs += [Path(user_dir) / d.relative_to(d.anchor) for d in sources]
+    sources = [d for d in sources if d.name != "__pycache__"]
+    dirs = [d / "__pycache__" for d in sources]
+    elsewhere = []
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        elsewhere.append(Path(os.environ["NUMBA_CACHE_DIR"]))
+    try:
+        from numba.misc.appdirs import AppDirs
+
+        elsewhere.append(Path(AppDirs(appname="numba", appauthor=False).user_cache_dir))
+    except ImportError:  # pragma: no cover - numba is a dependency
+        pass
+    dirs += [base / numba_subpath(d) for base in elsewhere for d in sources]
     return dirs
 
 
