@@ -55,15 +55,6 @@ def test_user_cache_dir_is_cleaned_too(tmp_path, monkeypatch):
     assert not any(elsewhere.iterdir())
 
 
-def test_subpath_is_numbas():
-    """Our copy of numba's rule for cache folders outside the source tree."""
-    from numba.core.caching import _CacheLocator
-
-    source = _kernel_cache.ROOT / "integrate" / "_dop853.py"
-    expected = _CacheLocator.get_suitable_cache_subpath(str(source))
-    assert _kernel_cache.numba_subpath(source.parent) == expected
-
-
 def test_digest_covers_paths_and_contents(tmp_path):
     root = _tree(tmp_path)
     first = _kernel_cache.sources_digest(root)

@@ -35,11 +35,11 @@ def sources_digest(root: Path = ROOT) -> str:
 
 
 def numba_subpath(directory: Path) -> str:
-    """The folder name numba gives a source folder's cache outside the source tree:
-    ``<folder name>_<sha1 of its absolute path>`` (``_CacheLocator.get_suitable_cache_subpath``
-    in ``numba/core/caching.py``; a test holds this copy to it)."""
-    path = os.path.abspath(directory)
-    return f"{os.path.basename(path)}_{hashlib.sha1(path.encode()).hexdigest()}"
+    """The folder name numba gives a source folder's cache outside the source tree
+    (``<folder name>_<sha1 of its absolute path>``), from numba itself."""
+    from numba.core.caching import _CacheLocator
+
+    return _CacheLocator.get_suitable_cache_subpath(os.path.join(directory, "module.py"))
 
 
 def _cache_dirs(root: Path) -> list[Path]:
@@ -52,12 +52,9 @@ def _cache_dirs(root: Path) -> list[Path]:
     elsewhere = []
     if os.environ.get("NUMBA_CACHE_DIR"):
         elsewhere.append(Path(os.environ["NUMBA_CACHE_DIR"]))
-    try:
-        from numba.misc.appdirs import AppDirs
+    from numba.misc.appdirs import AppDirs  # numba's own user-wide cache folder
 
-        elsewhere.append(Path(AppDirs(appname="numba", appauthor=False).user_cache_dir))
-    except ImportError:  # pragma: no cover - numba is a dependency
-        pass
+    elsewhere.append(Path(AppDirs(appname="numba", appauthor=False).user_cache_dir))
     dirs += [base / numba_subpath(d) for base in elsewhere for d in sources]
     return dirs
 
