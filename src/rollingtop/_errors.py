@@ -34,5 +34,17 @@ class IntegrationError(RuntimeError):
     """The integrator could not reach the requested end time."""
 
 
+class Interrupted(KeyboardInterrupt):
+    """A run was stopped by a signal (SIGINT or SIGTERM); ``signum`` says which.
+
+    The command-line interface reports it as one line and exits with ``128 + signum``
+    (130 for SIGINT, 143 for SIGTERM).
+    """
+
+    def __init__(self, signum: int, message: str = "") -> None:
+        super().__init__(message or f"interrupted by signal {signum}")
+        self.signum = int(signum)
+
+
 class ContactLostWarning(UserWarning):
     """The normal reaction turned negative: the body would leave the plane."""

@@ -11,7 +11,12 @@ import warnings
 
 import click
 
-from rollingtop._errors import ContactLostWarning, IntegrationError, RollingTopError
+from rollingtop._errors import (
+    ContactLostWarning,
+    IntegrationError,
+    Interrupted,
+    RollingTopError,
+)
 
 EXIT_USAGE = 2
 _NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
@@ -586,8 +591,11 @@ def main(argv: list[str] | None = None) -> None:
         _fail(str(exc))
     except IntegrationError as exc:
         _fail(str(exc), EXIT_FAILURE)
+    except Interrupted as exc:
+        name = {2: "SIGINT", 15: "SIGTERM"}.get(exc.signum, f"signal {exc.signum}")
+        _fail(f"interrupted by {name}; no output was written", 128 + exc.signum)
     except KeyboardInterrupt:
-        _fail("interrupted; nothing was written", 130)
+        _fail("interrupted; no output was written", 130)
     except OSError as exc:
         _fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "), EXIT_FAILURE)
 

@@ -35,8 +35,12 @@ SOUTH_CODE = 3
 NORTH_CODE = 4
 #: Below this ``sqrt(gamma1^2 + gamma2^2)`` the axis counts as vertical and ``nu`` is undefined.
 POLE_TOLERANCE = 1e-8
-#: ``|C1 -+ M3|`` at most this times ``max(|M3|, |C1|)`` is a pole case (also for the reduction).
-POLE_CASE_TOLERANCE = 1e-9
+#: ``|C1 -+ M3|`` at most this times ``max(|M3|, |C1|)`` is a pole case: the one decision used by
+#: the simulator (:func:`kernel_code`), the reduction and every command (:func:`pole_case`). Small
+#: enough that the near-pole levels ``|C1 -+ M3| >= 1e-12 max(|M3|, |C1|)`` are resolved as what
+#: they are (orbits reflected at a thin wall next to the pole), large enough to absorb the
+#: round-off of ``C1`` computed from a state (a few ulps).
+POLE_CASE_TOLERANCE = 1e-13
 #: Above this ``s`` the carried azimuth is re-synchronised with the geometric one (modulo pi).
 RESYNC_S = 0.05
 
@@ -114,6 +118,24 @@ def rows_pole(p, y, J, bias, dirs, north):
     return 2
 
 
+def pole_case(M3: float, C1: float) -> str | None:
+    """Which pole the level set ``(M3, C1)`` lets touch the plane (paper Sec. 3.3).
+
+    Returns ``"south"`` when ``C1 = M3`` (``gamma3 = 1`` can be reached), ``"north"`` when
+    ``C1 = -M3``, ``"both"`` when ``M3 = C1 = 0`` (no spin: both poles at once), else ``None``;
+    equalities hold within :data:`POLE_CASE_TOLERANCE` times ``max(|M3|, |C1|)``.
+    """
+    M3, C1 = float(M3), float(C1)
+    scale = max(abs(M3), abs(C1))
+    if scale == 0.0:
+        return "both"
+    if abs(C1 - M3) <= POLE_CASE_TOLERANCE * scale:
+        return "south"
+    if abs(C1 + M3) <= POLE_CASE_TOLERANCE * scale:
+        return "north"
+    return None
+
+
 def kernel_code(body, y: np.ndarray) -> int:
     """Kernel code for a motion from state ``y``: :data:`SOUTH_CODE` / :data:`NORTH_CODE` on the
     pole level sets ``C1 = +-M3`` of a symmetric body (within :data:`POLE_CASE_TOLERANCE`), else
@@ -122,11 +144,11 @@ def kernel_code(body, y: np.ndarray) -> int:
         return CODE
     M3 = body.I3 * y[5]
     C1 = float(np.dot(body.inertia * y[3:6], y[12:15]))
-    scale = max(abs(M3), abs(C1), 1e-300)
-    if abs(C1 - M3) <= POLE_CASE_TOLERANCE * scale:
-        return SOUTH_CODE
-    if abs(C1 + M3) <= POLE_CASE_TOLERANCE * scale:
+    pole = pole_case(M3, C1)
+    if pole == "north":
         return NORTH_CODE
+    if pole is not None:  # "south", or "both" (no spin: the carried direction does not turn)
+        return SOUTH_CODE
     return CODE
 
 
