@@ -578,8 +578,11 @@ def verify(models, as_json):
 
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point."""
+    from rollingtop._signals import handle_signals
+
     try:
-        cli.main(args=argv, prog_name="rollingtop", standalone_mode=False)
+        with handle_signals():
+            cli.main(args=argv, prog_name="rollingtop", standalone_mode=False)
     except _NO_ARGS_IS_HELP as exc:  # click >= 8.2 raises this for a bare ``rollingtop``
         click.echo(exc.format_message())
         sys.exit(0)
