@@ -29,7 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rollingtop.reduction.level import LevelSet, LevelSetError
-from rollingtop.reduction.orbits import Orbit, orbits, period
+from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits, period
 
 __all__ = ["PeriodMap", "period_map", "reconstruct", "RESONANCE_TOLERANCE", "NEAR_RESONANT"]
 
@@ -128,6 +128,8 @@ class PeriodMap:
     period : float
     delta_psi : float
         Advance of the azimuth per period (by quadrature, like the period).
+    delta_psi_error : float
+        Estimated absolute error of ``delta_psi`` (two quadrature levels).
     displacement : (float, float)
         CoM displacement over one period from the canonical start.
     motion : {"bounded", "drifting"}
@@ -149,6 +151,7 @@ class PeriodMap:
     drift_velocity: tuple[float, float] | None
     near_resonant: bool
     start_theta: float
+    delta_psi_error: float = math.nan
 
     def to_dict(self) -> dict:
         """JSON-ready dict."""
@@ -184,18 +187,27 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
     if orbit.kind != "periodic":
         raise LevelSetError(f"no per-period map for a {orbit.kind} orbit ({orbit.note})")
     T = orbit.period
-    peaks = [t for t in (level.pole_theta,) if t is not None]
-    dpsi, _ = period(level, h, orbit.theta_min, orbit.theta_max, peaks=peaks,
-                     weight=level.psi_dot)  # fmt: skip
-    theta0 = start_theta(orbit)
-    path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=0.0)
+    w_tau0 = 0.0
+    if level.pole == "both":  # no spin: the axis does not precess (rollingtop.reduction.no_spin)
+        dpsi, dpsi_err = 0.0, 0.0
+        theta0 = start_theta(orbit)
+        if orbit.theta_max - orbit.theta_min >= 2 * math.pi * (1 - 1e-12):  # rolling over
+            theta0 = orbit.theta_min
+            w_tau0 = -math.sqrt(2 * (h - float(level.U(theta0))) / float(level.rho(theta0)))
+    else:
+        exact_level, exact_orbit = canonical_orbit(level, h, orbit)  # near north: its mirror
+        peaks = [t for t in (exact_level.pole_theta,) if t is not None]
+        dpsi, dpsi_err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max,
+                                peaks=peaks, weight=exact_level.psi_dot)  # fmt: skip
+        theta0 = start_theta(orbit)
+    path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
     D = complex(*path["position"][-1])
     turns = dpsi / (2 * math.pi)
     if abs(turns - round(turns)) < RESONANCE_TOLERANCE:
         v = D / T
         return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None, (v.real, v.imag),
-                         False, theta0)  # fmt: skip
+                         False, theta0, dpsi_err)  # fmt: skip
     c = D / (1 - cmath.exp(1j * dpsi))
     radius = abs(c)
     return PeriodMap(T, dpsi, (D.real, D.imag), "bounded", (c.real, c.imag), radius, None,
-                     radius > NEAR_RESONANT * level.body.R, theta0)  # fmt: skip
+                     radius > NEAR_RESONANT * level.body.R, theta0, dpsi_err)  # fmt: skip

@@ -29,11 +29,13 @@ import numpy as np
 
 from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
+from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
 
 __all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE"]
 
-#: ``|C1 - M3|`` (or ``|C1 + M3|``) below this times ``max(|M3|, |C1|, 1e-300)`` is a pole case.
-POLE_TOLERANCE = 1e-12
+#: ``|C1 -+ M3|`` below this times ``max(|M3|, |C1|)`` is a pole case: the simulator's tolerance
+#: (:data:`rollingtop.contact.meridian.POLE_CASE_TOLERANCE`), one decision for every command.
+POLE_TOLERANCE = POLE_CASE_TOLERANCE
 #: Step of the complex-step derivative (exact to round-off for analytic functions).
 _COMPLEX_STEP = 1e-30
 
@@ -59,10 +61,21 @@ class LevelSet:
 
     Attributes
     ----------
-    pole : {None, "south", "north"}
+    pole : {None, "south", "north", "both"}
         ``"south"`` when ``C1 = M3`` (the pole ``gamma3 = 1`` can touch the plane), ``"north"``
         when ``C1 = -M3``, within :data:`POLE_TOLERANCE`; in these cases ``C1`` is snapped to
-        ``+-M3`` exactly.
+        ``+-M3`` exactly. ``"both"`` when ``M3 = C1 = 0`` (no spin): then ``w_n = 0``,
+        ``v_tau = C2 / I1`` and ``U = m C2^2 / (2 I1^2) + m g a3 cos(theta)`` is smooth on the
+        whole circle -- the planar rocking and rolling-over motions, through both poles.
+        The decision is :func:`rollingtop.contact.meridian.pole_case`, shared with the simulator.
+
+    Notes
+    -----
+    Near a pole level (``0 < |C1 -+ M3|`` small) ``U`` has a wall of width about
+    ``|C1 -+ M3| / sqrt(I1 h)`` next to the pole. The differences ``C1 - M3 cos(theta)`` etc.
+    are then formed from ``M3 - C1`` (or ``M3 + C1``), which is exact for nearby floats, and
+    ``1 -+ cos(theta) = 2 sin^2(theta/2)`` (``2 cos^2``), so ``U`` keeps its relative accuracy
+    inside the wall (see :meth:`_q`).
     """
 
     body: SphericalTop
@@ -83,15 +96,33 @@ class LevelSet:
                 f"the reduction needs a dynamically symmetric body (I1 = I2), got "
                 f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
             )
-        scale = max(abs(self.M3), abs(self.C1), 1e-300)
-        pole = None
-        if abs(self.C1 - self.M3) <= POLE_TOLERANCE * scale:
-            pole = "south"
+        pole = pole_case(self.M3, self.C1)
+        if pole == "south":
             object.__setattr__(self, "C1", self.M3)
-        elif abs(self.C1 + self.M3) <= POLE_TOLERANCE * scale:
-            pole = "north"
+        elif pole == "north":
             object.__setattr__(self, "C1", -self.M3)
+        elif pole == "both":
+            object.__setattr__(self, "M3", 0.0)
+            object.__setattr__(self, "C1", 0.0)
         object.__setattr__(self, "pole", pole)
+
+    def mirrored(self) -> LevelSet:
+        """The same motions seen with the body axis reversed (``e3 -> -e3``): ``theta -> pi -
+        theta``, ``a3 -> -a3``, ``M3 -> -M3``, ``C1`` kept, ``C2 -> -C2 - pi M3 a3``.
+
+        ``U``, ``rho`` and ``psi'`` at ``pi - theta`` on the mirrored level equal those at
+        ``theta`` here (tested), so a level near the north pole can be computed as one near the
+        south pole, where the distance to the pole is a float of its own (``theta`` itself)
+        rather than the difference ``pi - theta``, which keeps only absolute precision.
+        """
+        from dataclasses import replace
+
+        return LevelSet(
+            replace(self.body, a3=-self.body.a3),
+            -self.M3,
+            self.C1,
+            -self.C2 - math.pi * self.M3 * self.body.a3,
+        )
 
     # ---- domain in theta ------------------------------------------------------------------
     @property
@@ -102,12 +133,20 @@ class LevelSet:
             return (-math.pi, math.pi)
         if self.pole == "north":
             return (0.0, 2 * math.pi)
+        if self.pole == "both":
+            return (-math.pi / 2, 3 * math.pi / 2)  # the whole circle, both poles inside
         return (0.0, math.pi)
 
     @property
     def pole_theta(self) -> float | None:
-        """``theta`` of the pole the motion can pass (0 or pi), or ``None``."""
+        """``theta`` of the pole the motion can pass (0 or pi), or ``None`` (also for ``"both"``:
+        see :attr:`pole_thetas`)."""
         return {"south": 0.0, "north": math.pi}.get(self.pole)
+
+    @property
+    def pole_thetas(self) -> tuple[float, ...]:
+        """``theta`` of every pole the motion can pass: ``()``, ``(0,)``, ``(pi,)`` or both."""
+        return {"south": (0.0,), "north": (math.pi,), "both": (0.0, math.pi)}.get(self.pole, ())
 
     # ---- the reduced quantities -------------------------------------------------------------
     def _q(self, theta):
@@ -122,12 +161,23 @@ class LevelSet:
             ct = 1 / np.tan(theta / 2)
             csc2 = 1 / (2 * np.sin(theta / 2) ** 2)
             return -M3 * ct, M3 * (b.R + b.a3) * ct, M3 * csc2, -M3 * (b.R + b.a3) * csc2
+        if self.pole == "both":
+            z = np.zeros_like(np.asarray(theta, dtype=float) if np.isrealobj(theta) else theta)
+            return z, z, z, z
         c, s = np.cos(theta), np.sin(theta)
-        N = b.R * (M3 - C1 * c) + b.a3 * (M3 * c - C1)
+        # Free of cancellation near either pole (class Notes): with d = M3 - C1 (exact for
+        # nearby floats) and u = 1 - cos = 2 sin^2(theta/2), or d = M3 + C1 and v = 1 + cos.
+        if abs(M3 - C1) <= abs(M3 + C1):
+            d, u = M3 - C1, 2 * np.sin(theta / 2) ** 2
+            a, b_, e = M3 * u - d, M3 * u + d * c, d - M3 * u  # C1-M3c, M3-C1c, M3c-C1
+        else:
+            d, v = M3 + C1, 2 * np.cos(theta / 2) ** 2
+            a, b_, e = d - M3 * v, M3 * v - d * c, M3 * v - d
+        N = b.R * b_ + b.a3 * e
         return (
-            (C1 - M3 * c) / s,
+            a / s,
             N / s,
-            (M3 - C1 * c) / s**2,
+            b_ / s**2,
             (b.R * C1 - b.a3 * M3) - N * c / s**2,
         )
 
@@ -173,11 +223,14 @@ class LevelSet:
         """Precession rate ``psi' = -w_n / s`` (``MODEL.md``, "Motion in absolute space"),
         finite at the pole in a pole case."""
         I1 = self.body.I1
+        if self.pole == "both":
+            return np.zeros_like(np.asarray(theta, dtype=float))
         if self.pole == "south":
             return self.M3 / (I1 * (1 + np.cos(theta)))
         if self.pole == "north":
             return -self.M3 / (I1 * (1 - np.cos(theta)))
-        return (self.C1 - self.M3 * np.cos(theta)) / (I1 * np.sin(theta) ** 2)
+        q1, _, _, _ = self._q(theta)
+        return q1 / (I1 * np.sin(theta))
 
     # ---- in gamma3 (the paper's variables) ---------------------------------------------------
     @staticmethod
@@ -197,5 +250,10 @@ class LevelSet:
 
     def describe(self) -> str:
         """One line naming the level set."""
-        pole = {None: "", "south": " (south pole case)", "north": " (north pole case)"}[self.pole]
+        pole = {
+            None: "",
+            "south": " (south pole case)",
+            "north": " (north pole case)",
+            "both": " (no spin: both poles)",
+        }[self.pole]
         return f"M3 = {self.M3:g}, C1 = {self.C1:g}, C2 = {self.C2:g}{pole}"

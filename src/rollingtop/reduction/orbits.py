@@ -19,7 +19,7 @@ number that would be noise.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -155,6 +155,15 @@ def _graded_gauss(f, a: float, b: float, points, n: int) -> float:
     return total
 
 
+#: An orbit's end closer to its pole than this fraction of the orbit's width sits next to a thin
+#: wall of ``U`` (a level near a pole level): that half of the orbit is integrated in the
+#: variable ``x`` of ``dist = dist_end cosh x`` (see :func:`_wall_period`).
+WALL_RATIO = 0.25
+#: Within this fraction of the local length scale from a turning point, ``h - U`` is integrated
+#: from ``U'`` instead of subtracted (see :func:`_half_integrand`).
+_GAP_NEAR_WALL = 0.1
+
+
 def period(
     level: LevelSet, h: float, theta1: float, theta2: float, peaks=(), weight=None
 ) -> tuple[float, float]:
@@ -163,7 +172,15 @@ def period(
     ``peaks`` are theta values of saddles near the orbit (break points for the graded
     fallback). With ``weight`` (a function of theta) the integral over one period of
     ``weight(theta(t)) dt`` instead. Returns ``(value, estimated absolute error)``.
+
+    When an end of the orbit lies next to a thin wall of ``U`` at a pole (a level near a pole
+    level, closer to the pole than :data:`WALL_RATIO` times the orbit's width), the orbit is
+    split and each half integrated in a variable that resolves the wall
+    (:func:`_wall_period`); otherwise by ``theta = c + d sin(phi)`` on the whole orbit.
     """
+    walls = _walls(level, theta1, theta2)
+    if any(walls):
+        return _wall_period(level, h, theta1, theta2, walls, peaks, weight)
     c, d = (theta1 + theta2) / 2, (theta2 - theta1) / 2
     f = _integrand(level, h, theta1, theta2, weight)
     prev, _ = _gauss(f, 32)
@@ -181,14 +198,134 @@ def period(
     return fine, abs(fine - coarse)
 
 
+def _walls(level: LevelSet, theta1: float, theta2: float) -> tuple[bool, bool]:
+    """Whether each end of the orbit ``[theta1, theta2]`` sits at a thin wall next to a pole."""
+    if level.pole is not None or not 0.0 < theta1 < theta2 < math.pi:
+        return (False, False)
+    width = theta2 - theta1
+    return (theta1 < WALL_RATIO * width, math.pi - theta2 < WALL_RATIO * width)
+
+
+def _half_map(t_end: float, mid: float, wall: bool, left: bool):
+    """The substitution for the half orbit between the turning point ``t_end`` and ``mid``.
+
+    Returns ``(u_max, theta(u), |dtheta/du|(u), dist(u), scale)`` with ``u in [0, u_max]``,
+    ``u = 0`` at the turning point, ``dist = |theta - t_end|`` without cancellation and
+    ``scale`` the length on which ``U`` varies near the turning point.
+
+    - At a wall (``dist_pole`` = distance of ``t_end`` from its pole, 0 or pi):
+      ``dist_pole(theta) = dist_pole cosh u``. The inverse square root at the turning point
+      becomes smooth (``dist ~ u^2``) and the wall, of width ``~dist_pole``, is stretched to
+      ``u = O(1)``; the rest of the half orbit takes ``u`` up to ``log(2 width / dist_pole)``.
+    - Otherwise ``theta = mid -+ (mid - t_end) sin u`` on ``[0, pi/2]`` (``u = pi/2`` at ``mid``
+      is mapped to the start so that ``u = 0`` is the turning point).
+    """
+    sign = 1.0 if left else -1.0  # direction from the turning point into the orbit
+    if wall:
+        p = t_end if left else math.pi - t_end
+        pole = 0.0 if left else math.pi
+        u_max = math.acosh(abs(mid - pole) / p)
+
+        def theta(u):
+            return pole + sign * p * np.cosh(u)
+
+        def jac(u):
+            return p * np.sinh(u)
+
+        def dist(u):
+            return 2 * p * np.sinh(u / 2) ** 2
+
+        return u_max, theta, jac, dist, p
+    L = abs(mid - t_end)
+
+    def theta(u):
+        return mid - sign * L * np.cos(u)
+
+    def jac(u):
+        return L * np.sin(u)
+
+    def dist(u):
+        return 2 * L * np.sin(u / 2) ** 2
+
+    return math.pi / 2, theta, jac, dist, L
+
+
+def _half_integrand(level: LevelSet, h: float, t_end: float, half, left: bool, weight):
+    """``2 sqrt(rho / (2 (h - U))) |dtheta/du| weight`` on one half orbit (see :func:`_half_map`).
+
+    ``h - U`` within :data:`_GAP_NEAR_WALL` of the local scale from the turning point is
+    ``U(t_end) - U(theta)``, the integral of ``U'`` by a 20-point Gauss-Legendre rule over an
+    interval on which ``U'`` is smooth; elsewhere the plain difference (no cancellation there).
+    """
+    _, theta_of, jac, dist_of, scale = half
+    sign = 1.0 if left else -1.0
+
+    def f(u):
+        u = np.asarray(u, dtype=float)
+        theta = theta_of(u)
+        dist = dist_of(u)
+        gap = h - level.U(theta)
+        near = dist < _GAP_NEAR_WALL * scale
+        if np.any(near):
+            half_d = dist[near] / 2
+            x = t_end + sign * half_d[:, None] * (1 + _GAP_NODES[None, :])
+            gap[near] = -sign * np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half_d
+        with np.errstate(divide="ignore", invalid="ignore"):
+            val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * np.maximum(gap, 0.0))) * jac(u)
+            if weight is not None:
+                val = val * weight(theta)
+        return np.where(np.isfinite(val), val, 0.0)
+
+    return f
+
+
+def _wall_period(level, h, theta1, theta2, walls, peaks, weight) -> tuple[float, float]:
+    """:func:`period` split at the middle, each half in the variable of :func:`_half_map`.
+
+    Each half is a Gauss-Legendre rule doubled until two successive values agree to
+    :data:`PERIOD_RTOL` (of the integral of ``|f|``); the reported error is the sum of the last
+    differences. A half that does not converge by 4096 nodes (a saddle near it) falls back to
+    the composite rule graded towards its ends and the saddles.
+    """
+    mid = (theta1 + theta2) / 2
+    total, error = 0.0, 0.0
+    for t_end, wall, left in ((theta1, walls[0], True), (theta2, walls[1], False)):
+        half = _half_map(t_end, mid, wall, left)
+        f = _half_integrand(level, h, t_end, half, left, weight)
+        u_max = half[0]
+        x, w = np.polynomial.legendre.leggauss(32)
+        prev = float(np.sum(f(u_max * (x + 1) / 2) * w)) * u_max / 2
+        n, done = 64, False
+        while n <= 4096:
+            x, w = np.polynomial.legendre.leggauss(n)
+            vals = f(u_max * (x + 1) / 2) * w * (u_max / 2)
+            cur, size = float(np.sum(vals)), float(np.sum(np.abs(vals)))
+            if abs(cur - prev) <= PERIOD_RTOL * size:
+                total, error, done = total + cur, error + abs(cur - prev), True
+                break
+            prev, n = cur, 2 * n
+        if not done:
+            breaks = []
+            for p in peaks:
+                if min(t_end, mid) < p < max(t_end, mid):
+                    breaks.append(float(brentq(lambda u, p=p: half[1](u) - p, 0.0, u_max)))
+            coarse = _graded_gauss(f, 0.0, u_max, breaks, 20)
+            fine = _graded_gauss(f, 0.0, u_max, breaks, 30)
+            total, error = total + fine, error + abs(fine - coarse)
+    return total, error
+
+
 def _root(level: LevelSet, h: float, a: float, b: float) -> float:
-    return brentq(lambda t: h - level.U(t), a, b, xtol=1e-16, rtol=8.9e-16, maxiter=500)
+    # xtol tiny: the root is found to a relative 4 ulps also next to a pole (theta ~ 1e-12)
+    return brentq(lambda t: h - level.U(t), a, b, xtol=1e-300, rtol=8.9e-16, maxiter=500)
 
 
 def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
     """A point near a domain end where ``U > h`` (the potential's barrier)."""
-    for eps in (1e-6, 1e-9, 1e-12, 1e-15):
+    for eps in (1e-6, 1e-9, 1e-12, 1e-15, 1e-20, 1e-30, 1e-50, 1e-100, 1e-200, 1e-300):
         t = end + inward * eps * (1 + abs(end))
+        if t == end:
+            break
         with np.errstate(all="ignore"):
             if level.U(t) > h:
                 return t
@@ -201,6 +338,10 @@ def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
 def orbits(level: LevelSet, h: float) -> list[Orbit]:
     """All connected components of the level set ``(M3, C1, C2, h)``, sorted by ``gamma3_min``.
 
+    A level nearer the north pole level than the south one is computed on its mirror image
+    (:meth:`LevelSet.mirrored`), where the distance of the wall from the pole is ``theta``
+    itself and keeps its relative precision; the turning points are mapped back.
+
     Raises
     ------
     LevelSetError
@@ -209,6 +350,50 @@ def orbits(level: LevelSet, h: float) -> list[Orbit]:
     if not isinstance(h, int | float) or isinstance(h, bool) or not math.isfinite(h):
         raise LevelSetError(f"level h = {h!r} must be a finite number")
     h = float(h)
+    if level.pole == "both":
+        from rollingtop.reduction.no_spin import no_spin_orbits
+
+        return no_spin_orbits(level, h)
+    if near_north(level):
+        mirrored = [_mirror(o) for o in _orbits(level.mirrored(), h)]
+        return sorted(mirrored, key=lambda o: (o.gamma3_min, o.theta_min))
+    return _orbits(level, h)
+
+
+def near_north(level: LevelSet) -> bool:
+    """A level that is no pole case and lies nearer ``C1 = -M3`` than ``C1 = M3``: computed on
+    its mirror image (:meth:`LevelSet.mirrored`)."""
+    return level.pole is None and abs(level.M3 + level.C1) < abs(level.M3 - level.C1)
+
+
+def _mirror(o: Orbit) -> Orbit:
+    """An orbit of the mirrored level seen on the original one (``theta -> pi - theta``)."""
+    return replace(
+        o,
+        gamma3_min=-o.gamma3_max,
+        gamma3_max=-o.gamma3_min,
+        theta_min=math.pi - o.theta_max,
+        theta_max=math.pi - o.theta_min,
+    )
+
+
+def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, Orbit]:
+    """The level and orbit on which quadratures of ``orbit`` are most accurate: the mirror image
+    for a level near the north pole (:func:`near_north`), where the turning point next to the
+    pole is known to its full relative precision; else ``(level, orbit)``."""
+    if not near_north(level):
+        return level, orbit
+    mirrored = level.mirrored()
+    candidates = _orbits(mirrored, h)
+    best = min(
+        candidates,
+        key=lambda c: abs(math.pi - c.theta_max - orbit.theta_min)
+        + abs(math.pi - c.theta_min - orbit.theta_max),
+    )
+    return mirrored, best
+
+
+def _orbits(level: LevelSet, h: float) -> list[Orbit]:
     lo_end, hi_end = level.theta_domain
     lo = _barrier_end(level, h, lo_end, +1)
     hi = _barrier_end(level, h, hi_end, -1)

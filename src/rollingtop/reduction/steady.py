@@ -78,7 +78,13 @@ def _grid(level: LevelSet) -> np.ndarray:
     lo, hi = level.theta_domain
     # Chebyshev-like spacing clusters points near the barriers, where U varies fastest.
     x = np.cos(np.linspace(math.pi, 0.0, GRID_POINTS))
-    return lo + (hi - lo) * (x + 1) / 2
+    grid = lo + (hi - lo) * (x + 1) / 2
+    if level.pole is None:
+        # near a pole level the wall of U, and a steady motion beside it, can sit as close to
+        # the pole as |C1 -+ M3|: add points at geometrically shrinking distances from the ends
+        d = (hi - lo) * np.logspace(-18.0, -3.0, 301)
+        grid = np.unique(np.concatenate([grid, lo + d, hi - d]))
+    return grid
 
 
 def critical_points(level: LevelSet) -> np.ndarray:
@@ -145,5 +151,18 @@ def steady_motions(level: LevelSet) -> list[SteadyMotion]:
     In a pole case the list may include motions on the negative-``s`` branch (after a pole
     passage); their ``theta`` lies outside ``(0, pi)``.
     """
-    motions = [steady_motion(level, float(t)) for t in critical_points(level)]
+    from rollingtop.reduction.orbits import near_north
+
+    if near_north(level):  # computed on the mirror image, where theta ~ 0 keeps its precision
+        motions = [_mirror(m) for m in steady_motions(level.mirrored())]
+    else:
+        motions = [steady_motion(level, float(t)) for t in critical_points(level)]
     return sorted(motions, key=lambda m: (m.gamma3, m.theta))
+
+
+def _mirror(m: SteadyMotion) -> SteadyMotion:
+    """A steady motion of the mirrored level (:meth:`LevelSet.mirrored`) seen on the original:
+    ``gamma3 -> -gamma3``, ``theta -> pi - theta``, ``v_tau`` and the spin change sign."""
+    from dataclasses import replace
+
+    return replace(m, gamma3=-m.gamma3, theta=math.pi - m.theta, v_tau=-m.v_tau, spin=-m.spin)
