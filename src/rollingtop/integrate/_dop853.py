@@ -34,11 +34,37 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 ERROR_EXPONENT = -1.0 / 8.0
 
-# Status codes returned by ``run``.
+# Status codes returned by ``run`` (and, per trajectory, by the ensemble kernel): >= 0 the run
+# may go on (or is done), < 0 it cannot reach ``t_end``.
 FINISHED = 0
+#: The step budget of this call is spent (the caller resumes, or reports ``max_steps``).
 BUDGET_EXHAUSTED = 1
+#: An ensemble trajectory stopped (or never started) on a stop request; never returned by ``run``.
+INTERRUPTED = 2
+#: The step size fell below ten units in the last place of ``t``, or is zero or NaN (no initial
+#: step: the scaled norm of the state or its derivative overflows).
 STEP_TOO_SMALL = -1
+#: The state or its derivative is not finite (at an accepted step, or when ``run`` is entered),
+#: or ``MAX_REJECTED_IN_A_ROW`` steps in a row were rejected with a non-finite error estimate.
 NOT_FINITE = -2
+#: ``MAX_REJECTED_IN_A_ROW`` steps in a row were rejected by the error control.
+TOO_MANY_REJECTED = -3
+
+#: Short descriptions of the status codes (the ensemble reports them per trajectory).
+STATUS_NAMES = {
+    FINISHED: "finished",
+    BUDGET_EXHAUSTED: "max_steps reached",
+    INTERRUPTED: "interrupted",
+    STEP_TOO_SMALL: "step size underflow",
+    NOT_FINITE: "non-finite state",
+    TOO_MANY_REJECTED: "too many rejected steps in a row",
+}
+
+#: Rejected attempts in a row after which a run gives up. After a rejection the next attempt is
+#: at most 0.9 times as long and usually far shorter (the error scales as ``h**8``), so a sound
+#: step needs a handful; a hundred in a row (the step shrunk by at least ``0.9**100 ~ 3e-5``)
+#: means the error control cannot meet the tolerance here (too tight, or a singular point).
+MAX_REJECTED_IN_A_ROW = 100
 
 # Indices into the float control array ``ctrl``.
 T, H_ABS, T_END, RTOL, ATOL, G_OLD = 0, 1, 2, 3, 4, 5
@@ -74,7 +100,12 @@ def update_track(track, t, N, T_force):
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
 def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
-    """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy."""
+    """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy.
+
+    NaN (and no evaluation of the right-hand side) when the scaled norm of ``y`` or ``f`` is not
+    finite: :func:`run` then stops at once, with ``NOT_FINITE`` for a non-finite ``y`` or ``f``,
+    else (the norm overflows: a tiny ``atol`` or huge values) with ``STEP_TOO_SMALL``.
+    """
     n = y.shape[0]
     d0 = 0.0
     d1 = 0.0
@@ -84,6 +115,9 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
         d1 += (f[i] / sc) ** 2
     d0 = math.sqrt(d0 / n)
     d1 = math.sqrt(d1 / n)
+    if not (math.isfinite(d0) and math.isfinite(d1)):
+        # a non-finite state or derivative, or one that overflows: no step; ``run`` reports it
+        return math.nan
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, t_end - t0)
     for i in range(n):
@@ -245,7 +279,10 @@ def run(
     Returns
     -------
     status : int
-        ``FINISHED``, ``BUDGET_EXHAUSTED``, ``STEP_TOO_SMALL`` or ``NOT_FINITE``.
+        ``FINISHED``, ``BUDGET_EXHAUSTED``, ``STEP_TOO_SMALL``, ``NOT_FINITE`` or
+        ``TOO_MANY_REJECTED``. Every call ends: after at most ``budget`` accepted steps, each
+        preceded by fewer than :data:`MAX_REJECTED_IN_A_ROW` rejected attempts. Splitting a run
+        into calls does not change its steps.
     """
     n = y.shape[0]
     t = ctrl[T]
@@ -254,6 +291,9 @@ def run(
     rtol = ctrl[RTOL]
     atol = ctrl[ATOL]
     n_samples = t_eval.shape[0]
+    for i in range(n):
+        if not math.isfinite(y[i]) or not math.isfinite(f[i]):
+            return NOT_FINITE
     taken = 0
     while t < t_end:
         if taken >= budget:
@@ -261,9 +301,9 @@ def run(
             ctrl[H_ABS] = h_abs
             return BUDGET_EXHAUSTED
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
-        rejected = False
+        rejected = 0  # attempts rejected in a row
         while True:
-            if h_abs < min_step:
+            if not h_abs >= min_step:  # also a NaN step
                 ctrl[T] = t
                 ctrl[H_ABS] = h_abs
                 return STEP_TOO_SMALL
@@ -296,17 +336,25 @@ def run(
             if not math.isfinite(err):
                 h_abs *= MIN_FACTOR
                 counts[REJECTED] += 1
-                rejected = True
+                rejected += 1
+                if rejected >= MAX_REJECTED_IN_A_ROW:
+                    ctrl[T] = t
+                    ctrl[H_ABS] = h_abs
+                    return NOT_FINITE
             elif err < 1.0:
                 factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
-                if rejected:
+                if rejected > 0:
                     factor = min(1.0, factor)
                 h_abs *= factor
                 break
             else:
                 h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
                 counts[REJECTED] += 1
-                rejected = True
+                rejected += 1
+                if rejected >= MAX_REJECTED_IN_A_ROW:
+                    ctrl[T] = t
+                    ctrl[H_ABS] = h_abs
+                    return TOO_MANY_REJECTED
         # Contact reaction at the new point, from the last stage (FSAL), before ws is reused.
         N, T_force = reaction(nc_new, ynew, ws)
         # Dense output over [t, t_new] for the samples that fall in it.

@@ -16,7 +16,9 @@ from rollingtop.integrate import _dop853 as dop
 
 __all__ = ["IntegrationResult", "integrate", "compile_kernels"]
 
-#: Accepted steps per call of the compiled loop when a progress callback is given.
+#: Accepted steps per call of the compiled loop (tens of milliseconds). Between calls the driver
+#: is back in Python: the progress callback runs and so do signal handlers (Ctrl-C, SIGTERM;
+#: :mod:`rollingtop._signals`). Resuming does not change the step sequence.
 PROGRESS_CHUNK = 20_000
 
 _compile_time: float | None = None
@@ -108,9 +110,9 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
     ctrl, counts, track = dop.start(code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
                                     w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
     t_end = float(t_eval[-1])
-    budget = PROGRESS_CHUNK if progress is not None else (max_steps or 2**62)
     start = time.perf_counter()
     while True:
+        budget = PROGRESS_CHUNK
         if max_steps is not None:
             budget = min(budget, max_steps - int(counts[dop.STEPS]))
         status = dop.run(
@@ -144,19 +146,40 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
                 f"before t_end = {t_end:g}; raise max_steps or loosen rtol"
             )
     wall = time.perf_counter() - start
-    if status == dop.STEP_TOO_SMALL:
-        raise IntegrationError(
-            f"step size underflow at t = {ctrl[dop.T]:.9g} (h = {ctrl[dop.H_ABS]:.3g}): "
-            "the equations are singular or the tolerance is too tight"
-        )
-    if status == dop.NOT_FINITE:
-        raise IntegrationError(
-            f"the state became non-finite at t = {ctrl[dop.T]:.9g} "
-            "(for the meridian model: the symmetry axis reached the vertical?)"
-        )
+    _raise_for_status(status, ctrl, counts)
     found = int(counts[dop.N_EVENTS])
     kept = min(found, capacity)
     return w["out"], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
+
+
+def _raise_for_status(status: int, ctrl: np.ndarray, counts: np.ndarray) -> None:
+    """:class:`IntegrationError` (one line) for a status of ``dop.run`` that ends a run early."""
+    t, h = float(ctrl[dop.T]), float(ctrl[dop.H_ABS])
+    if status == dop.STEP_TOO_SMALL and np.isnan(h):
+        raise IntegrationError(
+            f"no initial step size at t = {t:.9g}: the state or its derivative, scaled by the "
+            f"tolerances (atol = {ctrl[dop.ATOL]:.3g}, rtol = {ctrl[dop.RTOL]:.3g}), overflows"
+        )
+    if status == dop.STEP_TOO_SMALL:
+        raise IntegrationError(
+            f"step size underflow at t = {t:.9g} (h = {h:.3g}): "
+            "the equations are singular or the tolerance is too tight"
+        )
+    if status == dop.NOT_FINITE:
+        if counts[dop.STEPS] == 0 and counts[dop.REJECTED] == 0:
+            raise IntegrationError(
+                f"the initial state or its derivative is not finite at t = {t:.9g} "
+                "(initial values too large?)"
+            )
+        raise IntegrationError(
+            f"the state became non-finite at t = {t:.9g} "
+            "(for the meridian model: the symmetry axis reached the vertical?)"
+        )
+    if status == dop.TOO_MANY_REJECTED:
+        raise IntegrationError(
+            f"{dop.MAX_REJECTED_IN_A_ROW} rejected steps in a row at t = {t:.9g} (h = {h:.3g}): "
+            "the tolerance is too tight or the equations are singular"
+        )
 
 
 def integrate(
@@ -189,10 +212,22 @@ def integrate(
     rtol, atol : float
         Tolerances of the error control (mixed, per component: ``atol + rtol |y|``).
     max_steps : int, optional
-        Bound on accepted steps; :class:`IntegrationError` when reached.
+        Bound on accepted steps; :class:`IntegrationError` when reached. Rejected attempts are
+        bounded separately: :data:`~._dop853.MAX_REJECTED_IN_A_ROW` in a row end the run.
     progress : callable, optional
         Called with the current time every :data:`PROGRESS_CHUNK` steps and at the end. Does
         not change the step sequence.
+
+    Raises
+    ------
+    IntegrationError
+        When ``t_eval[-1]`` cannot be reached, with one line saying why: ``max_steps`` reached, a
+        non-finite state or derivative (also at the start, e.g. from huge initial values), a
+        step size below ten units in the last place of ``t``, or too many rejected steps in a
+        row. Every run ends after finitely many attempted steps.
+    KeyboardInterrupt
+        Signal handlers (Ctrl-C) run between calls of the compiled loop, every
+        :data:`PROGRESS_CHUNK` accepted steps, whether or not ``progress`` is given.
     events : str, optional
         Name of an event function (``"w_tau"``: zeros of ``w_tau``, the turning points of
         ``gamma3``) whose zeros are located on the dense output of each step.
@@ -205,6 +240,8 @@ def integrate(
     y0 = np.ascontiguousarray(y0, dtype=float)
     if t_eval.ndim != 1 or t_eval.size < 2 or np.any(np.diff(t_eval) <= 0):
         raise ValueError("t_eval must be strictly increasing with at least 2 entries")
+    if not np.all(np.isfinite(t_eval)):
+        raise ValueError("t_eval must be finite")
     if y0.shape != (N_STATE,):
         raise ValueError(f"y0 must have shape ({N_STATE},), got {y0.shape}")
     if events is not None and events not in EVENTS:
