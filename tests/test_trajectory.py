@@ -1,6 +1,7 @@
 """Trajectory: derived quantities, summary, NetCDF and CSV export, atomic writes."""
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -81,12 +82,13 @@ def test_failed_write_leaves_nothing(traj, tmp_path, monkeypatch):
     target = tmp_path / "run.nc"
     target.write_text("previous")
 
-    def broken(self, path, **kwargs):
-        with open(path, "wb") as fh:
-            fh.write(b"partial")
+    real_write = os.write
+
+    def broken(fd, data):  # part of the file goes out, then the run is interrupted
+        real_write(fd, bytes(data[:7]))
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", broken)
+    monkeypatch.setattr(os, "write", broken)
     with pytest.raises(KeyboardInterrupt):
         traj.save(target)
     assert target.read_text() == "previous"

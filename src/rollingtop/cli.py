@@ -17,6 +17,7 @@ from rollingtop._errors import (
     Interrupted,
     RollingTopError,
 )
+from rollingtop.io import WriteFailed
 
 EXIT_USAGE = 2
 _NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
@@ -599,6 +600,8 @@ def main(argv: list[str] | None = None) -> None:
         _fail(f"interrupted by {name}; no output was written", 128 + exc.signum)
     except KeyboardInterrupt:
         _fail("interrupted; no output was written", 130)
+    except WriteFailed as exc:
+        _fail(str(exc), EXIT_FAILURE)
     except OSError as exc:
         _fail(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": "), EXIT_FAILURE)
 

@@ -19,7 +19,7 @@ from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.integrate.driver import compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
-from rollingtop.io import atomic_write, check_output_path
+from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
 from rollingtop.scenario import InitialConditions, Scenario
 
 __all__ = ["EnsembleResult", "simulate_ensemble", "states_from_table", "grid_table"]
@@ -150,8 +150,7 @@ class EnsembleResult:
     def to_netcdf(self, path) -> Path:
         """Write :meth:`to_xarray` to NetCDF-4, atomically."""
         path = check_output_path(path, (".nc",))
-        ds = self.to_xarray()
-        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+        return write_bytes_atomic(path, netcdf_bytes(self.to_xarray()))
 
 
 def simulate_ensemble(

@@ -1,16 +1,92 @@
-"""Atomic file output: a failed or interrupted write never leaves a partial file behind."""
+"""Atomic file output: a failed or interrupted write never leaves a partial file behind.
+
+Every writer goes through a temporary file beside the target, renamed onto it only once it is
+complete and flushed to disk. Data that can be built in memory (NetCDF, CSV) is written with
+plain checked ``os.write`` calls (:func:`write_bytes_atomic`), so that a full disk, a file-size
+limit or an I/O error is an ordinary :class:`WriteFailed` and never reaches a C library in the
+middle of its own writes (HDF5 crashed the interpreter under ``ulimit -f``).
+"""
 
 from __future__ import annotations
 
+import codecs
 import contextlib
+import errno as _errno
 import os
+import signal
+import stat
+import subprocess
 import tempfile
+import threading
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from rollingtop._errors import OutputError
 
-__all__ = ["atomic_write", "check_output_path"]
+__all__ = [
+    "WriteFailed",
+    "atomic_write",
+    "check_output_path",
+    "format_bytes",
+    "netcdf_bytes",
+    "read_input_text",
+    "write_bytes_atomic",
+]
+
+#: Largest piece handed to one ``os.write`` call.
+_CHUNK = 1 << 20
+
+
+class WriteFailed(OSError):
+    """An output file could not be written: disk full, file too large, I/O error, permission
+    lost during the run. A runtime failure (the command line exits with status 1), not an input
+    error; the target is left as it was and no temporary file remains."""
+
+    def __init__(self, path: str | os.PathLike, errno: int | None, reason: str) -> None:
+        super().__init__(errno, reason, os.fspath(path))
+
+    def __str__(self) -> str:
+        return f"cannot write {self.filename!r}: {self.strerror}; no output was written"
+
+
+def _reason(exc: BaseException) -> tuple[int | None, str]:
+    """The errno and a short reason of a failed write."""
+    code = getattr(exc, "errno", None)
+    if isinstance(code, int) and code > 0:
+        return code, os.strerror(code)
+    if isinstance(exc, subprocess.CalledProcessError):
+        if exc.returncode < 0:
+            with contextlib.suppress(ValueError):
+                sig = signal.Signals(-exc.returncode)
+                why = signal.strsignal(sig) or ""
+                return None, f"the encoder was stopped by {sig.name}" + (f" ({why})" if why else "")
+        return None, f"the encoder exited with status {exc.returncode}"
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return None, text if len(text) <= 200 else text[:199] + "…"
+
+
+def _write_error(exc: BaseException) -> BaseException | None:
+    """The ``OSError`` (or failed encoder process) behind ``exc``, if any: a writer that fails
+    while cleaning up after a failed write (matplotlib's PDF backend raises ``zlib.error``) still
+    counts as a write failure."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, OSError | subprocess.CalledProcessError):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def _ignore_sigxfsz() -> None:
+    """Make a file-size limit an ``EFBIG`` error instead of a fatal signal (the Python
+    interpreter already does this at start-up; an embedding application may not)."""
+    sig = getattr(signal, "SIGXFSZ", None)
+    if sig is None or threading.current_thread() is not threading.main_thread():
+        return
+    with contextlib.suppress(ValueError, OSError):
+        if signal.getsignal(sig) == signal.SIG_DFL:
+            signal.signal(sig, signal.SIG_IGN)
 
 
 def check_output_path(path: str | os.PathLike, suffixes: Iterable[str]) -> Path:
@@ -38,29 +114,172 @@ def check_output_path(path: str | os.PathLike, suffixes: Iterable[str]) -> Path:
     return path
 
 
-def atomic_write(
-    path: str | os.PathLike, write: Callable[[Path], None], *, keep_suffix: bool = False
-) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it onto ``path``.
-
-    The rename is atomic on POSIX file systems, so readers see either the old file or the
-    complete new one. On any exception (``KeyboardInterrupt`` included) the temporary file is
-    removed and the exception propagates. With ``keep_suffix`` the temporary name ends with
-    ``path``'s suffix (for writers that infer the format from it, such as ffmpeg).
-    """
-    path = Path(path)
-    suffix = f".tmp{path.suffix}" if keep_suffix else ".tmp"
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent or ".")
-    os.close(fd)
-    tmp = Path(tmp)
+def _new_temporary(path: Path, suffix: str) -> tuple[int, Path]:
     try:
-        write(tmp)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    except OSError as exc:
+        raise WriteFailed(path, *_reason(exc)) from None
+    return fd, Path(tmp)
+
+
+def _publish(fd: int, tmp: Path, path: Path) -> None:
+    """Flush ``fd`` to disk, give it the permissions ``open()`` would, close it (always) and
+    rename ``tmp`` onto ``path``."""
+    try:
         umask = os.umask(0)
         os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give what open() would
-        os.replace(tmp, path)
+        os.fchmod(fd, 0o666 & ~umask)  # mkstemp creates 0600
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+    os.replace(tmp, path)
+    with contextlib.suppress(OSError):  # make the rename itself durable where possible
+        dir_fd = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(dir_fd)
+        finally:
+            os.close(dir_fd)
+
+
+def write_bytes_atomic(path: str | os.PathLike, data) -> Path:
+    """Write the bytes ``data`` (any buffer) to ``path`` atomically.
+
+    Raises
+    ------
+    WriteFailed
+        Any operating-system error on the way (``ENOSPC``, ``EFBIG``, ``EIO``, ``EACCES``...),
+        naming ``path``; the temporary file is removed and ``path`` is unchanged.
+    """
+    path = Path(path)
+    _ignore_sigxfsz()
+    view = memoryview(data).cast("B")
+    fd, tmp = _new_temporary(path, ".tmp")
+    try:
+        try:
+            try:
+                while view:
+                    n = os.write(fd, view[:_CHUNK])
+                    if n <= 0:
+                        raise OSError(_errno.EIO, os.strerror(_errno.EIO))
+                    view = view[n:]
+            except BaseException:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+                raise
+            _publish(fd, tmp, path)
+        except OSError as exc:
+            raise WriteFailed(path, *_reason(exc)) from None
     except BaseException:
         with contextlib.suppress(OSError):
             tmp.unlink()
         raise
     return path
+
+
+def atomic_write(
+    path: str | os.PathLike, write: Callable[[Path], None], *, keep_suffix: bool = False
+) -> Path:
+    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it onto ``path``.
+
+    For writers that need a file name (matplotlib, ffmpeg); prefer :func:`write_bytes_atomic`
+    for data built in memory. The rename is atomic on POSIX file systems, so readers see either
+    the old file or the complete new one. On any exception (``KeyboardInterrupt`` included) the
+    temporary file is removed; an ``OSError`` of the writer (or a failed encoder process) is
+    raised as :class:`WriteFailed` naming ``path``, anything else propagates unchanged. With
+    ``keep_suffix`` the temporary name ends with ``path``'s suffix (for writers that infer the
+    format from it, such as ffmpeg).
+    """
+    path = Path(path)
+    _ignore_sigxfsz()
+    suffix = f".tmp{path.suffix}" if keep_suffix else ".tmp"
+    fd, tmp = _new_temporary(path, suffix)
+    os.close(fd)
+    try:
+        try:
+            write(tmp)
+            _publish(os.open(tmp, os.O_RDONLY), tmp, path)
+        except WriteFailed:
+            raise
+        except Exception as exc:
+            cause = _write_error(exc)
+            if cause is None:
+                raise
+            raise WriteFailed(path, *_reason(cause)) from None
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
+    return path
+
+
+def netcdf_bytes(ds) -> memoryview:
+    """The NetCDF-4 file of the :class:`xarray.Dataset` ``ds`` (engine ``h5netcdf``), in memory.
+
+    HDF5 then never writes to disk itself: the bytes go out through :func:`write_bytes_atomic`.
+    """
+    return memoryview(ds.to_netcdf(engine="h5netcdf"))
+
+
+def format_bytes(n: float) -> str:
+    """``n`` bytes in B, KiB, MiB, GiB, TiB or PiB, to one decimal (``"4.8 MiB"``)."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.1f}".removesuffix(".0") + f" {unit}"
+        n /= 1024
+
+
+_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))  # fmt: skip
+
+
+def read_input_text(
+    path: str | os.PathLike, what: str, limit: int, error: type[Exception] = ValueError
+) -> str:
+    """The UTF-8 text of the input file ``path`` (a scenario, a table), read safely.
+
+    Only a regular file of at most ``limit`` bytes is read: a FIFO, a device such as
+    ``/dev/zero`` or a folder is refused at once (the file is opened without blocking), and so
+    is text that is not UTF-8 or starts with a byte-order mark (TOML and our CSV tables are
+    plain UTF-8). Every refusal raises ``error`` with one line naming the file as ``what``.
+    """
+    path = Path(path)
+    where = f"cannot read {what} {str(path)!r}"
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        raise error(f"{where}: {_reason(exc)[1]}") from None
+    try:
+        info = os.fstat(fd)
+        if stat.S_ISDIR(info.st_mode):
+            raise error(f"{where}: it is a folder")
+        if not stat.S_ISREG(info.st_mode):
+            kind = next((name for test, name in _KINDS if test(info.st_mode)), "special")
+            raise error(f"{where}: not a regular file (it is {kind})")
+        if info.st_size > limit:
+            raise error(
+                f"{where}: it is {format_bytes(info.st_size)}, more than the "
+                f"{format_bytes(limit)} an input file may have"
+            )
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, limit + 1 - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > limit:  # the file grew while read
+            raise error(f"{where}: more than the {format_bytes(limit)} an input file may have")
+    except OSError as exc:
+        raise error(f"{where}: {_reason(exc)[1]}") from None
+    finally:
+        os.close(fd)
+    data = b"".join(chunks)
+    if data.startswith(codecs.BOM_UTF8):
+        raise error(
+            f"{where}: it starts with a UTF-8 byte-order mark (BOM); save it as UTF-8 without BOM"
+        )
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{where}: not UTF-8 text (invalid byte at offset {exc.start})") from None

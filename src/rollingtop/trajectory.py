@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import io
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +16,7 @@ from rollingtop.contact import ContactModel, meridian
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop.dynamics.integrals import evaluate
-from rollingtop.io import atomic_write, check_output_path
+from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
 
 __all__ = ["Trajectory", "OUTPUT_SUFFIXES"]
 
@@ -339,20 +340,17 @@ class Trajectory:
         cols, table = self._csv_table()
         header = "\n".join(f"{k} = {v}" for k, v in self._attrs().items() if k != "summary_json")
 
-        def write(tmp: Path) -> None:
-            with open(tmp, "w", encoding="utf-8", newline="") as fh:
-                for line in header.splitlines():
-                    fh.write(f"# {line}\n")
-                fh.write(",".join(cols) + "\n")
-                np.savetxt(fh, table, delimiter=",", fmt="%.17g")
-
-        return atomic_write(path, write)
+        text = io.StringIO(newline="")
+        for line in header.splitlines():
+            text.write(f"# {line}\n")
+        text.write(",".join(cols) + "\n")
+        np.savetxt(text, table, delimiter=",", fmt="%.17g")
+        return write_bytes_atomic(path, text.getvalue().encode("utf-8"))
 
     def to_netcdf(self, path) -> Path:
         """Write the samples as NetCDF-4 (engine ``h5netcdf``), atomically."""
         path = check_output_path(path, (".nc",))
-        ds = self.to_xarray()
-        return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+        return write_bytes_atomic(path, netcdf_bytes(self.to_xarray()))
 
     def save(self, path) -> Path:
         """Write to ``.nc`` (NetCDF) or ``.csv``, chosen by the suffix."""
