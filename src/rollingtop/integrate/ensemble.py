@@ -3,16 +3,26 @@
 Each trajectory keeps its own adaptive steps (the same compiled stepper as a single run, with its
 own work arrays); memory is bounded by what is kept: final states, statistics, and samples only
 when asked for.
+
+The parallel kernel runs in a worker thread without the GIL, while the calling thread waits in
+short slices (:data:`WAIT_SLICE`), so that its signal handlers run (Python runs them in the main
+thread only, between bytecodes). On any exception there (Ctrl-C, SIGTERM, an error in the
+progress callback) it raises a stop flag, which every trajectory polls each
+:data:`STOP_POLL_STEPS` accepted steps, waits for the worker, and re-raises: the kernel stops
+within milliseconds, whatever the length of a trajectory. Polling only splits the stepper's loop
+into calls, which does not change the steps.
 """
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 
 import numba
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, types
+from numba.extending import intrinsic
 
 from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
@@ -26,13 +36,32 @@ BATCH = 256
 #: contiguous block per thread up front; trajectories differ in cost (a grid of initial states
 #: runs from cheap to dear), so small chunks taken on demand keep every core busy to the end.
 CHUNK = 4
+#: Accepted steps of a trajectory between two looks at the stop flag (about a millisecond).
+STOP_POLL_STEPS = 1000
+#: Seconds the calling thread waits for the worker at a time (its signal handlers run between).
+WAIT_SLICE = 0.05
+
+
+@intrinsic
+def _read_flag(typingctx, flag):
+    """``flag[0]`` of an int64 array, by an atomic (relaxed) load: another thread sets it while
+    a compiled loop runs, and a plain load could be hoisted out of that loop by the compiler."""
+    if not (isinstance(flag, types.Array) and flag.dtype == types.int64):
+        return None
+
+    def codegen(context, builder, signature, args):
+        array = context.make_array(signature.args[0])(context, builder, args[0])
+        return builder.load_atomic(array.data, "monotonic", 8)
+
+    return types.int64(flag), codegen
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"})
-def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats):
+def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats, stop):
     """Integrate one trajectory; ``out`` (len(t_eval), 18) samples, ``final`` (18,) state,
-    ``stats`` (6,): status, steps, rejected, rhs evaluations, min normal force, max friction
-    ratio."""
+    ``stats`` (6,): status (``dop.FINISHED``, a failure code, ``dop.BUDGET_EXHAUSTED`` for
+    ``max_steps`` accepted steps, ``dop.INTERRUPTED`` when ``stop[0]`` was set), steps,
+    rejected, rhs evaluations, min normal force, max friction ratio."""
     n = N_STATE
     K = np.zeros((16, n))
     ynew = np.zeros(n)
@@ -46,8 +75,15 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
     ev_spec = np.zeros(2, dtype=np.int64)
     ev_t = np.zeros(1)
     ev_y = np.zeros((1, n))
-    status = dop.run(code, p, y, f, ctrl, counts, track, t_eval, out, ev_spec, ev_t, ev_y,
-                     max_steps, K, ynew, ytmp, y_old, Fd, ws)  # fmt: skip
+    while True:
+        if _read_flag(stop) != 0:
+            status = dop.INTERRUPTED
+            break
+        budget = min(STOP_POLL_STEPS, max_steps - counts[dop.STEPS])
+        status = dop.run(code, p, y, f, ctrl, counts, track, t_eval, out, ev_spec, ev_t, ev_y,
+                         budget, K, ynew, ytmp, y_old, Fd, ws)  # fmt: skip
+        if status != dop.BUDGET_EXHAUSTED or counts[dop.STEPS] >= max_steps:
+            break
     for i in range(n):
         final[i] = y[i]
     stats[0] = status
@@ -58,11 +94,14 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
     stats[5] = track[dop.MAX_RATIO]
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, parallel=True)
-def _batch(codes, P, Y0, t_eval, rtol, atol, max_steps, out, final, stats):
+@njit(cache=True, error_model="numpy", fastmath={"contract"}, parallel=True, nogil=True)
+def _batch(codes, P, Y0, t_eval, rtol, atol, max_steps, out, final, stats, stop):
     for k in prange(Y0.shape[0]):
-        _integrate_one(codes[k], P[k], Y0[k], t_eval, rtol, atol, max_steps, out[k], final[k],
-                       stats[k])  # fmt: skip
+        if _read_flag(stop) != 0:
+            stats[k, 0] = dop.INTERRUPTED
+        else:
+            _integrate_one(codes[k], P[k], Y0[k], t_eval, rtol, atol, max_steps, out[k],
+                           final[k], stats[k], stop)  # fmt: skip
 
 
 _compiled = False
@@ -78,7 +117,8 @@ def compile_ensemble() -> float:
     y[0, 6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
     P = np.array([[1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5]])
     _batch(np.zeros(1, dtype=np.int64), P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
-           np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)))  # fmt: skip
+           np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
+           np.zeros(1, dtype=np.int64))  # fmt: skip
     _compiled = True
     return time.perf_counter() - start
 
@@ -110,17 +150,27 @@ def integrate_batch(
     threads : int, optional
         Threads to use (default: numba's, all cores).
     progress : callable, optional
-        ``progress(done, N)`` after each batch of :data:`BATCH` trajectories.
+        ``progress(done, N)`` now and then as batches of :data:`BATCH` trajectories finish
+        (called in the calling thread), and ``progress(N, N)`` at the end.
 
     Returns
     -------
     samples : ndarray, shape (N, n, 18)
     final : ndarray, shape (N, 18)
     stats : ndarray, shape (N, 6)
-        Status (0 finished; see :mod:`._dop853`), steps, rejected steps, rhs evaluations, min
-        normal force, max friction ratio (monitored at every step).
+        Status (0 finished, 1 ``max_steps`` accepted steps reached, -1 step size underflow, -2
+        non-finite state, -3 too many rejected steps in a row: ``_dop853.STATUS_NAMES``),
+        steps, rejected steps, rhs evaluations, min normal force, max friction ratio (monitored
+        at every step).
     wall : float
         Seconds in the compiled kernel.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        (or any exception raised in the calling thread while it waits, such as
+        :class:`rollingtop._errors.Interrupted` from a signal): the trajectories stop within
+        :data:`STOP_POLL_STEPS` steps and the exception propagates; no result is returned.
     """
     states = np.ascontiguousarray(states, dtype=float)
     N = states.shape[0]
@@ -130,20 +180,46 @@ def integrate_batch(
     out = np.full((N, t_eval.size, N_STATE), np.nan)
     final = np.full((N, N_STATE), np.nan)
     stats = np.zeros((N, 6))
-    previous = numba.get_num_threads()
+    # numba's thread count is per thread: the worker takes the caller's (or ``threads``)
+    n_threads = numba.get_num_threads()
     if threads is not None:
-        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+        n_threads = max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
+    step = N if progress is None else BATCH
+    stop = np.zeros(1, dtype=np.int64)
+    done = [0]  # trajectories finished, written by the worker
+    failure: list[BaseException] = []
+
+    def work():
+        try:
+            numba.set_num_threads(n_threads)
+            for lo in range(0, N, step):
+                hi = min(N, lo + step)
+                with numba.parallel_chunksize(CHUNK):
+                    _batch(codes[lo:hi], params[lo:hi], states[lo:hi], t_eval, rtol, atol,
+                           max_steps, out[lo:hi], final[lo:hi], stats[lo:hi], stop)  # fmt: skip
+                if stop[0]:
+                    return
+                done[0] = hi
+        except BaseException as exc:  # pragma: no cover - re-raised in the calling thread
+            failure.append(exc)
+
+    start = time.perf_counter()
+    worker = threading.Thread(target=work, name="rollingtop-ensemble", daemon=True)
+    worker.start()
+    reported = 0
     try:
-        start = time.perf_counter()
-        step = N if progress is None else BATCH
-        for lo in range(0, N, step):
-            hi = min(N, lo + step)
-            with numba.parallel_chunksize(CHUNK):
-                _batch(codes[lo:hi], params[lo:hi], states[lo:hi], t_eval, rtol, atol,
-                       max_steps, out[lo:hi], final[lo:hi], stats[lo:hi])  # fmt: skip
-            if progress is not None:
-                progress(hi, N)
-        wall = time.perf_counter() - start
-    finally:
-        numba.set_num_threads(previous)
+        while worker.is_alive():
+            worker.join(WAIT_SLICE)
+            if progress is not None and reported < done[0] < N:
+                reported = done[0]
+                progress(reported, N)
+    except BaseException:
+        stop[0] = 1  # every trajectory sees it within STOP_POLL_STEPS steps
+        worker.join()
+        raise
+    wall = time.perf_counter() - start
+    if failure:
+        raise failure[0]
+    if progress is not None:
+        progress(N, N)
     return out, final, stats, wall
