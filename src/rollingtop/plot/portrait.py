@@ -48,6 +48,12 @@ def _abscissa(level: LevelSet, theta):
 
 
 def _orbit_curve(level: LevelSet, h: float, t1: float, t2: float, n: int = 400):
+    if level.pole == "both" and t2 - t1 >= 2 * math.pi * (1 - 1e-12):
+        # rolling over (no spin): theta runs round the circle; draw w_tau > 0 and < 0 branches
+        # over the plotted window, separated by a NaN so that they are not joined
+        theta = np.linspace(*level.theta_domain, 2 * n)
+        w = np.sqrt(np.maximum(2 * (h - level.U(theta)) / level.rho(theta), 0.0))
+        return np.concatenate([theta, [np.nan], theta]), np.concatenate([w, [np.nan], -w])
     phi = np.linspace(-math.pi / 2, math.pi / 2, n)
     theta = (t1 + t2) / 2 + (t2 - t1) / 2 * np.sin(phi)
     w = np.sqrt(np.maximum(2 * _gap(level, h, t1, t2, phi) / level.rho(theta), 0.0))
@@ -116,8 +122,8 @@ def phase_portrait(
             if o.kind == "steady":
                 continue
             x, y = _orbit_curve(level, h, o.theta_min, o.theta_max)
-            g_lo, g_hi = min(g_lo, x.min()), max(g_hi, x.max())
-            w_top = max(w_top, float(np.max(np.abs(y))))
+            g_lo, g_hi = min(g_lo, np.nanmin(x)), max(g_hi, np.nanmax(x))
+            w_top = max(w_top, float(np.nanmax(np.abs(y))))
             if separatrix or o.kind == "separatrix":
                 ax.plot(x, y, color="crimson", lw=1.8, zorder=3,
                         label=None if drawn_sep else "separatrix")  # fmt: skip
@@ -150,10 +156,12 @@ def phase_portrait(
             ax.plot(x, 0, "o", color="black", ms=5, zorder=4)
         else:
             ax.plot(x, 0, "x", color="crimson", ms=8, mew=2, zorder=4)
+    for pole_theta in level.pole_thetas:
+        ax.axvline(pole_theta, color="0.5", ls="--", lw=0.8, zorder=0)
     if level.pole:
-        ax.axvline(level.pole_theta, color="0.5", ls="--", lw=0.8, zorder=0)
-        ax.plot([], [], color="0.5", ls="--", lw=0.8, label=f"{level.pole} pole (gamma3 = "
-                f"{'+' if level.pole == 'south' else '-'}1)")  # fmt: skip
+        names = {"south": "south pole (gamma3 = +1)", "north": "north pole (gamma3 = -1)",
+                 "both": "poles (gamma3 = +1 at 0, -1 at pi)"}  # fmt: skip
+        ax.plot([], [], color="0.5", ls="--", lw=0.8, label=names[level.pole])
     ax.plot([], [], "o", color="black", ms=5, label="steady motion (centre)")
     if saddle_levels:
         ax.plot([], [], "x", color="crimson", ms=8, mew=2, label="steady motion (saddle)")
@@ -163,7 +171,8 @@ def phase_portrait(
     ax.axhline(0, color="0.85", lw=0.6, zorder=0)
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncols=3, fontsize=8,
                frameon=False)  # fmt: skip
-    pole = {None: "", "south": ", south pole case", "north": ", north pole case"}[level.pole]
+    pole = {None: "", "south": ", south pole case", "north": ", north pole case",
+            "both": ", no spin: both poles"}[level.pole]  # fmt: skip
     ax.set_title(
         rf"$M_3={level.M3:g},\ C_1={level.C1:g},\ C_2={level.C2:g}${pole}"
         "\n"

@@ -59,6 +59,10 @@ class Orbit:
         Largest ``|w_tau|`` on the orbit.
     note : str
         Plain-language remark (near separatrix, pole passage, ...), or empty.
+    pole_distance : float
+        Distance in ``theta`` of the orbit's nearer end from its pole, to full relative
+        precision (``theta_max = pi - pole_distance`` near the north pole rounds it): the width
+        of the gap next to the pole on a level near a pole level; NaN in a pole case.
     """
 
     gamma3_min: float
@@ -71,6 +75,7 @@ class Orbit:
     pole_passage: bool
     w_tau_max: float
     note: str = ""
+    pole_distance: float = math.nan
 
     def to_dict(self) -> dict:
         """JSON-ready dict (non-finite values become ``None``)."""
@@ -280,39 +285,47 @@ def _half_integrand(level: LevelSet, h: float, t_end: float, half, left: bool, w
 
 
 def _wall_period(level, h, theta1, theta2, walls, peaks, weight) -> tuple[float, float]:
-    """:func:`period` split at the middle, each half in the variable of :func:`_half_map`.
-
-    Each half is a Gauss-Legendre rule doubled until two successive values agree to
-    :data:`PERIOD_RTOL` (of the integral of ``|f|``); the reported error is the sum of the last
-    differences. A half that does not converge by 4096 nodes (a saddle near it) falls back to
-    the composite rule graded towards its ends and the saddles.
-    """
+    """:func:`period` split at the middle, each half by :func:`half_integral`."""
     mid = (theta1 + theta2) / 2
     total, error = 0.0, 0.0
     for t_end, wall, left in ((theta1, walls[0], True), (theta2, walls[1], False)):
-        half = _half_map(t_end, mid, wall, left)
-        f = _half_integrand(level, h, t_end, half, left, weight)
-        u_max = half[0]
-        x, w = np.polynomial.legendre.leggauss(32)
-        prev = float(np.sum(f(u_max * (x + 1) / 2) * w)) * u_max / 2
-        n, done = 64, False
-        while n <= 4096:
-            x, w = np.polynomial.legendre.leggauss(n)
-            vals = f(u_max * (x + 1) / 2) * w * (u_max / 2)
-            cur, size = float(np.sum(vals)), float(np.sum(np.abs(vals)))
-            if abs(cur - prev) <= PERIOD_RTOL * size:
-                total, error, done = total + cur, error + abs(cur - prev), True
-                break
-            prev, n = cur, 2 * n
-        if not done:
-            breaks = []
-            for p in peaks:
-                if min(t_end, mid) < p < max(t_end, mid):
-                    breaks.append(float(brentq(lambda u, p=p: half[1](u) - p, 0.0, u_max)))
-            coarse = _graded_gauss(f, 0.0, u_max, breaks, 20)
-            fine = _graded_gauss(f, 0.0, u_max, breaks, 30)
-            total, error = total + fine, error + abs(fine - coarse)
+        value, err = half_integral(level, h, t_end, mid, wall, left, peaks, weight)
+        total, error = total + value, error + err
     return total, error
+
+
+def half_integral(
+    level: LevelSet, h, t_end, mid, wall: bool, left: bool, peaks=(), weight=None
+) -> tuple[float, float]:
+    """Twice the time (or the integral of ``weight dt``) from the turning point ``t_end`` to the
+    interior point ``mid`` (in the variable of :func:`_half_map`). Returns ``(value, error)``.
+
+    A Gauss-Legendre rule doubled until two successive values agree to :data:`PERIOD_RTOL` (of
+    the integral of ``|f|``), the error being their difference; without convergence by 4096
+    nodes (a saddle near the half orbit) the composite rule graded towards the ends and the
+    saddles ``peaks``.
+    """
+    half = _half_map(t_end, mid, wall, left)
+    f = _half_integrand(level, h, t_end, half, left, weight)
+    u_max = half[0]
+    x, w = np.polynomial.legendre.leggauss(32)
+    prev = float(np.sum(f(u_max * (x + 1) / 2) * w)) * u_max / 2
+    n = 64
+    while n <= 4096:
+        x, w = np.polynomial.legendre.leggauss(n)
+        vals = f(u_max * (x + 1) / 2) * w * (u_max / 2)
+        cur, size = float(np.sum(vals)), float(np.sum(np.abs(vals)))
+        if abs(cur - prev) <= PERIOD_RTOL * size:
+            return cur, abs(cur - prev)
+        prev, n = cur, 2 * n
+    breaks = [
+        float(brentq(lambda u, p=p: half[1](u) - p, 0.0, u_max))
+        for p in peaks
+        if min(t_end, mid) < p < max(t_end, mid)
+    ]
+    coarse = _graded_gauss(f, 0.0, u_max, breaks, 20)
+    fine = _graded_gauss(f, 0.0, u_max, breaks, 30)
+    return fine, abs(fine - coarse)
 
 
 def _root(level: LevelSet, h: float, a: float, b: float) -> float:
@@ -394,6 +407,13 @@ def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, 
 
 
 def _orbits(level: LevelSet, h: float) -> list[Orbit]:
+    found = _components(level, h)
+    if level.pole is None:
+        found = [replace(o, pole_distance=min(o.theta_min, math.pi - o.theta_max)) for o in found]
+    return found
+
+
+def _components(level: LevelSet, h: float) -> list[Orbit]:
     lo_end, hi_end = level.theta_domain
     lo = _barrier_end(level, h, lo_end, +1)
     hi = _barrier_end(level, h, hi_end, -1)

@@ -67,6 +67,7 @@ def state_from_level(
     phi: float = 0.0,
     psi: float = 0.0,
     position=(0.0, 0.0),
+    theta: float | None = None,
 ) -> np.ndarray:
     """Full state on the level set ``(M3, C1, C2)`` with reduced energy ``h`` at ``gamma3``.
 
@@ -84,6 +85,9 @@ def state_from_level(
         Euler angles fixing the orientation (see the module docstring).
     position : (float, float)
         Horizontal CoM position.
+    theta : float, optional
+        The nutation angle in ``(0, pi)`` instead of ``gamma3`` (which is then ignored): keeps
+        the distance from the south pole to full precision (``cos(1e-12)`` rounds to 1).
 
     Returns
     -------
@@ -91,11 +95,16 @@ def state_from_level(
         Satisfies the meridian model's constraints; ``(M3, C1, C2, h)`` as given.
     """
     body = level.body
-    if not -1.0 < gamma3 < 1.0:
+    if theta is not None:
+        if not 0.0 < theta < math.pi:
+            raise LevelSetError(f"theta = {theta!r} must lie strictly inside (0, pi)")
+        gamma3 = math.cos(theta)
+    elif not -1.0 < gamma3 < 1.0:
         raise LevelSetError(f"gamma3 = {gamma3!r} must lie strictly inside (-1, 1)")
     if branch not in (1, -1):
         raise LevelSetError(f"branch = {branch!r} must be +1 or -1")
-    theta = math.acos(gamma3)
+    if theta is None:
+        theta = math.acos(gamma3)
     U = float(level.U(theta))
     if h < U - 1e-12 * max(1.0, abs(U)):
         raise LevelSetError(
@@ -111,7 +120,7 @@ def state_from_level(
     e3 = np.array([0.0, 0.0, 1.0])
     tau = np.cross(e3, gamma) / s
     n = np.cross(e3, tau)
-    nu = (e3 - gamma3 * gamma) / s
+    nu = np.array([-gamma3 * gamma[0] / s, -gamma3 * gamma[1] / s, s])  # (e3 - gamma3 gamma)/s
     alpha = math.cos(psi) * nu + math.sin(psi) * tau
     beta = math.sin(psi) * nu - math.cos(psi) * tau
     w = w_tau * tau + w_n * n + (level.M3 / body.I3) * e3
