@@ -200,7 +200,13 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
         dpsi, dpsi_err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max,
                                 peaks=peaks, weight=exact_level.psi_dot)  # fmt: skip
         theta0 = start_theta(orbit)
-    path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
+        if exact_level is not level:
+            # near the north pole: integrate the mirror image, where the wall next to the pole
+            # is resolved in theta; the same physical motion has psi + pi and theta -> pi - theta
+            start = exact_orbit.theta_min if theta0 == orbit.theta_max else exact_orbit.theta_max
+            path = reconstruct(exact_level, [0.0, T], theta0=start, w_tau0=0.0, psi0=math.pi)
+    if level.pole == "both" or exact_level is level:
+        path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
     D = complex(*path["position"][-1])
     turns = dpsi / (2 * math.pi)
     if abs(turns - round(turns)) < RESONANCE_TOLERANCE:

@@ -42,7 +42,6 @@ __all__ = ["no_spin_orbits", "rolling_over_period"]
 
 def _poles(level: LevelSet) -> tuple[float, float] | None:
     """``(theta of the centre, theta of the saddle)``, or ``None`` when ``U`` is constant."""
-    b = level.body
     k = b.m * b.g * b.a3
     if k == 0.0:
         return None
@@ -87,7 +86,6 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
     if level.pole != "both":
         raise LevelSetError(f"not a no-spin level: {level.describe()}")
     poles = _poles(level)
-    b = level.body
     rho_min = float(np.min(level.rho(np.array([0.0, math.pi]))))
     if poles is None:  # U constant: uniform rolling over (or rest)
         U0 = float(level.U(0.0))

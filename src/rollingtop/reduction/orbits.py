@@ -400,8 +400,10 @@ def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, 
     candidates = _orbits(mirrored, h)
     best = min(
         candidates,
-        key=lambda c: abs(math.pi - c.theta_max - orbit.theta_min)
-        + abs(math.pi - c.theta_min - orbit.theta_max),
+        key=lambda c: (
+            abs(math.pi - c.theta_max - orbit.theta_min)
+            + abs(math.pi - c.theta_min - orbit.theta_max)
+        ),
     )
     return mirrored, best
 
