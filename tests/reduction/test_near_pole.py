@@ -204,3 +204,26 @@ def test_mirror_image_is_the_same_motion(paper_body):
     direct = reconstruct(level, [0.0, orbit.period], theta0=start_theta(orbit), w_tau0=0.0)
     assert pm.displacement == pytest.approx(tuple(direct["position"][-1]), abs=1e-9)
     assert pm.delta_psi == pytest.approx(direct["psi"][-1], abs=1e-9)
+
+
+def test_full_simulation_near_the_pole_level(paper_body):
+    """The full equations on a level 1e-8 from the pole level: the period between turning
+    points and the friction coefficient needed agree with the reduction's."""
+    from rollingtop import simulate
+    from rollingtop.scenario import IntegrationOptions, LevelSpec, Scenario
+
+    M3, C1, C2, h = 1.0, 1.0 - 1e-8, -0.3, 1.1
+    level = LevelSet(paper_body, M3, C1, C2)
+    (orbit,) = orbits(level, h)
+    info = near_pole(level, h, orbit)
+    sc = Scenario(paper_body, "meridian", None,
+                  IntegrationOptions(t_end=8.0, rtol=1e-12, atol=1e-14, samples=11),
+                  level=LevelSpec(M3, C1, C2, h=h))  # fmt: skip
+    traj = simulate(sc, events="w_tau", event_direction=1)
+    assert traj.kernel_code == 0  # no pole case: the paper's geometric direction nu
+    periods = np.diff(traj.event_t)
+    assert len(periods) >= 2
+    np.testing.assert_allclose(periods, orbit.period, rtol=1e-8)
+    # the step-by-step monitoring samples the wall more coarsely than friction_needed: 5 %
+    mu = traj.step_reactions["max_friction_ratio"]
+    assert mu == pytest.approx(info.friction_needed, rel=0.05)
