@@ -19,6 +19,32 @@ constraint direction along the motion, regular at the pole. Away from the pole
 every step, so there the constraint is exactly the paper's. After each pole passage
 ``psi_nu = psi + pi``: the sign ``sigma = cos(psi_nu - psi)`` tells on which side of the pole the
 motion is, which is what keeps ``F6`` (odd under the passage) continuous in the monitoring.
+
+**No spin.** On ``M3 = C1 = 0`` both poles are pole levels at once (:func:`pole_case` says
+``"both"``, :func:`kernel_code` takes the south variant) and the exact rate is ``psi_nu' = 0``:
+the motion is planar rocking in a fixed vertical plane, through either pole. ``M3 = I3 w3`` read
+from the state is exactly 0 only in special orientations (round-off of the torque about ``e3``
+gives ``|w3|`` of a few ulps of ``|w|`` otherwise), and the variant's rate
+``M3 / (I1 (1 + gamma3))`` would turn such noise into a huge turn of ``nu`` at the north pole
+(and ``0/0`` there for an exact zero; measured: a general-orientation rocking motion stalled with
+"step size underflow" before this rule). So :func:`psi_nu_rate` is exactly 0 while
+``|M3| <= NO_SPIN_TOLERANCE |I w|``: this is the no-spin level to round-off, where the pole the
+variant is not made for is no wall but a passage.
+
+**Vertical start.** At a vertical axis ``gamma = (0, 0, +-1)`` the geometric ``nu`` is undefined,
+but every such state is on a pole level: ``C1 = (I w, gamma) = +-I3 w3 = +-M3`` exactly, whatever
+``w1, w2``. So a motion from it is started in the pole variant with the carried direction
+(:func:`vertical_direction`). That direction is not free when the axis moves: the axis leaves the
+vertical along ``gamma' = gamma x w``, and the meridian direction of the motion for ``t -> 0+``
+is ``nu = (e3 - gamma3 gamma)/s -> (w x e3)/|w x e3|`` at either pole, horizontal and across the
+horizontal part of ``w``. That is the only ``nu`` with which the state lies on its level's motion
+(``w_n = (w, n) = 0`` at the pole, as ``w_n = (M3 gamma3 - C1)/(I1 s) -> 0`` requires; with
+another ``nu`` the carried direction would leave the meridian plane at once and the area integral
+would not hold). Only when ``w1 = w2 = 0`` (the sleeping top) is ``nu`` free; it is then taken
+along the fixed ``x`` axis, ``nu = alpha`` (``psi_nu = 0``). An axis within
+:data:`POLE_TOLERANCE` of the vertical counts as vertical and is set exactly vertical
+(:func:`rollingtop.dynamics.state.initial_state`): so near it the geometric ``nu`` (which sweeps
+through all horizontal directions there) is never used to start a motion.
 """
 
 import math
@@ -33,7 +59,9 @@ CODE = 0
 #: Kernel codes of the pole cases (carried constraint direction), chosen by :func:`kernel_code`.
 SOUTH_CODE = 3
 NORTH_CODE = 4
-#: Below this ``sqrt(gamma1^2 + gamma2^2)`` the axis counts as vertical and ``nu`` is undefined.
+#: Below this ``sqrt(gamma1^2 + gamma2^2)`` the axis counts as vertical: the geometric ``nu`` is
+#: undefined (or sweeps through all directions), and an initial state there is set exactly
+#: vertical and started with the carried direction (module docstring, "Vertical start").
 POLE_TOLERANCE = 1e-8
 #: ``|C1 -+ M3|`` at most this times ``max(|M3|, |C1|)`` is a pole case: the one decision used by
 #: the simulator (:func:`kernel_code`), the reduction and every command (:func:`pole_case`). Small
@@ -43,6 +71,12 @@ POLE_TOLERANCE = 1e-8
 POLE_CASE_TOLERANCE = 1e-13
 #: Above this ``s`` the carried azimuth is re-synchronised with the geometric one (modulo pi).
 RESYNC_S = 0.05
+#: ``|M3| = |I3 w3|`` at most this times ``|I w|`` counts as no spin in the carried direction's
+#: rate (:func:`psi_nu_rate`): well above the round-off that the torque about ``e3`` leaves in
+#: ``w3`` of a planar motion (a few 1e-16 ``|w|``, measured), far below any spin that matters (a
+#: south level with ``|M3| = 1e-10 |I w|`` has its north-pole wall within ~1e-10 rad of the pole,
+#: where a passage and a reflection with ``psi`` turned by pi are the same motion).
+NO_SPIN_TOLERANCE = 1e-10
 
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
@@ -68,8 +102,12 @@ def nu_geometric(y):
 
 @njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
 def psi_nu_rate(p, y, north):
-    """``psi_nu' = M3 / (I1 (1 + gamma3))`` (south) or ``-M3 / (I1 (1 - gamma3))`` (north)."""
+    """``psi_nu' = M3 / (I1 (1 + gamma3))`` (south) or ``-M3 / (I1 (1 - gamma3))`` (north);
+    exactly 0 with no spin, ``|M3| <= NO_SPIN_TOLERANCE |I w|`` (see the module docstring)."""
     M3 = p[6] * y[5]
+    Iw1, Iw2 = p[4] * y[3], p[5] * y[4]
+    if M3 * M3 <= NO_SPIN_TOLERANCE * NO_SPIN_TOLERANCE * (Iw1 * Iw1 + Iw2 * Iw2 + M3 * M3):
+        return 0.0
     if north:
         return -M3 / (p[4] * (1.0 - y[14]))
     return M3 / (p[4] * (1.0 + y[14]))
@@ -118,16 +156,19 @@ def rows_pole(p, y, J, bias, dirs, north):
     return 2
 
 
-def pole_case(M3: float, C1: float) -> str | None:
+def pole_case(M3: float, C1: float, scale: float = 0.0) -> str | None:
     """Which pole the level set ``(M3, C1)`` lets touch the plane (paper Sec. 3.3).
 
     Returns ``"south"`` when ``C1 = M3`` (``gamma3 = 1`` can be reached), ``"north"`` when
     ``C1 = -M3``, ``"both"`` when ``M3 = C1 = 0`` (no spin: both poles at once), else ``None``;
-    equalities hold within :data:`POLE_CASE_TOLERANCE` times ``max(|M3|, |C1|)``.
+    equalities hold within :data:`POLE_CASE_TOLERANCE` times ``max(|M3|, |C1|, scale)``.
+    ``scale`` is the size of the terms ``M3, C1`` were computed from, where they may cancel: for
+    values read from a state, ``|I w|`` (``C1 = (I w, gamma)`` of a motion with no spin is a few
+    ulps of ``|I w|``, not 0). Without it (0) a value counts as zero only when it is exactly 0.
     """
     M3, C1 = float(M3), float(C1)
-    scale = max(abs(M3), abs(C1))
-    if scale == 0.0:
+    scale = max(abs(M3), abs(C1), float(scale))
+    if scale == 0.0 or max(abs(M3), abs(C1)) <= POLE_CASE_TOLERANCE * scale:
         return "both"
     if abs(C1 - M3) <= POLE_CASE_TOLERANCE * scale:
         return "south"
@@ -139,12 +180,15 @@ def pole_case(M3: float, C1: float) -> str | None:
 def kernel_code(body, y: np.ndarray) -> int:
     """Kernel code for a motion from state ``y``: :data:`SOUTH_CODE` / :data:`NORTH_CODE` on the
     pole level sets ``C1 = +-M3`` of a symmetric body (within :data:`POLE_CASE_TOLERANCE`), else
-    :data:`CODE`."""
+    :data:`CODE`. A vertical axis is always on a pole level (``C1 = +-M3`` there, see the module
+    docstring); no spin (``M3 = C1 = 0`` to round-off of ``|I w|``) takes the south variant, whose
+    direction then does not turn."""
     if not body.symmetric:
         return CODE
+    Iw = body.inertia * np.asarray(y[3:6], dtype=float)
     M3 = body.I3 * y[5]
-    C1 = float(np.dot(body.inertia * y[3:6], y[12:15]))
-    pole = pole_case(M3, C1)
+    C1 = float(np.dot(Iw, y[12:15]))
+    pole = pole_case(M3, C1, float(np.linalg.norm(Iw)))
     if pole == "north":
         return NORTH_CODE
     if pole is not None:  # "south", or "both" (no spin: the carried direction does not turn)
@@ -159,17 +203,41 @@ def tau_nu(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.array([-g2, g1, 0.0]) / s, np.array([-g3 * g1 / s, -g3 * g2 / s, s])
 
 
-def _singular(gamma: np.ndarray) -> str | None:
-    if math.hypot(gamma[0], gamma[1]) < POLE_TOLERANCE:
+def vertical_direction(omega, alpha, beta, psi_nu: float = 0.0) -> float:
+    """Azimuth ``psi_nu`` of the carried constraint direction at a vertical axis.
+
+    ``nu = cos(psi_nu) alpha + sin(psi_nu) beta`` (the convention of :func:`nu_carried`): the
+    azimuth of ``nu`` in the fixed frame, from the fixed ``x`` axis (``alpha``) towards ``y``
+    (``beta``). At ``gamma = (0, 0, +-1)`` it is the direction in which the axis leaves the
+    vertical, ``nu = (w x e3)/|w x e3|`` (module docstring); when ``w1 = w2 = 0`` the axis does
+    not leave it and ``nu`` is free: ``psi_nu`` is returned unchanged (0 for a new state:
+    ``nu = alpha``).
+    """
+    w1, w2 = float(omega[0]), float(omega[1])
+    if w1 == 0.0 and w2 == 0.0:
+        return float(psi_nu)
+    nu = np.array([w2, -w1, 0.0])  # w x e3, horizontal at either pole; its length cancels
+    return math.atan2(float(nu @ np.asarray(beta)), float(nu @ np.asarray(alpha)))
+
+
+def _singular(body, gamma: np.ndarray) -> str | None:
+    if gamma[0] == 0.0 and gamma[1] == 0.0 and not body.symmetric:
         return (
-            f"the symmetry axis is vertical (gamma3 = {gamma[2]:+.12g}): the meridian constraint "
-            "direction nu = (e3 - gamma3 gamma)/sqrt(1 - gamma3^2) is undefined"
+            f"the symmetry axis is vertical (gamma3 = {gamma[2]:+.12g}), where the meridian "
+            "constraint direction nu = (e3 - gamma3 gamma)/sqrt(1 - gamma3^2) is undefined, and "
+            f"the body is not dynamically symmetric (I1 = {body.I1:g}, I2 = {body.I2:g}): the "
+            "direction is carried through the vertical only on the pole levels of a symmetric body"
         )
     return None
 
 
 def _velocity(body, gamma, omega, alpha, beta, free):
-    tau, _ = tau_nu(gamma)
+    if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction (module docstring)
+        psi_nu = vertical_direction(omega, alpha, beta)
+        nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
+        tau = np.cross(nu, gamma)
+    else:
+        tau, _ = tau_nu(gamma)
     wxr = np.cross(omega, contact_arm(body, gamma))
     slip = free["v_tau"] + wxr @ tau  # contact-point velocity vp = slip * tau
     return -wxr + slip * tau
@@ -185,4 +253,7 @@ MODEL = ContactModel(
     integrals_general=("energy", "area"),
     velocity=_velocity,
     singular=_singular,
+    vertical_tolerance=POLE_TOLERANCE,
+    vertical_direction=vertical_direction,
+    select_code=kernel_code,
 )

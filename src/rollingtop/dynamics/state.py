@@ -58,6 +58,31 @@ def default_alpha(gamma: np.ndarray) -> np.ndarray:
     raise AssertionError("unreachable: some body axis is not vertical")
 
 
+def _vertical(model: ContactModel, gamma: np.ndarray) -> np.ndarray:
+    """``gamma`` set exactly vertical, ``(0, 0, +-1)``, where the model counts it as vertical
+    (``sqrt(gamma1^2 + gamma2^2)`` below :attr:`ContactModel.vertical_tolerance`)."""
+    if math.hypot(gamma[0], gamma[1]) < model.vertical_tolerance:
+        return np.array([0.0, 0.0, math.copysign(1.0, gamma[2])])
+    return gamma
+
+
+def _horizontal(alpha: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+    """``alpha`` made exactly orthogonal to ``gamma`` and unit (at a vertical ``gamma`` its third
+    component becomes exactly 0, which keeps the frame's zeros exact in the projection)."""
+    alpha = alpha - float(alpha @ gamma) * gamma
+    return alpha / np.linalg.norm(alpha)
+
+
+def _start_code(body: SphericalTop, model: ContactModel, y: np.ndarray) -> int:
+    """Kernel code used to project a new state: the model's own, except at a vertical axis, where
+    a model's variant (:meth:`ContactModel.kernel_code`: the meridian model's pole variant, which
+    carries ``nu``) is the only one defined. Away from the vertical the model's own code keeps the
+    constructed states exactly as they were before vertical starts existed."""
+    if y[12] == 0.0 and y[13] == 0.0:
+        return model.kernel_code(body, y)
+    return model.code
+
+
 def constraint_residuals(body: SphericalTop, model, y: np.ndarray) -> np.ndarray:
     """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
     model = get_model(model)
@@ -104,17 +129,27 @@ def initial_state(
     -------
     y : ndarray, shape (18,)
         ``(v, w, alpha, beta, gamma, X, Y, psi_nu)`` with ``beta = gamma x alpha`` and
-        ``psi_nu = atan2(beta3, alpha3)`` (0 when the axis is vertical).
+        ``psi_nu = atan2(beta3, alpha3)``, the azimuth of the axis in the fixed frame (see
+        "Vertical axis" for its value there).
+
+    Notes
+    -----
+    **Vertical axis.** A model with :attr:`~ContactModel.vertical_tolerance` (the meridian model:
+    ``1e-8``) takes an axis that close to the vertical as exactly vertical, ``gamma = (0, 0,
+    +-1)`` (and ``alpha`` re-orthogonalised to it); the others keep ``gamma`` as given. At an
+    exactly vertical axis ``psi_nu`` is the model's carried constraint direction,
+    ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``: for the meridian model
+    (:func:`rollingtop.contact.meridian.vertical_direction`) the direction in which the axis
+    leaves the vertical, ``(w x e3)/|w x e3|``, or ``nu = alpha`` (``psi_nu = 0``) when
+    ``w1 = w2 = 0``; the state lies on a pole level ``C1 = +-M3`` and
+    :func:`rollingtop.contact.meridian.kernel_code` picks the pole variant that carries ``nu``.
+    Other models: ``psi_nu = 0`` (unused).
     """
     model = get_model(model)
     free = dict(free or {})
     gamma = _unit("gamma", gamma)
     omega = _vector("omega", omega, 3)
-    if model.singular is not None and (why := model.singular(gamma)) is not None:
-        raise InitialStateError(f"model {model.name!r}: {why}")
-    if alpha is None:
-        alpha = default_alpha(gamma)
-    else:
+    if alpha is not None:
         alpha = _unit("alpha", alpha)
         dot = float(alpha @ gamma)
         if abs(dot) > UNIT_TOLERANCE:
@@ -122,8 +157,10 @@ def initial_state(
                 f"alpha = {alpha.tolist()} is not orthogonal to gamma ((alpha, gamma) = {dot:.3g}, "
                 f"tolerance {UNIT_TOLERANCE:g})"
             )
-        alpha = alpha - dot * gamma
-        alpha /= np.linalg.norm(alpha)
+    gamma = _vertical(model, gamma)
+    if model.singular is not None and (why := model.singular(body, gamma)) is not None:
+        raise InitialStateError(f"model {model.name!r}: {why}")
+    alpha = default_alpha(gamma) if alpha is None else _horizontal(alpha, gamma)
     beta = np.cross(gamma, alpha)
     position = _vector("position", position, 2)
 
@@ -139,6 +176,8 @@ def initial_state(
     y[6:9], y[9:12], y[12:15] = alpha, beta, gamma
     y[15:17] = position
     y[17] = math.atan2(beta[2], alpha[2]) if math.hypot(alpha[2], beta[2]) > 0 else 0.0
+    if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
+        y[17] = model.vertical_direction(omega, alpha, beta)
     if v is not None:
         if free:
             raise InitialStateError(
@@ -165,7 +204,7 @@ def initial_state(
             else:
                 values[name] = _vector(name, raw, length)
         y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
-    _kernel.project(model.code, body.params, y, _kernel.new_workspace())
+    _kernel.project(_start_code(body, model, y), body.params, y, _kernel.new_workspace())
     return y
 
 
@@ -175,11 +214,22 @@ def project_state(body: SphericalTop, model: str | ContactModel, y: np.ndarray) 
     Orientation, position and ``psi_nu`` are kept; the velocities ``u = (v, w)`` move to the
     nearest point of the constraint set in the kinetic-energy metric (the velocity projection of
     the integrator). Used to start several contact models from "the same" state.
+
+    At a vertical axis the rule of :func:`initial_state` applies: an axis within the model's
+    :attr:`~ContactModel.vertical_tolerance` is set exactly vertical, and ``psi_nu`` becomes the
+    model's carried direction there (meridian: the direction in which the axis leaves the
+    vertical; kept when ``w1 = w2 = 0``, where it is free).
     """
     model = get_model(model)
     y = np.array(y, dtype=float)
-    gamma = y[12:15]
-    if model.singular is not None and (why := model.singular(gamma)) is not None:
+    gamma = _vertical(model, y[12:15])
+    if model.singular is not None and (why := model.singular(body, gamma)) is not None:
         raise InitialStateError(f"model {model.name!r}: {why}")
-    _kernel.project(model.code, body.params, y, _kernel.new_workspace())
+    if gamma is not y[12:15]:  # set vertical: the frame follows
+        y[12:15] = gamma
+        y[6:9] = _horizontal(y[6:9], gamma)
+        y[9:12] = np.cross(gamma, y[6:9])
+    if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
+        y[17] = model.vertical_direction(y[3:6], y[6:9], y[9:12], y[17])
+    _kernel.project(_start_code(body, model, y), body.params, y, _kernel.new_workspace())
     return y
