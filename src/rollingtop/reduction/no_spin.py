@@ -42,6 +42,7 @@ __all__ = ["no_spin_orbits", "rolling_over_period"]
 
 def _poles(level: LevelSet) -> tuple[float, float] | None:
     """``(theta of the centre, theta of the saddle)``, or ``None`` when ``U`` is constant."""
+    b = level.body
     k = b.m * b.g * b.a3
     if k == 0.0:
         return None
