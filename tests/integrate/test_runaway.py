@@ -139,8 +139,9 @@ def test_ensemble_reports_runaway_trajectories_and_finishes_the_others():
     states = np.array(rows)
     n = len(rows)
     start = time.perf_counter()
-    _, final, stats, _ = integrate_batch(np.zeros(n, dtype=np.int64), np.tile(body.params, (n, 1)),
-                                         states, np.array([0.0, 5.0]), rtol=1e-10, atol=1e-12)  # fmt: skip
+    codes, params = np.zeros(n, dtype=np.int64), np.tile(body.params, (n, 1))
+    _, final, stats, _ = integrate_batch(codes, params, states, np.array([0.0, 5.0]), rtol=1e-10,
+                                         atol=1e-12)  # fmt: skip
     assert time.perf_counter() - start < RETURNS_WITHIN_S
     expected = [dop.FINISHED] + [dop.NOT_FINITE] * 4 + [dop.FINISHED]
     assert stats[:, 0].tolist() == expected

@@ -172,7 +172,7 @@ def _raise_for_status(status: int, ctrl: np.ndarray, counts: np.ndarray) -> None
                 "(initial values too large?)"
             )
         raise IntegrationError(
-            f"the state became non-finite at t = {t:.9g} "
+            f"the state (or every trial step from it) became non-finite at t = {t:.9g} "
             "(for the meridian model: the symmetry axis reached the vertical?)"
         )
     if status == dop.TOO_MANY_REJECTED:
