@@ -58,6 +58,10 @@ class LevelSet:
         Area integral ``F5 = (I w, gamma) = gamma3 M3 - I1 s w_n``.
     C2 : float
         The paper's integral ``F6``.
+    scale : float, optional
+        Size of the terms ``M3`` and ``C1`` were computed from, for values read from a state
+        (``|I w|``): then ``M3, C1`` within round-off of that size count as zero in the pole
+        decision (:func:`rollingtop.contact.meridian.pole_case`). Default 0: given values.
 
     Attributes
     ----------
@@ -82,6 +86,7 @@ class LevelSet:
     M3: float
     C1: float
     C2: float
+    scale: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("M3", "C1", "C2"):
@@ -96,7 +101,7 @@ class LevelSet:
                 f"the reduction needs a dynamically symmetric body (I1 = I2), got "
                 f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
             )
-        pole = pole_case(self.M3, self.C1)
+        pole = pole_case(self.M3, self.C1, scale=abs(float(self.scale)))
         if pole == "south":
             object.__setattr__(self, "C1", self.M3)
         elif pole == "north":
