@@ -100,9 +100,12 @@ def test_model_override(capsys):
             "alpha .* is not orthogonal to gamma",
         ),
         (
-            scenario_text(initial="gamma = [0.0, 0.0, -1.0]\nomega = [0.0, 0.0, 1.0]"),
+            scenario_text(
+                body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI2 = 0.35\nI3 = 0.5",
+                initial="gamma = [0.0, 0.0, -1.0]\nomega = [0.0, 0.0, 1.0]",
+            ),
             [],
-            "symmetry axis is vertical",
+            "symmetry axis is vertical .* not dynamically symmetric",
         ),
         (scenario_text(), ["--rtol", "x"], "Invalid value for '--rtol'"),
         (scenario_text(), ["--rtol", "2"], r"rtol = 2 must lie in \[1e-15, 0.1\]"),
@@ -151,3 +154,90 @@ def test_contact_loss_warns_on_stderr(tmp_path, capsys):
     assert code == 0
     assert json.loads(out)["reactions"]["contact_lost_at"] == pytest.approx(2.8305379, abs=1e-6)
     assert err.startswith("rollingtop: warning: the normal reaction turns negative at t = 2.83")
+
+
+def test_simulate_model_projects_like_compare(capsys):
+    """--model on a scenario whose free velocity belongs to another model: the state is
+    projected as `compare` does, a note says by how much, stdout stays one JSON object."""
+    from rollingtop import load_scenario
+    from rollingtop.simulate import simulate_models
+
+    paper = str(EXAMPLES / "paper.toml")
+    code, out, err = run_cli(capsys, "simulate", paper, "--t-end", "0.5", "--model", "rough",
+                             "--json")  # fmt: skip
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["model"] == "rough" and out.count("\n") == 1
+    (note,) = err.splitlines()
+    assert re.fullmatch(
+        r"rollingtop: note: initial state projected onto the rough model's constraints "
+        r"\(velocities changed by \|dv\| = [0-9.e+-]+, \|d omega\| = [0-9.e+-]+\)",
+        note,
+    ), note
+    sc = load_scenario(paper).with_overrides(t_end=0.5)
+    expected = simulate_models(sc, models=("rough",))["rough"].summary()
+    assert summary["final"] == expected["final"]
+    assert summary["integrals"]["energy"]["initial"] == expected["integrals"]["energy"]["initial"]
+    # the scenario's own model: nothing to say
+    code, out, err = run_cli(capsys, "simulate", paper, "--t-end", "0.1", "--model", "meridian")
+    assert code == 0 and err == ""
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["simulate", "{paper}", "--samples", "1000000000000"], "needs about 931.3 TiB of memory"),
+        (["simulate", "/dev/zero"], "not a regular file (it is a character device)"),
+        (["simulate", "{fifo}"], "not a regular file (it is a FIFO)"),
+        (["simulate", "{paper}", "--t-end", "z" * 5000], "'" + "z" * 80 + "…' is not a valid"),
+        (["simulate", "{paper}", "--model", "z" * 5000], "unknown contact model 'zzz"),
+        (["ensemble", "{paper}", "--grid", "omega3=1:2:2", "--samples", "10000000000"],
+         "--grid (2 trajectories of 10000000000 samples) needs about 7.9 TiB of memory"),
+        (["ensemble", "{paper}", "--grid", "omega3=1:3:100000,v_tau=0:1:100000"],
+         "--grid (10000000000 trajectories) needs about 37.3 TiB of memory"),
+        (["ensemble", "{paper}", "--initial", "{binary}"], "not UTF-8 text"),
+        (["ensemble", "{paper}", "--initial", "{fifo}"], "not a regular file (it is a FIFO)"),
+        (["ensemble", "{paper}", "--initial", "{inf}"], "'1e400' is not a finite number"),
+        (["path", "{paper}", "-o", "{tmp}/p.png", "--periods", "inf"], "--periods inf must lie"),
+        (["animate", "{paper}", "-o", "{tmp}/a.gif", "--duration", "1e9"], "more than 100000"),
+        (["portrait", "{paper}", "-o", "{tmp}/p.png", "--h-levels", "1,nan"], "must be finite"),
+        (["orbits", "{paper}", "--h", "inf"], "--h inf must be finite"),
+    ],
+)  # fmt: skip
+def test_hostile_input_refused_in_one_line(tmp_path, capsys, args, message):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    (tmp_path / "binary.csv").write_bytes(b"\xff\xfeomega3\n\x80\n")
+    (tmp_path / "inf.csv").write_text("omega3\n1e400\n")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    names = dict(paper=EXAMPLES / "paper.toml", fifo=fifo, binary=tmp_path / "binary.csv",
+                 inf=tmp_path / "inf.csv", tmp=tmp_path)  # fmt: skip
+    code, out, err = run_cli(capsys, *[a.format(**names) for a in args])
+    assert code == 2 and out == ""
+    (line,) = err.splitlines()
+    assert line.startswith("rollingtop: error: ") and message in line, line
+    assert len(line) < 400
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_line_breaks_in_a_message_are_escaped(tmp_path, capsys):
+    (tmp_path / "s.toml").write_text(scenario_text() + '\n["a\\nb\\u2028c"]\nx = 1\n')
+    code, _, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"))
+    assert code == 2
+    (line,) = err.splitlines()
+    assert "unknown table ['a\\nb\\u2028c']" in line
+
+
+def test_threads_above_the_cores_are_reduced_with_a_note(capsys):
+    import numba
+
+    cores = numba.config.NUMBA_NUM_THREADS
+    code, out, err = run_cli(capsys, "ensemble", str(EXAMPLES / "paper.toml"), "--grid",
+                             "omega3=1:2:2", "--t-end", "0.01", "--threads", str(cores + 7),
+                             "--json")  # fmt: skip
+    assert code == 0
+    assert json.loads(out)["threads"] == cores
+    assert err == (
+        f"rollingtop: note: --threads {cores + 7} is more than the {cores} cores available; "
+        f"used {cores}\n"
+    )

@@ -139,3 +139,43 @@ def test_cli_ensemble(capsys, tmp_path):
     assert code == 2 and "exactly one of --initial" in err
     code, _, err = run_cli(capsys, "ensemble", str(EXAMPLES / "paper.toml"), "--grid", "x=1:2:2")
     assert code == 2 and "unknown column x" in err
+
+
+def test_grid_and_samples_checked_before_allocating(paper_body):
+
+    cols = grid_table("omega3=1:3:3,v_tau=0:1:2")
+    assert cols["omega3"].tolist() == [1, 1, 2, 2, 3, 3] and cols["v_tau"].tolist() == [0, 1] * 3
+    with pytest.raises(ScenarioError, match=r"--grid \(10000000000 trajectories\) needs about"):
+        grid_table("omega3=1:3:100000,v_tau=0:1:100000")  # 1e10 rows: refused, not allocated
+    with pytest.raises(ScenarioError, match="count is too large"):
+        grid_table("omega3=1:3:" + "9" * 5000)
+    with pytest.raises(ScenarioError, match="must be finite"):
+        grid_table("omega3=nan:3:2")
+    y = initial_state(paper_body, "meridian", gamma=(0, 0.6, 0.8), omega=(0, 0, 2.0))
+    with pytest.raises(ScenarioError, match=r"\(1 trajectories of 10000000000 samples\)"):
+        simulate_ensemble(paper_body, "meridian", [y], t_end=1.0, samples=10**10)
+
+
+def test_threads_reduced_to_what_numba_may_use(paper_body):
+    import numba
+
+    y = initial_state(paper_body, "meridian", gamma=(0, 0.6, 0.8), omega=(0, 0, 2.0))
+    res = simulate_ensemble(paper_body, "meridian", [y], t_end=0.01, threads=10_000)
+    assert res.threads == numba.config.NUMBA_NUM_THREADS
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("omega3\n1e400\n", "'1e400' is not a finite number"),
+        ("omega3\nnan\n", "'nan' is not a finite number"),
+        ("omega3,omega3\n1,2\n", "the header names a column twice"),
+        ("omega3\n" + "x" * 10_000 + "\n", r"line 2: 'x{77}…' is not a number"),
+    ],
+)
+def test_bad_tables(tmp_path, text, message):
+    from rollingtop.ensemble import read_table
+
+    (tmp_path / "t.csv").write_text(text)
+    with pytest.raises(ScenarioError, match=message):
+        read_table(tmp_path / "t.csv")

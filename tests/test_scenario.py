@@ -1,5 +1,7 @@
 """Scenario files: the documented format loads, every malformed input is refused clearly."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -79,9 +81,12 @@ def test_overrides(tmp_path):
             "gamma .* is not a unit vector",
         ),
         (
-            dict(initial="gamma = [0.0, 0.0, 1.0]\nomega = [0.7, -0.3, 2.0]"),
+            dict(
+                body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI2 = 0.35\nI3 = 0.5",
+                initial="gamma = [0.0, 0.0, 1.0]\nomega = [0.7, -0.3, 2.0]",
+            ),
             InitialStateError,
-            "symmetry axis is vertical",
+            "symmetry axis is vertical .* not dynamically symmetric",
         ),
         (
             dict(initial="gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nspeed = 1"),
@@ -147,3 +152,89 @@ def test_level_table_builds_the_initial_state():
     assert float(red["w_tau"]) == pytest.approx(0.0, abs=1e-7)
     assert float(red["gamma3"]) == pytest.approx(-0.656411968, abs=1e-9)
     assert sc.level_h() == 4.0 and sc.level_set().C2 == -2.0
+
+
+BIG = "9" * 400
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        (dict(integration="samples = 1e12"), ScenarioError,
+         r"samples = 1000000000000 needs about 931.3 TiB of memory, more than the .* a run may"),
+        (dict(integration=f"max_steps = {2**63}"), ScenarioError,
+         r"max_steps = 9223372036854775808 must lie in \[1, 2\*\*62\]"),
+        (dict(integration="t_end = 5e-324"), ScenarioError,
+         "t_end = 4.94066e-324 is too small for 1001 samples"),
+        (dict(integration=f"t_end = {BIG}"), ScenarioError,
+         "t_end = <integer of 400 digits> is too large"),
+        (dict(body=f"R = {BIG}\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5"), ScenarioError,
+         "body.R = <integer of 400 digits> is too large"),
+        (dict(initial=f"gamma = [0.0, 0.6, 0.8]\nomega = [{BIG}, 0, 0]"), ScenarioError,
+         r"initial.omega\[0\] = <integer of 400 digits> is too large"),
+        (dict(initial='gamma = ["0", 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]'), ScenarioError,
+         r"initial.gamma\[0\] = '0' must be a number"),
+        (dict(initial="gamma = [0.0, 0.6, 0.8]\nomega = [true, 0, 0]"), ScenarioError,
+         r"initial.omega\[0\] = True must be a number"),
+        (dict(initial="gamma = [0.0, 0.6, 0.8]\nomega = {x = 1}"), ScenarioError,
+         r"initial.omega = \{'x': 1\} must be a list of 3 numbers"),
+        (dict(initial="gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nv_tau = [1]"),
+         ScenarioError, r"initial.v_tau = \[1\] must be a number"),
+        (dict(contact=f'model = "{"x" * 100_000}"'), ContactModelError,
+         r"unknown contact model 'x{77}…' \(known: meridian, smooth, rough\)$"),
+        (dict(contact="model = 3"), ContactModelError, "unknown contact model 3"),
+        (dict(body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n" + "k" * 5000
+                   + " = 1"),
+         ScenarioError, r"unknown key body.k{79}… \(allowed"),
+        (dict(body='R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n"a\\nb" = 1'),
+         ScenarioError, r"unknown key body.'a\\nb' \(allowed"),
+        (dict(level="M3 = 1.0\nC1 = 1.0\nC2 = -0.3\nbranch = 2"), ScenarioError,
+         "level.branch = 2 must be"),
+    ],
+)  # fmt: skip
+def test_hostile_values_refused_in_one_short_line(tmp_path, kwargs, error, message):
+    path = write(tmp_path, scenario_text(**kwargs))
+    with pytest.raises(error, match=message) as err:
+        load_scenario(path)
+    text = str(err.value)
+    assert str(path) in text and "\n" not in text and len(text) < 400
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b"\xef\xbb\xbf" + scenario_text().encode(), "starts with a UTF-8 byte-order mark"),
+        (b"[a]\nx = " + b"[" * 100_000 + b"]" * 100_000, "it is 195.3 KiB|nested too deeply"),
+        (b"[a]\nx = " + b"[" * 5000 + b"]" * 5000, "arrays or tables nested too deeply"),
+        (b"x" * (1 << 20) + b"x", r"it is 1 MiB, more than the 1 MiB an input file may have"),
+        (b"\x80\x81", "not UTF-8 text"),
+        (b"[integration]\nsamples = " + b"9" * 5000, "an integer with too many digits"),
+    ],
+    ids=["bom", "deep-big", "deep", "large", "binary", "5000-digits"],
+)
+def test_hostile_files_refused(tmp_path, content, message):
+    path = tmp_path / "s.toml"
+    path.write_bytes(content)
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario(path)
+
+
+def test_special_files_refused_without_reading(tmp_path):
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)  # no writer: opening or reading it normally would block forever
+    with pytest.raises(ScenarioError, match="not a regular file .it is a FIFO."):
+        load_scenario(fifo)
+    with pytest.raises(ScenarioError, match="not a regular file .it is a character device."):
+        load_scenario("/dev/zero")
+
+
+def test_samples_bounded_by_memory(monkeypatch, tmp_path):
+    from rollingtop import scenario as module
+
+    sc = load_scenario(write(tmp_path, scenario_text()))
+    limit = module.memory_limit()
+    assert 0 < limit <= 8 << 30
+    fits = limit // module.BYTES_PER_SAMPLE
+    assert sc.with_overrides(samples=fits).integration.samples == fits
+    with pytest.raises(ScenarioError, match="needs about .* of memory"):
+        sc.with_overrides(samples=fits + 1)

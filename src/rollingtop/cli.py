@@ -5,7 +5,11 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 
 from __future__ import annotations
 
+import contextlib
 import json
+import math
+import os
+import re
 import sys
 import warnings
 
@@ -22,17 +26,59 @@ from rollingtop.io import WriteFailed
 EXIT_USAGE = 2
 _NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
 EXIT_FAILURE = 1
+#: Bounds of the figure and animation commands' own options (samples and frames they imply).
+MAX_PERIODS = 1e5
+MAX_FRAMES = 100_000
+
+
+_LINE_BREAKS = {
+    ord(c): c.encode("unicode_escape").decode() for c in "\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029"
+}
+
+
+_LONG_QUOTE = re.compile(r"'([^']{80})[^']+'")
+_MAX_MESSAGE = 2000
+
+
+def _one_line(message: str) -> str:
+    """``message`` with line breaks escaped and long quoted values cut (click's messages quote
+    the whole value given): every report is one line of reasonable length."""
+    message = _LONG_QUOTE.sub(r"'\1…'", message.strip().translate(_LINE_BREAKS))
+    return message if len(message) <= _MAX_MESSAGE else message[: _MAX_MESSAGE - 1] + "…"
+
+
+def _note(message: str) -> None:
+    click.echo(f"rollingtop: note: {_one_line(message)}", err=True)
 
 
 def _fail(message: str, status: int = EXIT_USAGE) -> None:
-    click.echo(f"rollingtop: error: {message}", err=True)
+    click.echo(f"rollingtop: error: {_one_line(message)}", err=True)
     sys.exit(status)
+
+
+@contextlib.contextmanager
+def _warnings_as_lines():
+    """Python warnings that reach the command line (numerical ones from NumPy, say) as one
+    ``rollingtop: warning:`` line each, naming where they arose, instead of two raw lines."""
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        where = f"{os.path.basename(filename)}:{lineno}"
+        click.echo(f"rollingtop: warning: {_one_line(f'{message} ({where})')}", err=True)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = previous
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="rollingtop")
-def cli() -> None:
+@click.pass_context
+def cli(ctx: click.Context) -> None:
     """Rolling spherical tops under nonholonomic constraints (Kilin & Ivanova 2023)."""
+    ctx.with_resource(_warnings_as_lines())
 
 
 def _progress_bar():
@@ -120,10 +166,17 @@ def simulate(scenario, t_end, rtol, atol, samples, model, output, as_json):
 
     if output is not None:
         check_output_path(output, OUTPUT_SUFFIXES)
-    overrides = dict(t_end=t_end, rtol=rtol, atol=atol, samples=samples, model=model)
     from rollingtop.scenario import load_scenario
+    from rollingtop.simulate import switch_model
 
-    sc = load_scenario(scenario).with_overrides(**overrides)
+    sc = load_scenario(scenario).with_overrides(t_end=t_end, rtol=rtol, atol=atol, samples=samples)
+    if model is not None and model != sc.model.name:
+        sc, change = switch_model(sc, model)
+        dv, dw = math.hypot(*change[:3]), math.hypot(*change[3:])
+        _note(
+            f"initial state projected onto the {sc.model.name} model's constraints (velocities "
+            f"changed by |dv| = {dv:.3g}, |d omega| = {dw:.3g})"
+        )
     traj = _run_with_progress(run, sc)
     if output is not None:
         traj.save(output)
@@ -193,17 +246,24 @@ def orbits(scenario, h, as_json):
     from rollingtop.absolute import period_map
     from rollingtop.reduction import orbits as find_orbits
 
+    if h is not None and not math.isfinite(h):
+        raise click.UsageError(f"--h {h:g} must be finite")
     sc, level = _level_of(scenario)
     h = sc.level_h() if h is None else h
+    from rollingtop.reduction.near_pole import near_pole
+
     found = find_orbits(level, h)
     maps = [period_map(level, h, o) if o.kind == "periodic" else None for o in found]
+    poles = [near_pole(level, h, o) for o in found]
     if as_json:
         rows = []
-        for o, pm in zip(found, maps, strict=True):
+        for o, pm, npl in zip(found, maps, poles, strict=True):
             row = o.to_dict()
+            row["near_pole"] = None if npl is None else npl.to_dict()
             if pm is not None:
                 row.update(
                     delta_psi=pm.delta_psi,
+                    delta_psi_error=pm.delta_psi_error,
                     motion=pm.motion,
                     near_resonant=pm.near_resonant,
                     displacement=list(pm.displacement),
@@ -230,7 +290,7 @@ def orbits(scenario, h, as_json):
     )
     for col in cols:
         table.add_column(col, justify="left" if col in ("motion", "note") else "right")
-    for o, pm in zip(found, maps, strict=True):
+    for o, pm, npl in zip(found, maps, poles, strict=True):
         if pm is None:
             extra = ("-", o.kind, "-")
         elif pm.motion == "bounded":
@@ -248,7 +308,7 @@ def orbits(scenario, h, as_json):
             f"{o.period:.12g}",
             f"{o.period_error:.1e}",
             *extra,
-            o.note,
+            "; ".join(x for x in (o.note, npl.note() if npl else "") if x),
         )
     # fmt: skip
     _console().print(table)
@@ -274,14 +334,18 @@ def portrait(scenario, output, h_levels, no_contact):
     check_output_path(output, FIGURE_SUFFIXES)
     levels = None
     if h_levels is not None:
+        from rollingtop.scenario import short_repr
+
         try:
             levels = [float(x) for x in h_levels.split(",") if x.strip()]
         except ValueError:
             raise click.UsageError(
-                f"--h-levels {h_levels!r}: expected comma-separated numbers"
+                f"--h-levels {short_repr(h_levels)}: expected comma-separated numbers"
             ) from None
         if not levels:
             raise click.UsageError("--h-levels: no value given")
+        if not all(math.isfinite(x) for x in levels):
+            raise click.UsageError(f"--h-levels {short_repr(h_levels)}: values must be finite")
     _, level = _level_of(scenario)
     fig = phase_portrait(level, levels, show_contact=not no_contact)
     save_figure(fig, output)
@@ -356,8 +420,8 @@ def path(scenario, output, periods, t_end):
     from rollingtop.plot.paths import path_figure
     from rollingtop.simulate import simulate as run
 
-    if periods <= 0:
-        raise click.UsageError(f"--periods {periods:g} must be > 0")
+    if not 0 < periods <= MAX_PERIODS:
+        raise click.UsageError(f"--periods {periods:g} must lie in (0, {MAX_PERIODS:g}]")
     sc = _figure_scenario(scenario, output)
     pm = _meridian_map(sc)
     if t_end is None and pm is not None:
@@ -425,6 +489,10 @@ def animate(scenario, output, fps, duration, speed, camera):
     from rollingtop.simulate import simulate as run
 
     check_output_path(output, ANIMATION_SUFFIXES)
+    if not duration * fps <= MAX_FRAMES:
+        raise click.UsageError(
+            f"--duration {duration:g} at --fps {fps} makes more than {MAX_FRAMES} frames"
+        )
     n_frames = int(round(duration * fps))
     t_end = (n_frames - 1) / fps * speed if n_frames > 1 else speed / fps
     sc = load_scenario(scenario).with_overrides(t_end=t_end, samples=max(2, 4 * n_frames))
@@ -484,7 +552,10 @@ def animate(scenario, output, fps, duration, speed, camera):
     help="Keep this many samples per trajectory in OUT.nc (default: final states).",
 )
 @click.option(
-    "--threads", type=click.IntRange(min=1), default=None, help="Threads (default: all cores)."
+    "--threads",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Threads (default: all cores; more than the cores are reduced to them, with a note).",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print exactly one JSON object on stdout.")
 def ensemble(scenario, initial_csv, grid, output, t_end, rtol, atol, samples, threads, as_json):
@@ -498,7 +569,15 @@ def ensemble(scenario, initial_csv, grid, output, t_end, rtol, atol, samples, th
     if output is not None:
         check_output_path(output, (".nc",))
     sc = load_scenario(scenario).with_overrides(t_end=t_end, rtol=rtol, atol=atol)
-    columns = read_table(initial_csv) if initial_csv is not None else grid_table(grid)
+    columns = read_table(initial_csv) if initial_csv is not None else grid_table(grid, samples)
+    reduced = None
+    if threads is not None:
+        import numba
+
+        cores = numba.config.NUMBA_NUM_THREADS
+        if threads > cores:  # said once the input is known to be good, below
+            reduced = f"--threads {threads} is more than the {cores} cores available; used {cores}"
+            threads = cores
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
@@ -518,6 +597,8 @@ def ensemble(scenario, initial_csv, grid, output, t_end, rtol, atol, samples, th
             )
     else:
         result = ensemble_from_scenario(sc, columns, **kwargs)
+    if reduced is not None:
+        _note(reduced)
     if output is not None:
         result.to_netcdf(output)
     summary = result.summary()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 import re
@@ -19,12 +18,35 @@ from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.integrate.driver import compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
-from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
-from rollingtop.scenario import InitialConditions, Scenario
+from rollingtop.io import check_output_path, netcdf_bytes, read_input_text, write_bytes_atomic
+from rollingtop.scenario import (
+    InitialConditions,
+    Scenario,
+    check_memory,
+    short_name,
+    short_repr,
+)
 
 __all__ = ["EnsembleResult", "simulate_ensemble", "states_from_table", "grid_table"]
 
 STATUS = {0: "finished", -1: "step size underflow", -2: "non-finite state", 1: "max_steps reached"}
+
+#: Largest CSV table of initial states read (bytes).
+MAX_TABLE_BYTES = 64 << 20
+#: Rough memory of one trajectory without samples (input and final states, statistics,
+#: integrals, the Python objects of its row), and of one kept sample of one trajectory (the
+#: samples array, the dataset and its serialised file), used to refuse ensembles that cannot fit
+#: in :func:`rollingtop.scenario.memory_limit` before anything is allocated.
+BYTES_PER_TRAJECTORY = 4096
+BYTES_PER_TRAJECTORY_SAMPLE = 3 * N_STATE * 8
+
+
+def check_ensemble_memory(n: int, samples: int | None, what: str = "the ensemble") -> None:
+    """Refuse (``ScenarioError``, with the size) an ensemble of ``n`` trajectories keeping
+    ``samples`` samples each whose memory exceeds :func:`rollingtop.scenario.memory_limit`."""
+    needed = n * (BYTES_PER_TRAJECTORY + (samples or 0) * BYTES_PER_TRAJECTORY_SAMPLE)
+    label = f"{what} ({n} trajectories" + (f" of {samples} samples)" if samples else ")")
+    check_memory(label, needed)
 
 
 @dataclass
@@ -184,11 +206,17 @@ def simulate_ensemble(
         Keep this many equally spaced samples per trajectory (memory ``N * samples * 18``);
         default: keep only the final states.
     threads : int, optional
-        Number of threads (default: all cores).
+        Number of threads (default: all cores). More than numba may use
+        (``numba.config.NUMBA_NUM_THREADS``, the cores by default) are reduced to that number;
+        the result's ``threads`` says how many ran.
     progress : callable, optional
         ``progress(done, N)``.
     """
     model = get_model(model)
+    if samples is not None:
+        if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 2:
+            raise ScenarioError(f"samples = {short_repr(samples)} must be an integer >= 2")
+        check_ensemble_memory(len(states), int(samples))
     states = np.array(states, dtype=float)
     if states.ndim != 2 or states.shape[1] != N_STATE:
         raise ScenarioError(f"states must have shape (N, {N_STATE}), got {states.shape}")
@@ -205,8 +233,6 @@ def simulate_ensemble(
     atol = rtol / 100 if atol is None else atol
     if not atol > 0:
         raise ScenarioError(f"atol = {atol:g} must be > 0")
-    if samples is not None and samples < 2:
-        raise ScenarioError(f"samples = {samples} must be >= 2")
     from rollingtop.dynamics.state import constraint_residuals
 
     for k, (b, y) in enumerate(zip(bodies, states, strict=True)):
@@ -218,6 +244,12 @@ def simulate_ensemble(
                 f"state {k + 1} violates the constraint {which} of model {model.name!r} "
                 "(build states with rollingtop.initial_state for the same body)"
             )
+    import numba
+
+    if threads is not None:
+        if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
+            raise ScenarioError(f"threads = {short_repr(threads)} must be an integer >= 1")
+        threads = min(int(threads), numba.config.NUMBA_NUM_THREADS)  # what is really used
     codes = np.full(N, model.code, dtype=np.int64)
     if model.name == "meridian":
         codes = np.array([meridian.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)])
@@ -227,8 +259,6 @@ def simulate_ensemble(
     out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol, atol=atol,
                                               max_steps=max_steps, threads=threads,
                                               progress=progress)  # fmt: skip
-    import numba
-
     used = numba.get_num_threads() if threads is None else int(threads)
     integrals = _ensemble_integrals(model, bodies, codes, states, final)
     return EnsembleResult(
@@ -294,9 +324,11 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
     allowed = _column_map(model)
     unknown = [c for c in columns if c not in allowed]
     if unknown:
+        shown = ", ".join(short_name(c) for c in unknown[:5]) + (
+            ", ..." if len(unknown) > 5 else ""
+        )
         raise ScenarioError(
-            f"unknown column {', '.join(unknown)} for model {model.name!r} (allowed: "
-            f"{', '.join(allowed)})"
+            f"unknown column {shown} for model {model.name!r} (allowed: {', '.join(allowed)})"
         )
     lengths = {len(v) for v in columns.values()}
     if len(lengths) != 1:
@@ -347,57 +379,74 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
 _GRID = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*([^:]+):([^:]+):(\d+)\s*$")
 
 
-def grid_table(spec: str) -> dict[str, np.ndarray]:
-    """Columns of a Cartesian grid from ``"name=start:stop:count,name=..."``."""
+def grid_table(spec: str, samples: int | None = None) -> dict[str, np.ndarray]:
+    """Columns of a Cartesian grid from ``"name=start:stop:count,name=..."``.
+
+    The grid's size is checked against the memory limit (with ``samples`` kept per
+    trajectory, if given) before anything is allocated.
+    """
     axes = []
     for part in spec.split(","):
+        shown = short_repr(part.strip())
         m = _GRID.match(part)
         if not m:
-            raise ScenarioError(f"--grid {part.strip()!r}: expected name=start:stop:count")
+            raise ScenarioError(f"--grid {shown}: expected name=start:stop:count")
         name, a, b, count = m.groups()
         try:
-            a, b, count = float(a), float(b), int(count)
+            a, b = float(a), float(b)
         except ValueError:
-            raise ScenarioError(
-                f"--grid {part.strip()!r}: start and stop must be numbers"
-            ) from None
+            raise ScenarioError(f"--grid {shown}: start and stop must be numbers") from None
+        if len(count) > 18:
+            raise ScenarioError(f"--grid {shown}: count is too large")
+        count = int(count)
+        if not (math.isfinite(a) and math.isfinite(b)):
+            raise ScenarioError(f"--grid {shown}: start and stop must be finite")
         if count < 1:
-            raise ScenarioError(f"--grid {part.strip()!r}: count must be >= 1")
-        axes.append((name, np.linspace(a, b, count)))
+            raise ScenarioError(f"--grid {shown}: count must be >= 1")
+        axes.append((name, a, b, count))
     names = [a[0] for a in axes]
     if len(set(names)) != len(names):
         raise ScenarioError("--grid names a column twice")
-    rows = list(itertools.product(*[a[1] for a in axes]))
-    return {name: np.array([r[i] for r in rows]) for i, name in enumerate(names)}
+    check_ensemble_memory(math.prod(a[3] for a in axes), samples, "--grid")
+    mesh = np.meshgrid(*[np.linspace(a, b, n) for _, a, b, n in axes], indexing="ij")
+    return {name: m.ravel() for name, m in zip(names, mesh, strict=True)}
 
 
 def read_table(path) -> dict[str, np.ndarray]:
     """Columns of a CSV file with a header row (``#`` comment lines allowed)."""
     path = Path(path)
-    try:
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines()
-                 if ln.strip() and not ln.lstrip().startswith("#")]  # fmt: skip
-    except OSError as exc:
-        raise ScenarioError(f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    text = read_input_text(path, "table", MAX_TABLE_BYTES, ScenarioError)
+    lines = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
+             if ln.strip() and not ln.lstrip().startswith("#")]  # fmt: skip
     if len(lines) < 2:
         raise ScenarioError(f"{path}: expected a header row and at least one data row")
-    header = [h.strip() for h in lines[0].split(",")]
-    data = []
-    for k, line in enumerate(lines[1:], start=2):
+    header = [h.strip() for h in lines[0][1].split(",")]
+    if len(set(header)) != len(header):
+        raise ScenarioError(f"{path}: the header names a column twice")
+    check_ensemble_memory(len(lines) - 1, None, f"{path}")
+    data = np.empty((len(lines) - 1, len(header)))
+    for row, (k, line) in enumerate(lines[1:]):
         cells = line.split(",")
         if len(cells) != len(header):
             raise ScenarioError(f"{path}: line {k} has {len(cells)} values, header {len(header)}")
-        try:
-            data.append([float(c) for c in cells])
-        except ValueError:
-            raise ScenarioError(f"{path}: line {k}: not a number in {line!r}") from None
-    arr = np.array(data)
-    return {h: arr[:, i] for i, h in enumerate(header)}
+        for i, cell in enumerate(cells):
+            try:
+                data[row, i] = x = float(cell)
+            except ValueError:
+                raise ScenarioError(
+                    f"{path}: line {k}: {short_repr(cell.strip())} is not a number"
+                ) from None
+            if not math.isfinite(x):
+                raise ScenarioError(
+                    f"{path}: line {k}: {short_repr(cell.strip())} is not a finite number"
+                )
+    return {h: data[:, i] for i, h in enumerate(header)}
 
 
 def ensemble_from_scenario(scenario: Scenario, columns: dict, **kwargs) -> EnsembleResult:
     """Run the scenario's body and model over the initial states of ``columns``."""
     opts = scenario.integration
+    check_ensemble_memory(len(next(iter(columns.values()), ())), kwargs.get("samples"))
     kwargs.setdefault("t_end", opts.t_end)
     kwargs.setdefault("rtol", opts.rtol)
     kwargs.setdefault("atol", opts.resolved_atol if kwargs["rtol"] == opts.rtol else None)

@@ -12,12 +12,18 @@ A scenario names a body, a contact model, initial conditions and integration opt
                   initial state is built on that level (``reduction.state_from_level``)
 
 Unknown tables and keys are errors, so that a typo never silently falls back to a default.
+Scenario files are read only when they are regular files of at most :data:`MAX_SCENARIO_BYTES`
+(1 MiB) of UTF-8 text without a byte-order mark (a BOM is refused, saying so). Quoted values are
+cut to 80 characters in messages. ``samples`` is bounded so that a run's samples fit in
+:func:`memory_limit` (8 GiB, or half the physical memory if less), ``max_steps`` by ``2**62``.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import re
+import sys
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -25,10 +31,11 @@ from typing import Any
 
 import numpy as np
 
-from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._errors import ContactModelError, RollingTopError, ScenarioError
 from rollingtop.body import SphericalTop
-from rollingtop.contact import ContactModel, get_model
+from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.dynamics.state import initial_state
+from rollingtop.io import format_bytes, read_input_text
 
 __all__ = [
     "DEFAULTS",
@@ -45,22 +52,104 @@ DEFAULT_MODEL = "meridian"
 
 _BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3", "I2")
 _INITIAL_KEYS = ("gamma", "omega", "alpha", "position", "v")
+_VECTOR_LENGTHS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3}
 _LEVEL_KEYS = ("M3", "C1", "C2", "h", "gamma3", "branch", "phi", "psi")
+
+#: Largest scenario file read (bytes).
+MAX_SCENARIO_BYTES = 1 << 20
+#: Largest ``max_steps`` (the integrator's own "no limit").
+MAX_STEPS_LIMIT = 2**62
+#: Rough memory of one output sample of a single run (state, diagnostics, integrals, the
+#: dataset and its serialised file), used to refuse ``samples`` that cannot fit.
+BYTES_PER_SAMPLE = 1024
+#: Cap on the memory a run may plan for, before the physical-memory bound.
+MEMORY_CAP_BYTES = 8 << 30
+
+_QUOTE_CHARS = 80
+
+
+def short_repr(value: Any, limit: int = _QUOTE_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters (with an ellipsis), for error messages."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:
+        try:
+            return f"<integer of {len(str(abs(value)))} digits>"
+        except ValueError:  # longer than Python converts to text
+            return f"<integer of about {int(value.bit_length() * 0.30103)} digits>"
+    if isinstance(value, str) and len(value) > limit:
+        return repr(value[: limit - 3] + "…")
+    if isinstance(value, list | tuple | dict) and len(value) > limit:
+        return f"<{type(value).__name__} of {len(value)} items>"
+    try:
+        text = repr(value)
+    except (RecursionError, ValueError):
+        return f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def short_name(key: str, limit: int = _QUOTE_CHARS) -> str:
+    """A TOML key for a message: bare keys as they are, others quoted; cut to ``limit``."""
+    key = str(key)
+    if not re.fullmatch(r"[A-Za-z0-9_-]+", key):
+        return short_repr(key, limit)
+    return key if len(key) <= limit else key[: limit - 1] + "…"
+
+
+def memory_limit() -> int:
+    """Bytes a run may plan to allocate: :data:`MEMORY_CAP_BYTES` (8 GiB), or half the physical
+    memory when that is less."""
+    try:
+        physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return MEMORY_CAP_BYTES
+    return min(MEMORY_CAP_BYTES, physical // 2) if physical > 0 else MEMORY_CAP_BYTES
+
+
+def check_memory(what: str, needed: float) -> None:
+    """Refuse (``ScenarioError``) when ``needed`` bytes exceed :func:`memory_limit`."""
+    limit = memory_limit()
+    if needed > limit:
+        raise ScenarioError(
+            f"{what} needs about {format_bytes(needed)} of memory, more than the "
+            f"{format_bytes(limit)} a run may use (the lesser of 8 GiB and half the physical "
+            "memory)"
+        )
 
 
 def _number(where: str, key: str, value: Any, *, integer: bool = False) -> float | int:
     if isinstance(value, bool) or not isinstance(value, int | float):
         kind = "an integer" if integer else "a number"
-        raise ScenarioError(f"{where}.{key} = {value!r} must be {kind}")
+        raise ScenarioError(f"{where}.{key} = {short_repr(value)} must be {kind}")
     if integer:
         if isinstance(value, float):
             if not value.is_integer():
-                raise ScenarioError(f"{where}.{key} = {value!r} must be an integer")
+                raise ScenarioError(f"{where}.{key} = {short_repr(value)} must be an integer")
             value = int(value)
         return value
-    if not math.isfinite(value):
-        raise ScenarioError(f"{where}.{key} = {value!r} must be finite")
-    return float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        raise ScenarioError(f"{where}.{key} = {short_repr(value)} is too large") from None
+    if not math.isfinite(x):
+        raise ScenarioError(f"{where}.{key} = {short_repr(value)} must be finite")
+    return x
+
+
+def _vector(where: str, key: str, value: Any, length: int) -> tuple[float, ...]:
+    """A list of ``length`` finite real numbers (no strings, booleans or tables in it)."""
+    if not isinstance(value, list | tuple) or len(value) != length:
+        raise ScenarioError(
+            f"{where}.{key} = {short_repr(value)} must be a list of {length} numbers"
+        )
+    return tuple(_number(where, f"{key}[{i}]", x) for i, x in enumerate(value))
+
+
+def check_model_name(where: str, name: Any) -> str:
+    """``name`` if it names a contact model, else a ``ScenarioError`` quoting it (shortened)."""
+    if not isinstance(name, str) or name not in MODELS:
+        raise ContactModelError(
+            f"{where}: unknown contact model {short_repr(name)} (known: {', '.join(MODELS)})"
+        )
+    return name
 
 
 @dataclass(frozen=True)
@@ -101,9 +190,18 @@ class IntegrationOptions:
         if atol <= 0:
             raise ScenarioError(f"integration.atol = {atol:g} must be > 0")
         if samples < 2:
-            raise ScenarioError(f"integration.samples = {samples} must be >= 2")
-        if max_steps < 1:
-            raise ScenarioError(f"integration.max_steps = {max_steps} must be >= 1")
+            raise ScenarioError(f"integration.samples = {short_repr(samples)} must be >= 2")
+        check_memory(f"integration.samples = {short_repr(samples)}", samples * BYTES_PER_SAMPLE)
+        if not 1 <= max_steps <= MAX_STEPS_LIMIT:
+            raise ScenarioError(
+                f"integration.max_steps = {short_repr(max_steps)} must lie in [1, 2**62]"
+            )
+        step = t_end / (samples - 1)
+        if step < sys.float_info.min or step <= 4 * math.ulp(t_end):
+            raise ScenarioError(
+                f"integration.t_end = {t_end:g} is too small for {samples} samples (their "
+                "spacing is not representable)"
+            )
         for k, val in (
             ("t_end", t_end),
             ("rtol", rtol),
@@ -182,8 +280,11 @@ class LevelSpec:
             value = getattr(self, key)
             if value is not None:
                 object.__setattr__(self, key, _number("level", key, value))
-        if self.branch not in (1, -1) or isinstance(self.branch, bool):
-            raise ScenarioError(f"level.branch = {self.branch!r} must be +1 or -1")
+        if isinstance(self.branch, bool) or not isinstance(self.branch, int | float):
+            raise ScenarioError(f"level.branch = {short_repr(self.branch)} must be +1 or -1")
+        if self.branch not in (1, -1):
+            raise ScenarioError(f"level.branch = {short_repr(self.branch)} must be +1 or -1")
+        object.__setattr__(self, "branch", int(self.branch))
 
 
 @dataclass(frozen=True)
@@ -274,6 +375,8 @@ class Scenario:
                 f"unknown override {', '.join(unknown)} (allowed: {', '.join(sorted(allowed))})"
             )
         model = overrides.pop("model", self.model)
+        if not isinstance(model, ContactModel):
+            model = check_model_name("model", model)
         integration = replace(self.integration, **overrides) if overrides else self.integration
         return Scenario(self.body, get_model(model), self.initial, integration, self.source,
                         self.level)  # fmt: skip
@@ -284,7 +387,9 @@ class Scenario:
         allowed_tables = ("body", "contact", "initial", "integration", "level")
         for key, value in data.items():
             if key not in allowed_tables:
-                raise ScenarioError(f"unknown table [{key}] (allowed: {', '.join(allowed_tables)})")
+                raise ScenarioError(
+                    f"unknown table [{short_name(key)}] (allowed: {', '.join(allowed_tables)})"
+                )
             if not isinstance(value, dict):
                 raise ScenarioError(f"[{key}] must be a table")
         if "body" not in data:
@@ -297,11 +402,12 @@ class Scenario:
         missing = [k for k in _BODY_KEYS[:-1] if k not in body_t]
         if missing:
             raise ScenarioError(f"[body] is missing {', '.join(missing)}")
-        body = SphericalTop(**{k: body_t[k] for k in _BODY_KEYS if k in body_t})
+        body = SphericalTop(**{k: _number("body", k, body_t[k]) for k in _BODY_KEYS
+                               if k in body_t})  # fmt: skip
 
         contact_t = data.get("contact", {})
         _reject_unknown("contact", contact_t, ("model",))
-        model = get_model(contact_t.get("model", DEFAULT_MODEL))
+        model = get_model(check_model_name("contact.model", contact_t.get("model", DEFAULT_MODEL)))
 
         level = None
         if "level" in data:
@@ -322,12 +428,18 @@ class Scenario:
         for key in init_t:
             if key not in _INITIAL_KEYS + free_keys:
                 raise ScenarioError(
-                    f"unknown key initial.{key} for model {model.name!r} (allowed: "
-                    f"{', '.join(_INITIAL_KEYS + free_keys)})"
+                    f"unknown key initial.{short_name(key)} for model {model.name!r} "
+                    f"(allowed: {', '.join(_INITIAL_KEYS + free_keys)})"
                 )
         for required in ("gamma", "omega"):
             if required not in init_t:
                 raise ScenarioError(f"[initial] is missing {required}")
+        for key, value in init_t.items():
+            length = _VECTOR_LENGTHS.get(key, model.free_velocity.get(key))
+            if length == 1:
+                init_t[key] = _number("initial", key, value)
+            else:
+                init_t[key] = _vector("initial", key, value, length)
         initial = InitialConditions(
             gamma=init_t["gamma"],
             omega=init_t["omega"],
@@ -342,7 +454,9 @@ class Scenario:
 def _reject_unknown(table: str, values: dict, allowed: tuple[str, ...]) -> None:
     for key in values:
         if key not in allowed:
-            raise ScenarioError(f"unknown key {table}.{key} (allowed: {', '.join(allowed)})")
+            raise ScenarioError(
+                f"unknown key {table}.{short_name(key)} (allowed: {', '.join(allowed)})"
+            )
 
 
 def load_scenario(path: str | os.PathLike) -> Scenario:
@@ -356,16 +470,15 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
         Any other inadmissible content (body, model, initial conditions), with the file named.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario {str(path)!r}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ScenarioError(f"cannot read scenario {str(path)!r}: not UTF-8 text") from None
+    text = read_input_text(path, "scenario", MAX_SCENARIO_BYTES, ScenarioError)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: invalid TOML: {exc}") from None
+    except RecursionError:
+        raise ScenarioError(f"{path}: invalid TOML: arrays or tables nested too deeply") from None
+    except ValueError:  # an integer beyond Python's limit on converting digits (4300)
+        raise ScenarioError(f"{path}: invalid TOML: an integer with too many digits") from None
     try:
         return Scenario.from_dict(data, source=str(path))
     except RollingTopError as exc:

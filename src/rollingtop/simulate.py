@@ -5,14 +5,42 @@ from __future__ import annotations
 import os
 import warnings
 from collections.abc import Callable
+from dataclasses import replace
+
+import numpy as np
 
 from rollingtop._errors import ContactLostWarning
-from rollingtop.contact import meridian
+from rollingtop.contact import ContactModel, get_model, meridian
 from rollingtop.integrate import integrate
-from rollingtop.scenario import Scenario, load_scenario
+from rollingtop.scenario import InitialConditions, Scenario, check_model_name, load_scenario
 from rollingtop.trajectory import Trajectory
 
-__all__ = ["simulate", "simulate_models"]
+__all__ = ["simulate", "simulate_models", "switch_model"]
+
+
+def switch_model(scenario: Scenario, model) -> tuple[Scenario, np.ndarray]:
+    """The scenario's initial state under another contact model, as :func:`simulate_models`
+    starts it: projected onto ``model``'s constraints
+    (:func:`rollingtop.dynamics.state.project_state`: orientation and position kept,
+    velocities moved to the nearest admissible ones in the kinetic-energy metric).
+
+    Returns the new scenario (its ``[level]`` dropped: the reduction is the meridian model's)
+    and the change of the velocities ``(v, omega)``, shape (6,); for the scenario's own model,
+    the scenario itself and zeros.
+    """
+    if not isinstance(model, ContactModel):
+        model = get_model(check_model_name("model", model))
+    if model.name == scenario.model.name:
+        return scenario, np.zeros(6)
+    switched = _projected(scenario, model)
+    return switched, switched.require_state()[:6] - scenario.require_state()[:6]
+
+
+def _projected(scenario: Scenario, model) -> Scenario:
+    from rollingtop.dynamics.state import project_state
+
+    y = project_state(scenario.body, model, scenario.require_state())
+    return replace(scenario, model=model, initial=InitialConditions.from_state(y), level=None)
 
 
 def simulate(
@@ -38,7 +66,9 @@ def simulate(
     event_direction : int
         ``+1`` rising zeros only, ``-1`` falling only, ``0`` both.
     **overrides
-        ``t_end, rtol, atol, samples, max_steps`` or ``model``, replacing the scenario's values.
+        ``t_end, rtol, atol, samples, max_steps`` or ``model``, replacing the scenario's values;
+        under another ``model`` the initial state is projected onto its constraints
+        (:func:`switch_model`).
 
     Warns
     -----
@@ -48,6 +78,9 @@ def simulate(
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
+    model = overrides.pop("model", None)
+    if model is not None:
+        scenario, _ = switch_model(scenario, model)
     scenario = scenario.with_overrides(**overrides)
     opts = scenario.integration
     y0 = scenario.require_state()
@@ -109,17 +142,10 @@ def simulate_models(
     moved to the nearest admissible ones in the kinetic-energy metric), so each model starts as
     close as it allows to the same state. Returns ``{model name: Trajectory}``.
     """
-    from dataclasses import replace
-
-    from rollingtop.dynamics.state import project_state
-    from rollingtop.scenario import InitialConditions
-
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
-    y0 = scenario.require_state()
+    scenario.require_state()
     runs = {}
     for name in models:
-        ic = InitialConditions.from_state(project_state(scenario.body, name, y0))
-        sc = replace(scenario, model=name, initial=ic, level=None)
-        runs[name] = simulate(sc, **overrides)
+        runs[name] = simulate(_projected(scenario, get_model(name)), **overrides)
     return runs
