@@ -389,11 +389,10 @@ def test_fuzz_reduction_commands(data, command):
         assert listing(folder) == ["s.toml"]
 
 
-# Huge finite values (1e150, 1e300) are left out: on such levels the reduction warns of overflows
-# (reduction/steady.py, level.py) before it refuses the level, so the refusal is not one line
-# (reported; put them back once fixed)
-hostile_level_numbers = st.sampled_from([0.0, 1.0, -1.0, 1e-12, -1e-300, math.inf, math.nan,
-                                         10**400, "1", True])  # fmt: skip
+# Huge and tiny finite values included: a level too large for double precision is refused in
+# one line (LevelSet), one whose walls are too thin near theta = pi too (orbits)
+hostile_level_numbers = st.sampled_from([0.0, 1.0, -1.0, 1e-12, -1e-300, 1e-150, 1e150, 1e300,
+                                         math.inf, math.nan, 10**400, "1", True])  # fmt: skip
 
 
 @st.composite

@@ -16,6 +16,7 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, meridian
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
+from rollingtop.integrate._dop853 import STATUS_NAMES
 from rollingtop.integrate.driver import compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
 from rollingtop.io import check_output_path, netcdf_bytes, read_input_text, write_bytes_atomic
@@ -29,7 +30,8 @@ from rollingtop.scenario import (
 
 __all__ = ["EnsembleResult", "simulate_ensemble", "states_from_table", "grid_table"]
 
-STATUS = {0: "finished", -1: "step size underflow", -2: "non-finite state", 1: "max_steps reached"}
+#: Per-trajectory status codes and their names (the compiled stepper's, :mod:`._dop853`).
+STATUS = dict(STATUS_NAMES)
 
 #: Largest CSV table of initial states read (bytes).
 MAX_TABLE_BYTES = 64 << 20
@@ -250,9 +252,9 @@ def simulate_ensemble(
         if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
             raise ScenarioError(f"threads = {short_repr(threads)} must be an integer >= 1")
         threads = min(int(threads), numba.config.NUMBA_NUM_THREADS)  # what is really used
-    codes = np.full(N, model.code, dtype=np.int64)
-    if model.name == "meridian":
-        codes = np.array([meridian.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)])
+    # the model picks its kernel variant per state (meridian: the pole cases)
+    codes = np.array([model.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)],
+                     dtype=np.int64)  # fmt: skip
     params = np.array([b.params for b in bodies])
     t_eval = np.linspace(0.0, t_end, samples) if samples else np.array([0.0, float(t_end)])
     compile_s = compile_kernels() + compile_ensemble()

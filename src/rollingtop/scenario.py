@@ -351,8 +351,11 @@ class Scenario:
         self._require_meridian("the reduction to one degree of freedom")
         if self.level is not None:
             return LevelSet(self.body, self.level.M3, self.level.C1, self.level.C2)
-        ints = reduced_integrals(self.body, self.require_state())
-        return LevelSet(self.body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]))
+        y = self.require_state()
+        ints = reduced_integrals(self.body, y)
+        scale = float(np.linalg.norm(self.body.inertia * y[3:6]))  # round-off scale of M3, C1
+        return LevelSet(self.body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]),
+                        scale=scale)  # fmt: skip
 
     def level_h(self) -> float:
         """The reduced energy ``h`` of ``[level]``, else of the initial state."""

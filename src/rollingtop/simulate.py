@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 
 from rollingtop._errors import ContactLostWarning
-from rollingtop.contact import ContactModel, get_model, meridian
+from rollingtop.contact import ContactModel, get_model
 from rollingtop.integrate import integrate
 from rollingtop.scenario import InitialConditions, Scenario, check_model_name, load_scenario
 from rollingtop.trajectory import Trajectory
@@ -84,9 +84,7 @@ def simulate(
     scenario = scenario.with_overrides(**overrides)
     opts = scenario.integration
     y0 = scenario.require_state()
-    code = scenario.model.code
-    if scenario.model.name == "meridian":
-        code = meridian.kernel_code(scenario.body, y0)  # pole cases carry nu through the pole
+    code = scenario.model.kernel_code(scenario.body, y0)  # meridian: pole cases carry nu
     result = integrate(
         code,
         scenario.body.params,

@@ -36,6 +36,9 @@ __all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE"]
 #: ``|C1 -+ M3|`` below this times ``max(|M3|, |C1|)`` is a pole case: the simulator's tolerance
 #: (:data:`rollingtop.contact.meridian.POLE_CASE_TOLERANCE`), one decision for every command.
 POLE_TOLERANCE = POLE_CASE_TOLERANCE
+#: Largest effective potential a level may reach at ``gamma3 = 0``: beyond it ``U``, its
+#: derivatives and ``h - U`` would overflow (or lose every digit) in double precision.
+_MAX_U = 1e100
 #: Step of the complex-step derivative (exact to round-off for analytic functions).
 _COMPLEX_STEP = 1e-30
 
@@ -110,6 +113,13 @@ class LevelSet:
             object.__setattr__(self, "M3", 0.0)
             object.__setattr__(self, "C1", 0.0)
         object.__setattr__(self, "pole", pole)
+        with np.errstate(all="ignore"):
+            size = abs(float(self.U(math.pi / 2)))
+        if not size <= _MAX_U:
+            raise LevelSetError(
+                f"level {self.describe()} is too large for double precision: its effective "
+                f"potential reaches {size:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale units)"
+            )
 
     def mirrored(self) -> LevelSet:
         """The same motions seen with the body axis reversed (``e3 -> -e3``): ``theta -> pi -

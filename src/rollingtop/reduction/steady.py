@@ -98,7 +98,8 @@ def critical_points(level: LevelSet) -> np.ndarray:
     with np.errstate(all="ignore"):
         d = level.dU(grid)
     roots = []
-    for i in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (d[:-1] * d[1:] <= 0)):
+    sign = np.sign(d)  # not d[:-1] * d[1:], which can overflow
+    for i in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (sign[:-1] * sign[1:] <= 0)):
         if d[i] == 0.0:
             roots.append(grid[i])
         elif d[i + 1] != 0.0:
