@@ -60,3 +60,29 @@ def test_digest_covers_paths_and_contents(tmp_path):
     first = _kernel_cache.sources_digest(root)
     (root / "contact" / "mod.py").rename(root / "contact" / "other.py")
     assert _kernel_cache.sources_digest(root) != first
+
+
+def test_unsavable_cache_is_a_warning_not_an_error(monkeypatch):
+    """A full disk or a file-size limit while numba saves a compiled kernel: one warning naming
+    the file and the reason, the kernel runs from memory (no exception escapes)."""
+    import errno
+    import warnings
+
+    from numba.core.caching import Cache
+
+    from rollingtop import _kernel_cache
+
+    monkeypatch.setattr(_kernel_cache, "_warned", False)
+    cache = Cache.__new__(Cache)  # numba's class with its guard; only the save itself is faked
+
+    def fail(sig, data):
+        raise OSError(errno.EFBIG, "File too large", "/cache/kernel.nbc")
+
+    cache._save_overload = fail
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cache.save_overload(None, None)
+        cache.save_overload(None, None)  # reported once only
+    assert [type(w.message) for w in caught] == [_kernel_cache.CacheNotSaved]
+    message = str(caught[0].message)
+    assert "/cache/kernel.nbc" in message and "File too large" in message

@@ -87,4 +87,52 @@ def refresh(root: Path = ROOT) -> bool:
         return False
 
 
+class CacheNotSaved(UserWarning):
+    """numba could not save a compiled kernel to its on-disk cache (full disk, file-size limit,
+    permissions): the run goes on with the kernel compiled in memory."""
+
+
+_warned = False
+
+
+def _tolerate_unsavable_cache() -> None:
+    """Make a failed write of numba's cache a warning instead of an error.
+
+    numba compiles a kernel, registers it in memory, and only then saves it to disk; an
+    ``OSError`` from that save (``ENOSPC``, ``EFBIG`` under ``ulimit -f``, ``EACCES``) escapes from
+    the call that triggered the compilation, and every command would fail on a full disk although
+    the kernel is ready. numba has no option for this (its guard forgives only spurious Windows
+    errors), so its ``Cache.save_overload`` is wrapped here: the error is reported once as a
+    :class:`CacheNotSaved` warning, the partial cache file numba may leave is its own to
+    overwrite next time, and the kernel runs from memory.
+    """
+    from numba.core.caching import Cache
+
+    original = Cache.save_overload
+    if getattr(original, "_rollingtop_tolerant", False):
+        return
+
+    def save_overload(self, sig, data):
+        global _warned
+        try:
+            original(self, sig, data)
+        except OSError as exc:
+            if not _warned:
+                import warnings
+
+                _warned = True
+                where = exc.filename or getattr(self, "_cache_path", "numba's cache folder")
+                warnings.warn(
+                    CacheNotSaved(
+                        f"compiled kernels not saved to {where} ({exc.strerror or exc}): they "
+                        "are compiled again in every run until it can be written"
+                    ),
+                    stacklevel=2,
+                )
+
+    save_overload._rollingtop_tolerant = True
+    Cache.save_overload = save_overload
+
+
 refresh()  # on import of the package, before any kernel is loaded from the cache
+_tolerate_unsavable_cache()
