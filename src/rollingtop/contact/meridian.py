@@ -16,9 +16,11 @@ is carried as a state variable instead: ``nu = cos(psi_nu) alpha + sin(psi_nu) b
 ``psi_nu' = M3 / (I1 (1 +- gamma3))`` and ``M3 = I3 w3`` from the state -- the limit of the
 constraint direction along the motion, regular at the pole. Away from the pole
 (``s > RESYNC_S``) ``psi_nu`` is re-synchronised to the geometric azimuth modulo ``pi`` after
-every step, so there the constraint is exactly the paper's. After each pole passage
-``psi_nu = psi + pi``: the sign ``sigma = cos(psi_nu - psi)`` tells on which side of the pole the
-motion is, which is what keeps ``F6`` (odd under the passage) continuous in the monitoring.
+every step, so there the constraint is exactly the paper's; nearer the pole too where the axis
+moves across its meridian rather than towards the pole (``RESYNC_ANGLE``), as a sleeping top
+does. After each pole passage ``psi_nu = psi + pi``: the sign ``sigma = cos(psi_nu - psi)`` tells
+on which side of the pole the motion is, which is what keeps ``F6`` (odd under the passage)
+continuous in the monitoring.
 
 **No spin.** On ``M3 = C1 = 0`` both poles are pole levels at once (:func:`pole_case` says
 ``"both"``, :func:`kernel_code` takes the south variant) and the exact rate is ``psi_nu' = 0``:
@@ -71,6 +73,13 @@ POLE_TOLERANCE = 1e-8
 POLE_CASE_TOLERANCE = 1e-13
 #: Above this ``s`` the carried azimuth is re-synchronised with the geometric one (modulo pi).
 RESYNC_S = 0.05
+#: Closer to the pole, ``psi_nu`` is re-synchronised where ``s > RESYNC_S_MIN`` and the axis moves
+#: across its meridian (the sine of the angle between the tilt and its rate above
+#: ``RESYNC_ANGLE``). Without it a sleeping top, which stays near the pole and precesses, lets the
+#: carried direction drift off the tilt: the mismatch ``eps`` and ``C1 - M3`` feed each other
+#: (``eps' = (M3 - C1) / (I1 s^2)``, ``C1' ~ a3 lambda s eps``), growing from round-off.
+RESYNC_S_MIN = 1e-7
+RESYNC_ANGLE = 0.5
 #: ``|M3| = |I3 w3|`` at most this times ``|I w|`` counts as no spin in the carried direction's
 #: rate (:func:`psi_nu_rate`): well above the round-off that the torque about ``e3`` leaves in
 #: ``w3`` of a planar motion (a few 1e-16 ``|w|``, measured), far below any spin that matters (a

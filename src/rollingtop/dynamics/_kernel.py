@@ -322,8 +322,21 @@ def _sync_psi_nu(code, y):
     only away from the pole (``s > RESYNC_S``)."""
     s = math.sqrt(y[8] * y[8] + y[11] * y[11])
     pole = code == meridian.SOUTH_CODE or code == meridian.NORTH_CODE
-    if s <= (meridian.RESYNC_S if pole else 1e-12):
+    if not pole and s <= 1e-12:
         return
+    if pole and s <= meridian.RESYNC_S:
+        # Near the pole only where the axis moves across its meridian rather than towards the
+        # pole (meridian.RESYNC_ANGLE): there the geometric direction is well defined although
+        # s is small (a sleeping top's precession), while along a passage it would carry the
+        # numerical miss distance of the pole.
+        if s <= meridian.RESYNC_S_MIN:
+            return
+        w1, w2 = y[3], y[4]
+        da = y[6] * w2 - y[7] * w1  # alpha3' (alpha' = alpha x w): the tilt's rate
+        db = y[9] * w2 - y[10] * w1  # beta3'
+        across = abs(y[8] * db - y[11] * da)
+        if across <= meridian.RESYNC_ANGLE * s * math.sqrt(da * da + db * db):
+            return
     period = math.pi if pole else 2.0 * math.pi
     psi = math.atan2(y[11], y[8])
     y[17] = psi + period * round((y[17] - psi) / period)
