@@ -18,6 +18,7 @@ number that would be noise.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass, replace
 
@@ -82,8 +83,17 @@ class Orbit:
         return json_ready(asdict(self))
 
 
+@functools.lru_cache(maxsize=16)
+def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1], kept (numpy computes them by an ``n x n``
+    eigenvalue problem: 0.2 s for ``n = 4096``)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
+
+
 #: Gauss-Legendre rule for the energy gap near the turning points (see :func:`_gap`).
-_GAP_NODES, _GAP_WEIGHTS = np.polynomial.legendre.leggauss(20)
+_GAP_NODES, _GAP_WEIGHTS = _leggauss(20)
 #: Within this fraction of the orbit's width from a turning point the gap is integrated.
 _GAP_NEAR = 0.1
 
@@ -135,7 +145,7 @@ def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight=None):
 
 def _gauss(f, n: int) -> tuple[float, float]:
     """Gauss-Legendre rule on ``[-pi/2, pi/2]``: the integral of ``f`` and of ``|f|``."""
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = _leggauss(n)
     values = f(x * (math.pi / 2)) * w * (math.pi / 2)
     return float(np.sum(values)), float(np.sum(np.abs(values)))
 
@@ -143,7 +153,7 @@ def _gauss(f, n: int) -> tuple[float, float]:
 def _graded_gauss(f, a: float, b: float, points, n: int) -> float:
     """Composite Gauss-Legendre on ``[a, b]``, graded geometrically (ratio 0.2, 24 levels)
     towards ``a``, ``b`` and each of ``points``: resolves peaks of width down to ~1e-17 there."""
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = _leggauss(n)
     knots = np.unique(np.clip([a, *points, b], a, b))
     edges = []
     ratios = 0.2 ** np.arange(24, -1, -1)
@@ -301,18 +311,18 @@ def half_integral(
     interior point ``mid`` (in the variable of :func:`_half_map`). Returns ``(value, error)``.
 
     A Gauss-Legendre rule doubled until two successive values agree to :data:`PERIOD_RTOL` (of
-    the integral of ``|f|``), the error being their difference; without convergence by 4096
+    the integral of ``|f|``), the error being their difference; without convergence by 2048
     nodes (a saddle near the half orbit) the composite rule graded towards the ends and the
     saddles ``peaks``.
     """
     half = _half_map(t_end, mid, wall, left)
     f = _half_integrand(level, h, t_end, half, left, weight)
     u_max = half[0]
-    x, w = np.polynomial.legendre.leggauss(32)
+    x, w = _leggauss(32)
     prev = float(np.sum(f(u_max * (x + 1) / 2) * w)) * u_max / 2
     n = 64
-    while n <= 4096:
-        x, w = np.polynomial.legendre.leggauss(n)
+    while n <= 2048:
+        x, w = _leggauss(n)
         vals = f(u_max * (x + 1) / 2) * w * (u_max / 2)
         cur, size = float(np.sum(vals)), float(np.sum(np.abs(vals)))
         if abs(cur - prev) <= PERIOD_RTOL * size:
