@@ -121,10 +121,27 @@ def _gap(level: LevelSet, h: float, t1: float, t2: float, phi) -> np.ndarray:
     ):
         near = np.abs(dist) < _GAP_NEAR * (t2 - t1)
         if np.any(near):
-            half = dist[near] / 2  # signed: (end - theta) / 2
-            x = end - half[:, None] * (1 + _GAP_NODES[None, :])
-            out[near] = np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half  # U(end) - U(theta)
+            out[near] = _gap_from_slope(level, end, dist[near] / 2)
     return out.reshape(shape)
+
+
+def _gap_from_slope(level: LevelSet, end: float, half: np.ndarray) -> np.ndarray:
+    """``U(end) - U(theta) = integral_theta^end U'`` by a 20-point Gauss-Legendre rule, with
+    ``half = (end - theta) / 2`` (signed) given without cancellation: the energy gap next to
+    the turning point ``end`` to its full relative accuracy."""
+    x = end - half[:, None] * (1 + _GAP_NODES[None, :])
+    return np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half
+
+
+def _time_density(level: LevelSet, theta, gap, jac, weight):
+    """``2 sqrt(rho / (2 gap)) |dtheta/du| weight(theta)``: twice ``dt/du`` (times the weight)
+    in an integration variable ``u`` with Jacobian ``jac``; 0 where it is not finite (at a
+    turning point the substitutions make the limit finite, the rule never samples it)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * np.maximum(gap, 0.0))) * jac
+        if weight is not None:
+            val = val * weight(theta)
+    return np.where(np.isfinite(val), val, 0.0)
 
 
 def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight=None):
@@ -133,21 +150,24 @@ def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight=None):
 
     def f(phi):
         theta = c + d * np.sin(phi)
-        gap = np.maximum(_gap(level, h, t1, t2, phi), 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * gap)) * d * np.cos(phi)
-            if weight is not None:
-                val = val * weight(theta)
-        return np.where(np.isfinite(val), val, 0.0)
+        return _time_density(level, theta, _gap(level, h, t1, t2, phi), d * np.cos(phi), weight)
 
     return f
 
 
-def _gauss(f, n: int) -> tuple[float, float]:
-    """Gauss-Legendre rule on ``[-pi/2, pi/2]``: the integral of ``f`` and of ``|f|``."""
-    x, w = _leggauss(n)
-    values = f(x * (math.pi / 2)) * w * (math.pi / 2)
-    return float(np.sum(values)), float(np.sum(np.abs(values)))
+def _doubled_gauss(f, a: float, b: float) -> tuple[float, float] | None:
+    """Gauss-Legendre rules of 32, 64, ..., 2048 nodes on ``[a, b]`` until two successive
+    values agree to :data:`PERIOD_RTOL` of the integral of ``|f|`` (the weighted integrals may
+    vanish); returns ``(value, their difference)``, or ``None`` without convergence."""
+    prev = None
+    for n in (32, 64, 128, 256, 512, 1024, 2048):
+        x, w = _leggauss(n)
+        values = f(a + (b - a) * (x + 1) / 2) * w * ((b - a) / 2)
+        cur, size = float(np.sum(values)), float(np.sum(np.abs(values)))
+        if prev is not None and abs(cur - prev) <= PERIOD_RTOL * size:
+            return cur, abs(cur - prev)
+        prev = cur
+    return None
 
 
 def _graded_gauss(f, a: float, b: float, points, n: int) -> float:
@@ -198,13 +218,9 @@ def period(
         return _wall_period(level, h, theta1, theta2, walls, peaks, weight)
     c, d = (theta1 + theta2) / 2, (theta2 - theta1) / 2
     f = _integrand(level, h, theta1, theta2, weight)
-    prev, _ = _gauss(f, 32)
-    n = 64
-    while n <= 2048:
-        cur, size = _gauss(f, n)  # relative to the integral of |f|: the weighted one may vanish
-        if abs(cur - prev) <= PERIOD_RTOL * size:
-            return cur, abs(cur - prev)
-        prev, n = cur, 2 * n
+    done = _doubled_gauss(f, -math.pi / 2, math.pi / 2)
+    if done is not None:
+        return done
     # Slow convergence: a logarithmic peak near a saddle, inside the orbit or at a turning point
     # that is nearly a double root. Composite rule graded towards the peaks and the ends.
     breaks = [math.asin(min(1.0, max(-1.0, (p - c) / d))) for p in peaks if theta1 < p < theta2]
@@ -282,14 +298,8 @@ def _half_integrand(level: LevelSet, h: float, t_end: float, half, left: bool, w
         gap = h - level.U(theta)
         near = dist < _GAP_NEAR_WALL * scale
         if np.any(near):
-            half_d = dist[near] / 2
-            x = t_end + sign * half_d[:, None] * (1 + _GAP_NODES[None, :])
-            gap[near] = -sign * np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half_d
-        with np.errstate(divide="ignore", invalid="ignore"):
-            val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * np.maximum(gap, 0.0))) * jac(u)
-            if weight is not None:
-                val = val * weight(theta)
-        return np.where(np.isfinite(val), val, 0.0)
+            gap[near] = _gap_from_slope(level, t_end, -sign * dist[near] / 2)
+        return _time_density(level, theta, gap, jac(u), weight)
 
     return f
 
@@ -318,16 +328,9 @@ def half_integral(
     half = _half_map(t_end, mid, wall, left)
     f = _half_integrand(level, h, t_end, half, left, weight)
     u_max = half[0]
-    x, w = _leggauss(32)
-    prev = float(np.sum(f(u_max * (x + 1) / 2) * w)) * u_max / 2
-    n = 64
-    while n <= 2048:
-        x, w = _leggauss(n)
-        vals = f(u_max * (x + 1) / 2) * w * (u_max / 2)
-        cur, size = float(np.sum(vals)), float(np.sum(np.abs(vals)))
-        if abs(cur - prev) <= PERIOD_RTOL * size:
-            return cur, abs(cur - prev)
-        prev, n = cur, 2 * n
+    done = _doubled_gauss(f, 0.0, u_max)
+    if done is not None:
+        return done
     breaks = [
         float(brentq(lambda u, p=p: half[1](u) - p, 0.0, u_max))
         for p in peaks
