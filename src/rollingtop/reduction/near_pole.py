@@ -36,6 +36,7 @@ from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.orbits import (
     WALL_RATIO,
     Orbit,
+    _half_map,
     canonical_orbit,
     half_integral,
     near_north,
@@ -107,18 +108,25 @@ def friction_needed(level: LevelSet, h: float, orbit: Orbit, samples: int = 400)
     The states are sampled at ``dist_pole = dist_end cosh u`` near a wall (where the force
     peaks) and uniformly in the nutation angle elsewhere.
     """
+    lv, o = canonical_orbit(level, h, orbit)
+    return _friction(lv, h, o, samples)
+
+
+def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400):
+    """:func:`friction_needed` on the canonical level and orbit (``canonical_orbit``)."""
+    from rollingtop.contact.meridian import CODE
     from rollingtop.dynamics import _kernel
     from rollingtop.reduction.variables import state_from_level
 
-    lv, o = canonical_orbit(level, h, orbit)
     t1, t2 = o.theta_min, o.theta_max
     if not 0.0 < t1 < t2 < math.pi:
         raise LevelSetError("friction_needed: the orbit must lie inside 0 < theta < pi")
-    p1 = t1 * np.cosh(np.linspace(0.0, math.acosh(max((t1 + t2) / 2 / t1, 1.0)), samples))
-    p2 = math.pi - (math.pi - t2) * np.cosh(
-        np.linspace(0.0, math.acosh(max((math.pi - (t1 + t2) / 2) / (math.pi - t2), 1.0)), samples)
-    )
-    thetas = np.unique(np.concatenate([p1, p2, np.linspace(t1, t2, samples)]))
+    mid = (t1 + t2) / 2
+    ends = []
+    for t_end, left in ((t1, True), (t2, False)):  # the quadrature's wall variable at each end
+        u_max, theta_of = _half_map(t_end, mid, True, left)[:2]
+        ends.append(theta_of(np.linspace(0.0, u_max, samples)))
+    thetas = np.unique(np.concatenate([*ends, np.linspace(t1, t2, samples)]))
     thetas = thetas[(thetas >= t1) & (thetas <= t2)]
     states = []
     for theta in thetas:
@@ -127,7 +135,7 @@ def friction_needed(level: LevelSet, h: float, orbit: Orbit, samples: int = 400)
             states.append(state_from_level(lv, hh, 0.0, theta=float(theta), branch=branch))
     Y = np.ascontiguousarray(states)
     out = np.zeros((Y.shape[0], 8))
-    _kernel.diagnostics(0, lv.body.params, Y, out)
+    _kernel.diagnostics(CODE, lv.body.params, Y, out)
     N, F = out[:, 0], out[:, 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(N > 0, np.abs(F) / N, np.inf)
@@ -165,6 +173,6 @@ def near_pole(level: LevelSet, h: float, orbit: Orbit) -> NearPole | None:
         T_pole = c.period
         dpsi_pole, _ = period(pole_level, h, c.theta_min, c.theta_max, peaks=[0.0],
                               weight=pole_level.psi_dot)  # fmt: skip
-    mu, n_min = friction_needed(level, h, orbit)
+    mu, n_min = _friction(lv, h, o)
     return NearPole("north" if north else "south", offset, o.theta_min, T_lim, dpsi_lim,
                     T_pole, dpsi_pole, mu, n_min)  # fmt: skip
