@@ -187,26 +187,26 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
     if orbit.kind != "periodic":
         raise LevelSetError(f"no per-period map for a {orbit.kind} orbit ({orbit.note})")
     T = orbit.period
-    w_tau0 = 0.0
     if level.pole == "both":  # no spin: the axis does not precess (rollingtop.reduction.no_spin)
         dpsi, dpsi_err = 0.0, 0.0
-        theta0 = start_theta(orbit)
-        if orbit.theta_max - orbit.theta_min >= 2 * math.pi * (1 - 1e-12):  # rolling over
+        theta0, w_tau0 = start_theta(orbit), 0.0
+        if orbit.rolls_over:  # no turning point: start where theta' is known, moving forwards
             theta0 = orbit.theta_min
             w_tau0 = -math.sqrt(2 * (h - float(level.U(theta0))) / float(level.rho(theta0)))
+        path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
     else:
         exact_level, exact_orbit = canonical_orbit(level, h, orbit)  # near north: its mirror
         peaks = [t for t in (exact_level.pole_theta,) if t is not None]
         dpsi, dpsi_err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max,
                                 peaks=peaks, weight=exact_level.psi_dot)  # fmt: skip
         theta0 = start_theta(orbit)
-        if exact_level is not level:
+        if exact_level is level:
+            path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=0.0)
+        else:
             # near the north pole: integrate the mirror image, where the wall next to the pole
             # is resolved in theta; the same physical motion has psi + pi and theta -> pi - theta
             start = exact_orbit.theta_min if theta0 == orbit.theta_max else exact_orbit.theta_max
             path = reconstruct(exact_level, [0.0, T], theta0=start, w_tau0=0.0, psi0=math.pi)
-    if level.pole == "both" or exact_level is level:
-        path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
     D = complex(*path["position"][-1])
     turns = dpsi / (2 * math.pi)
     if abs(turns - round(turns)) < RESONANCE_TOLERANCE:

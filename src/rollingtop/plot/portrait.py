@@ -47,8 +47,9 @@ def _abscissa(level: LevelSet, theta):
     return np.asarray(theta, dtype=float) if level.pole else np.cos(theta)
 
 
-def _orbit_curve(level: LevelSet, h: float, t1: float, t2: float, n: int = 400):
-    if level.pole == "both" and t2 - t1 >= 2 * math.pi * (1 - 1e-12):
+def _orbit_curve(level: LevelSet, h: float, orbit, n: int = 400):
+    t1, t2 = orbit.theta_min, orbit.theta_max
+    if orbit.rolls_over:
         # rolling over (no spin): theta runs round the circle; draw w_tau > 0 and < 0 branches
         # over the plotted window, separated by a NaN so that they are not joined
         theta = np.linspace(*level.theta_domain, 2 * n)
@@ -121,7 +122,7 @@ def phase_portrait(
         for o in comps:
             if o.kind == "steady":
                 continue
-            x, y = _orbit_curve(level, h, o.theta_min, o.theta_max)
+            x, y = _orbit_curve(level, h, o)
             g_lo, g_hi = min(g_lo, np.nanmin(x)), max(g_hi, np.nanmax(x))
             w_top = max(w_top, float(np.nanmax(np.abs(y))))
             if separatrix or o.kind == "separatrix":

@@ -177,7 +177,7 @@ class LevelSet:
             csc2 = 1 / (2 * np.sin(theta / 2) ** 2)
             return -M3 * ct, M3 * (b.R + b.a3) * ct, M3 * csc2, -M3 * (b.R + b.a3) * csc2
         if self.pole == "both":
-            z = np.zeros_like(np.asarray(theta, dtype=float) if np.isrealobj(theta) else theta)
+            z = 0.0 * np.asarray(theta)  # real, or complex for the complex-step derivative
             return z, z, z, z
         c, s = np.cos(theta), np.sin(theta)
         # Free of cancellation near either pole (class Notes): with d = M3 - C1 (exact for

@@ -82,6 +82,12 @@ class Orbit:
         """JSON-ready dict (non-finite values become ``None``)."""
         return json_ready(asdict(self))
 
+    @property
+    def rolls_over(self) -> bool:
+        """``theta`` runs round the whole circle (no spin, above the upright pole's energy):
+        the orbit has no turning points and ``theta_min``, ``theta_max`` are a full turn apart."""
+        return self.theta_max - self.theta_min >= 2 * math.pi * (1 - 1e-12)
+
 
 @functools.lru_cache(maxsize=16)
 def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
