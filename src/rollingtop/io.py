@@ -18,7 +18,7 @@ import stat
 import subprocess
 import tempfile
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 from rollingtop._errors import OutputError
@@ -122,10 +122,31 @@ def _new_temporary(path: Path, suffix: str) -> tuple[int, Path]:
     return fd, Path(tmp)
 
 
-def _publish(fd: int, tmp: Path, path: Path) -> None:
-    """Flush ``fd`` to disk, give it the permissions ``open()`` would, close it (always) and
-    rename ``tmp`` onto ``path``."""
+@contextlib.contextmanager
+def _temporary_beside(path: Path, suffix: str) -> Iterator[tuple[int, Path]]:
+    """A new temporary file ``(fd, name)`` beside ``path``, removed if the block raises
+    anything (``KeyboardInterrupt`` included). SIGXFSZ is ignored first, so that a file-size
+    limit is an ``EFBIG`` error rather than the death of the process."""
+    _ignore_sigxfsz()
+    fd, tmp = _new_temporary(path, suffix)
     try:
+        yield fd, tmp
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
+
+
+def _publish(fd: int, tmp: Path, path: Path, data: memoryview | None = None) -> None:
+    """Write ``data`` (if any) to ``fd`` with checked writes, flush it to disk, give it the
+    permissions ``open()`` would, close it (always) and rename ``tmp`` onto ``path``."""
+    try:
+        view = data if data is not None else memoryview(b"")
+        while view:
+            n = os.write(fd, view[:_CHUNK])
+            if n <= 0:
+                raise OSError(_errno.EIO, os.strerror(_errno.EIO))
+            view = view[n:]
         umask = os.umask(0)
         os.umask(umask)
         os.fchmod(fd, 0o666 & ~umask)  # mkstemp creates 0600
@@ -151,28 +172,12 @@ def write_bytes_atomic(path: str | os.PathLike, data) -> Path:
         naming ``path``; the temporary file is removed and ``path`` is unchanged.
     """
     path = Path(path)
-    _ignore_sigxfsz()
     view = memoryview(data).cast("B")
-    fd, tmp = _new_temporary(path, ".tmp")
-    try:
+    with _temporary_beside(path, ".tmp") as (fd, tmp):
         try:
-            try:
-                while view:
-                    n = os.write(fd, view[:_CHUNK])
-                    if n <= 0:
-                        raise OSError(_errno.EIO, os.strerror(_errno.EIO))
-                    view = view[n:]
-            except BaseException:
-                with contextlib.suppress(OSError):
-                    os.close(fd)
-                raise
-            _publish(fd, tmp, path)
+            _publish(fd, tmp, path, view)
         except OSError as exc:
             raise WriteFailed(path, *_reason(exc)) from None
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-        raise
     return path
 
 
@@ -190,11 +195,9 @@ def atomic_write(
     format from it, such as ffmpeg).
     """
     path = Path(path)
-    _ignore_sigxfsz()
     suffix = f".tmp{path.suffix}" if keep_suffix else ".tmp"
-    fd, tmp = _new_temporary(path, suffix)
-    os.close(fd)
-    try:
+    with _temporary_beside(path, suffix) as (fd, tmp):
+        os.close(fd)
         try:
             write(tmp)
             _publish(os.open(tmp, os.O_RDONLY), tmp, path)
@@ -205,10 +208,6 @@ def atomic_write(
             if cause is None:
                 raise
             raise WriteFailed(path, *_reason(cause)) from None
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-        raise
     return path
 
 
