@@ -48,6 +48,12 @@ class ContactModel:
         ``select_code(body, y) -> int``: the kernel code for a motion from state ``y`` where the
         model has variants (:func:`rollingtop.contact.meridian.kernel_code`); ``None``: always
         :attr:`code`. See :meth:`kernel_code`.
+    has_reduction : bool
+        Whether the model's motions of a dynamically symmetric body reduce to one degree of
+        freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
+        portraits and absolute-motion quadratures apply.
+    colour : str
+        Matplotlib colour of the model in figures that compare models.
     """
 
     name: str
@@ -62,6 +68,8 @@ class ContactModel:
     vertical_tolerance: float = 0.0
     vertical_direction: Callable[..., float] | None = None
     select_code: Callable[..., int] | None = None
+    has_reduction: bool = False
+    colour: str = "#7f7f7f"
 
     def integrals(self, symmetric: bool) -> tuple[str, ...]:
         """Names of the first integrals of this model for a (non-)symmetric body."""

@@ -265,4 +265,6 @@ MODEL = ContactModel(
     vertical_tolerance=POLE_TOLERANCE,
     vertical_direction=vertical_direction,
     select_code=kernel_code,
+    has_reduction=True,
+    colour="#1f77b4",
 )

@@ -35,4 +35,5 @@ MODEL = ContactModel(
     integrals_symmetric=("energy", "jellett", "routh"),
     integrals_general=("energy",),
     velocity=_velocity,
+    colour="#d62728",
 )

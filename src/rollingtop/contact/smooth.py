@@ -31,4 +31,5 @@ MODEL = ContactModel(
     integrals_symmetric=("energy", "lagrange", "jellett", "area", "momentum_x", "momentum_y"),
     integrals_general=("energy", "area", "momentum_x", "momentum_y"),
     velocity=_velocity,
+    colour="#2ca02c",
 )
