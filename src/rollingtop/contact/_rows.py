@@ -6,10 +6,10 @@ time derivative of the condition along the motion adds the *bias* ``dJ/dt . u`` 
 acceleration equation (``MODEL.md``, "Dynamics").
 """
 
-from numba import njit
+from rollingtop._jit import inline
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def row_bias(y, r1, r2, r3, rd1, rd2, rd3, d1, d2, d3, dd1, dd2, dd3):
     """``J' u = (d', v) + (r' x d + r x d', w)`` of the contact row along ``d``."""
     q1 = rd2 * d3 - rd3 * d2 + r2 * dd3 - r3 * dd2
@@ -18,7 +18,7 @@ def row_bias(y, r1, r2, r3, rd1, rd2, rd3, d1, d2, d3, dd1, dd2, dd3):
     return dd1 * y[0] + dd2 * y[1] + dd3 * y[2] + q1 * y[3] + q2 * y[4] + q3 * y[5]
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def contact_arm_rate(p, y):
     """Contact arm ``r = -R gamma - a`` and its rate ``r' = -R gamma'``, ``gamma' = gamma x w``
     (paper eq. 2.1), as six scalars."""
@@ -35,7 +35,7 @@ def contact_arm_rate(p, y):
     )
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     """Write row ``k`` for the no-slip condition ``(vp, d) = 0`` of the contact point.
 
@@ -56,7 +56,7 @@ def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
     dirs[k, 2] = d3
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def normal_row(p, y, k, J, bias, dirs):
     """Row ``k`` for the contact condition ``f1 = (vp, gamma) = 0`` (paper eq. 2.4)."""
     w1, w2, w3 = y[3], y[4], y[5]

@@ -52,8 +52,8 @@ through all horizontal directions there) is never used to start a motion.
 import math
 
 import numpy as np
-from numba import njit
 
+from rollingtop._jit import inline, kernel
 from rollingtop.contact._base import ContactModel, contact_arm
 from rollingtop.contact._rows import contact_row, normal_row
 
@@ -88,7 +88,7 @@ RESYNC_ANGLE = 0.5
 NO_SPIN_TOLERANCE = 1e-10
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def nu_geometric(y):
     """``nu = (e3 - gamma3 gamma)/s`` and its time derivative along the motion.
 
@@ -109,7 +109,7 @@ def nu_geometric(y):
     return n1, n2, s, nd1, nd2, sd
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def psi_nu_rate(p, y, north):
     """``psi_nu' = M3 / (I1 (1 + gamma3))`` (south) or ``-M3 / (I1 (1 - gamma3))`` (north);
     exactly 0 with no spin, ``|M3| <= NO_SPIN_TOLERANCE |I w|`` (see the module docstring)."""
@@ -122,7 +122,7 @@ def psi_nu_rate(p, y, north):
     return M3 / (p[4] * (1.0 + y[14]))
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def nu_carried(p, y, north):
     """Carried ``nu = cos(psi_nu) alpha + sin(psi_nu) beta`` (pole cases) and
     ``nu' = psi_nu' (gamma x nu) + nu x w``."""
@@ -139,7 +139,7 @@ def nu_carried(p, y, north):
     return n1, n2, n3, nd1, nd2, nd3
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def nu_of(p, y, code):
     """The constraint direction and its derivative for kernel ``code`` (geometric or carried)."""
     if code == CODE:
@@ -147,7 +147,7 @@ def nu_of(p, y, code):
     return nu_carried(p, y, code == NORTH_CODE)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def rows(p, y, J, bias, dirs):
     """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``); returns their number, 2."""
     normal_row(p, y, 0, J, bias, dirs)
@@ -156,7 +156,7 @@ def rows(p, y, J, bias, dirs):
     return 2
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def rows_pole(p, y, J, bias, dirs, north):
     """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu`` (:func:`nu_carried`). Returns 2."""
     normal_row(p, y, 0, J, bias, dirs)

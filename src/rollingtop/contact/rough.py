@@ -5,15 +5,15 @@ The three rows are ``(vp, e_i) = 0`` along the body axes: they span the same con
 """
 
 import numpy as np
-from numba import njit
 
+from rollingtop._jit import kernel
 from rollingtop.contact._base import ContactModel, contact_arm
 from rollingtop.contact._rows import contact_row
 
 CODE = 2
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def rows(p, y, J, bias, dirs):
     """Constraint rows ``(vp, e1) = (vp, e2) = (vp, e3) = 0``; returns 3."""
     contact_row(p, y, 0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, J, bias, dirs)

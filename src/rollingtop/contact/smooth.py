@@ -1,15 +1,15 @@
 """Smooth (frictionless) plane: only the contact is kept, ``f1 = (vp, gamma) = 0``."""
 
 import numpy as np
-from numba import njit
 
+from rollingtop._jit import kernel
 from rollingtop.contact._base import ContactModel, contact_arm
 from rollingtop.contact._rows import normal_row
 
 CODE = 1
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def rows(p, y, J, bias, dirs):
     """Constraint row ``f1``; returns 1."""
     normal_row(p, y, 0, J, bias, dirs)

@@ -9,8 +9,7 @@ carried direction ``nu`` (continuous through the pole).
 
 import math
 
-from numba import njit
-
+from rollingtop._jit import kernel
 from rollingtop.contact import meridian
 
 NONE = 0
@@ -20,7 +19,7 @@ W_TAU = 1
 EVENTS = {"w_tau": W_TAU}
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def event_value(code, model_code, y):
     """Value of event function ``code`` at state ``y`` under kernel ``model_code``."""
     if code == W_TAU:

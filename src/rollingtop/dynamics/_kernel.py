@@ -33,14 +33,14 @@ function must not allocate or return arrays; the test suite compiles each of the
 import math
 
 import numpy as np
-from numba import njit
 
+from rollingtop._jit import compiled, inline, kernel
 from rollingtop.contact import meridian, rough, smooth
 from rollingtop.contact._rows import contact_arm_rate, row_bias
 from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
 
 
-@njit(cache=True)
+@compiled()
 def new_workspace():
     """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels (callable from
     Python and from compiled code)."""
@@ -53,7 +53,7 @@ def new_workspace():
     )
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def constraint_rows(code, p, y, J, bias, dirs):
     """Fill the contact model's rows ``J``, their ``bias = J' u`` and force directions ``dirs``.
 
@@ -72,7 +72,7 @@ def constraint_rows(code, p, y, J, bias, dirs):
     return -1
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _solve_spd(n, A, x):
     """Solve ``A z = x`` in place (``x <- z``) for SPD ``A`` given by its lower triangle."""
     for j in range(n):
@@ -98,7 +98,7 @@ def _solve_spd(n, A, x):
         x[i] = s / A[i, i]
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _free_forces(p, y):
     """The free forces ``f = (m v x w - m g gamma, (I w) x w)`` as six scalars."""
     m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
@@ -114,7 +114,7 @@ def _free_forces(p, y):
     )
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
     """Closed form of :func:`rhs` for the normal row ``(vp, gamma) = 0`` plus, if ``two``, the
     row ``(vp, n) = 0`` with ``n' = nd`` (meridian models): the same equations as the general
@@ -161,7 +161,7 @@ def _rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
     return 2 if two else 1
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _rough_matrix(p, r1, r2, r3):
     """``A = J M^-1 J^T`` of the rough model's rows ``J_k = (e_k, r x e_k)`` (lower triangle):
     ``A = 1/m + sum_j (r x e_k)_j (r x e_l)_j / I_j`` with ``r x e1 = (0, r3, -r2)``,
@@ -176,7 +176,7 @@ def _rough_matrix(p, r1, r2, r3):
     return A11, A21, A22, A31, A32, A33
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _solve3(A11, A21, A22, A31, A32, A33, b1, b2, b3):
     """``A^-1 b`` for a 3x3 SPD ``A`` (lower triangle) by Cholesky, in scalars."""
     L11 = math.sqrt(A11)
@@ -194,7 +194,7 @@ def _solve3(A11, A21, A22, A31, A32, A33, b1, b2, b3):
     return x1, x2, x3
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _rhs_rough(p, y, dy, ws):
     """Closed form of :func:`rhs` for the rough model (rows ``(vp, e_k) = 0``, see
     :mod:`rollingtop.contact.rough`): with ``J u = vp = v + w x r`` the multipliers are the
@@ -226,7 +226,7 @@ def _rhs_rough(p, y, dy, ws):
     return 3
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _kinematics(code, p, y, dy):
     w1, w2, w3 = y[3], y[4], y[5]
     for base in (6, 9, 12):
@@ -242,7 +242,7 @@ def _kinematics(code, p, y, dy):
         dy[17] = 0.0
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def rhs(code, p, y, dy, ws):
     """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
 
@@ -267,7 +267,7 @@ def rhs(code, p, y, dy, ws):
     return rhs_rows(code, p, y, dy, ws)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def rhs_rows(code, p, y, dy, ws):
     """:func:`rhs` by the general path: the model's rows from :func:`constraint_rows` and the
     small SPD system solved by Cholesky. Every model has it; the tests hold the closed forms of
@@ -297,7 +297,7 @@ def rhs_rows(code, p, y, dy, ws):
     return nc
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def reaction(nc, y, ws):
     """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` (last :func:`rhs`).
 
@@ -315,7 +315,7 @@ def reaction(nc, y, ws):
     return N, math.sqrt(t1 * t1 + t2 * t2 + t3 * t3)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _sync_psi_nu(code, y):
     """Set ``psi_nu`` to the axis azimuth ``atan2(beta3, alpha3)``: the nearest value modulo
     ``2 pi`` (continuous), or modulo ``pi`` in a pole case (keeping the side of the pole), where
@@ -342,7 +342,7 @@ def _sync_psi_nu(code, y):
     y[17] = psi + period * round((y[17] - psi) / period)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _project_contact(p, y, two, n1, n2, n3):
     """Closed form of the velocity projection of :func:`project` for the normal row and, if
     ``two``, the row along ``n`` (the rows of :func:`_rhs_contact`; a 1x1 or 2x2 solve)."""
@@ -374,7 +374,7 @@ def _project_contact(p, y, two, n1, n2, n3):
     y[5] = w3 - (l1 * a3_ + l2 * b3) * i3
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, inline="always")
+@inline
 def _project_rough(p, y):
     """Closed form of the velocity projection of :func:`project` for the rough model:
     ``lambda = A^-1 vp``, ``v <- v - lambda / m``, ``w <- w - I^-1 (r x lambda)``."""
@@ -395,7 +395,7 @@ def _project_rough(p, y):
     y[5] -= (r1 * l2 - r2 * l1) / p[6]
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def project(code, p, y, ws):
     """Project ``y`` in place onto the constraint manifold.
 
@@ -431,7 +431,7 @@ def project(code, p, y, ws):
     project_velocity_rows(code, p, y, ws)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def project_velocity_rows(code, p, y, ws):
     """The velocity part of :func:`project` by the general path (rows and a Cholesky solve);
     the tests hold the closed forms to it."""
@@ -457,7 +457,7 @@ def project_velocity_rows(code, p, y, ws):
         y[k] -= minv[k] * s
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@compiled()
 def diagnostics(code, p, Y, out):
     """Per-sample reactions and constraint errors.
 

@@ -22,8 +22,8 @@ functions allocate nothing and are compiled without reference counting (``_nrt=F
 import math
 
 import numpy as np
-from numba import njit
 
+from rollingtop._jit import compiled, kernel
 from rollingtop.dynamics._events import event_value
 from rollingtop.dynamics._kernel import project, reaction, rhs
 from rollingtop.integrate._dop853_stages import scaled_errors, stage
@@ -76,14 +76,14 @@ EV_CODE, EV_DIRECTION = 0, 1
 MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 0, 1, 2, 3, 4, 5
 
 
-@njit(cache=True)
+@compiled()
 def new_track():
     """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
     the normal force at the last accepted step."""
     return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def update_track(track, t, N, T_force):
     """Fold one evaluation of the contact force into ``track``."""
     if N < track[MIN_NORMAL]:
@@ -98,7 +98,7 @@ def update_track(track, t, N, T_force):
             track[T_MAX_RATIO] = t
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@compiled()
 def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy.
 
@@ -135,7 +135,7 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
     return min(100.0 * h0, h1, t_end - t0)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@compiled()
 def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
     """Prepare a run from ``y`` at ``t_eval[0]``: derivative ``f``, reaction tracking, initial
     step, the first sample ``out[0]``. Returns ``(ctrl, counts, track)`` for :func:`run`."""
@@ -155,7 +155,7 @@ def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
     return ctrl, counts, track
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
     """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
     n = y.shape[0]
@@ -174,7 +174,7 @@ def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
             Fd[3 + r, i] = h * acc
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def _dense_eval(Fd, y, x, out):
     """State at the fraction ``x`` of the step: ``y + sum`` of the interpolant's terms."""
     for i in range(y.shape[0]):
@@ -185,7 +185,7 @@ def _dense_eval(Fd, y, x, out):
         out[i] = y[i] + acc
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def _normal_root(code, p, Fd, y, t, h, ytmp, dy, ws):
     """Time in ``[t, t + h]`` where the normal force crosses zero, by bisection on the dense
     output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings.
@@ -204,7 +204,7 @@ def _normal_root(code, p, Fd, y, t, h, ytmp, dy, ws):
     return t + 0.5 * (lo + hi) * h
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
     output (60 halvings: to the resolution of the interpolant)."""
@@ -222,7 +222,7 @@ def _event_root(ev_code, code, Fd, y, t, h, ytmp):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def run(
     code,
     p,

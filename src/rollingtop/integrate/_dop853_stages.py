@@ -4,10 +4,10 @@ Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 :mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
 """
 
-from numba import njit
+from rollingtop._jit import kernel
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def stage(K, s, y, h, ytmp):
     """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
 
@@ -161,7 +161,7 @@ def stage(K, s, y, h, ytmp):
             )
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, _nrt=False)
+@kernel
 def scaled_errors(K, y, ynew, rtol, atol, err5, err3):
     """``sum_j E[j] K[j]`` (the 5th- and 3rd-order error estimates over the step size) divided
     by the scale ``atol + max(|y|, |ynew|) rtol``, component by component.

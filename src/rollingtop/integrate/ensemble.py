@@ -21,9 +21,10 @@ from collections.abc import Callable
 
 import numba
 import numpy as np
-from numba import njit, prange, types
+from numba import prange, types
 from numba.extending import intrinsic
 
+from rollingtop._jit import compiled
 from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
@@ -56,7 +57,7 @@ def _read_flag(typingctx, flag):
     return types.int64(flag), codegen
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"})
+@compiled()
 def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats, stop):
     """Integrate one trajectory; ``out`` (len(t_eval), 18) samples, ``final`` (18,) state,
     ``stats`` (6,): status (``dop.FINISHED``, a failure code, ``dop.BUDGET_EXHAUSTED`` for
@@ -94,7 +95,7 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
     stats[5] = track[dop.MAX_RATIO]
 
 
-@njit(cache=True, error_model="numpy", fastmath={"contract"}, parallel=True, nogil=True)
+@compiled(parallel=True, nogil=True)
 def _batch(codes, P, Y0, t_eval, rtol, atol, max_steps, out, final, stats, stop):
     for k in prange(Y0.shape[0]):
         if _read_flag(stop) != 0:
