@@ -23,9 +23,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, TypeVar, cast
 
-from numba import njit
+from numba import njit as _numba_njit
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+# numba's stubs do not know the private ``_nrt`` flag; the options are checked by numba itself
+njit: Any = _numba_njit
 
 #: Options shared by every compiled function of the package.
 BASE_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy", "fastmath": {"contract"}}
