@@ -5,6 +5,8 @@ Dynamically Symmetric Spherical Top with One Nonholonomic Constraint", Russian J
 Nonlinear Dynamics 19(1), 2023, 3-17 (doi:10.20537/nd221205), and its neighbour contact models.
 """
 
+from importlib import metadata as _metadata
+
 from rollingtop import _kernel_cache  # noqa: F401  (first: refreshes numba's kernel cache)
 from rollingtop._errors import (
     BodyError,
@@ -25,7 +27,7 @@ from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario,
 from rollingtop.simulate import simulate, simulate_models
 from rollingtop.trajectory import Trajectory
 
-__version__ = "0.1.0"
+__version__ = _metadata.version("rollingtop")  # the one version string: pyproject.toml
 
 __all__ = [
     "BodyError",

@@ -1,6 +1,6 @@
 """Motion in absolute space: reconstruction on the plane and the per-period map.
 
-``MODEL.md``, "Motion in absolute space": with ``psi`` the azimuth of the constraint direction
+``docs/model.md``, "Motion in absolute space": with ``psi`` the azimuth of the constraint direction
 ``nu = (cos psi, sin psi)`` in the fixed frame (the horizontal projection of the axis; carried
 through the pole in a pole case), ``Z = X + i Y`` the CoM position and the signed nutation angle
 ``theta`` of :mod:`rollingtop.reduction.level`,

@@ -1,7 +1,7 @@
 """The spherical top: parameters, validation and derived quantities.
 
-Notation of Kilin & Ivanova (2023), Sec. 2 (see also ``MODEL.md``, "Body and frames"): a sphere of
-radius ``R`` and mass ``m`` whose centre of mass lies on the symmetry axis ``e3`` at
+Notation of Kilin & Ivanova (2023), Sec. 2 (see also ``docs/model.md``, "Body and frames"): a
+sphere of radius ``R`` and mass ``m`` whose centre of mass lies on the symmetry axis ``e3`` at
 ``a = (0, 0, a3)`` from the geometric centre, with central inertia ``diag(I1, I2, I3)``.
 """
 

@@ -131,7 +131,7 @@ class Trajectory:
         """Contact point on the plane, fixed frame, shape (n, 2).
 
         ``(X, Y) + ((r, alpha), (r, beta))`` with ``r = -R gamma - a``, i.e.
-        ``(X - a3 alpha3, Y - a3 beta3)`` (``MODEL.md``, "Motion in absolute space").
+        ``(X - a3 alpha3, Y - a3 beta3)`` (``docs/model.md``, "Motion in absolute space").
         """
         return self.position - self.body.a3 * np.stack([self.y[:, 8], self.y[:, 11]], axis=-1)
 

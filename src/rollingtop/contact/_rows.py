@@ -3,7 +3,7 @@
 A constraint row is a linear condition ``J . u = 0`` on the generalised velocity
 ``u = (v, w)``. Its reaction is ``lambda * J`` (ideal constraint, d'Alembert-Lagrange), and the
 time derivative of the condition along the motion adds the *bias* ``dJ/dt . u`` to the
-acceleration equation (``MODEL.md``, "Dynamics").
+acceleration equation (``docs/model.md``, "Dynamics").
 """
 
 from rollingtop._jit import inline

@@ -1,4 +1,4 @@
-"""Compiled constrained dynamics shared by every contact model (``MODEL.md``, "Dynamics").
+"""Compiled constrained dynamics shared by every contact model (``docs/model.md``, "Dynamics").
 
 With ``u = (v, w)`` and the diagonal mass matrix ``M = diag(m, m, m, I1, I2, I3)``, the free
 motion is (paper eq. 2.7 with gravity written out)

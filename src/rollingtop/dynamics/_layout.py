@@ -2,7 +2,7 @@
 
 ``y = (v[3], w[3], alpha[3], beta[3], gamma[3], X, Y, psi_nu)``, shape (18,): body-frame CoM
 velocity and angular velocity, the fixed frame's unit vectors seen in the body frame, the
-horizontal CoM position in the fixed frame (``MODEL.md``, "Body and frames"), and ``psi_nu``,
+horizontal CoM position in the fixed frame (``docs/model.md``, "Body and frames"), and ``psi_nu``,
 the azimuth in the fixed frame of the meridian constraint's direction ``nu``.
 
 ``psi_nu`` equals the axis azimuth ``psi = atan2(beta3, alpha3)`` (unwrapped) away from the

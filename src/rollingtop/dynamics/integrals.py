@@ -1,4 +1,4 @@
-"""First integrals, evaluated on arrays of states (``MODEL.md``, "Energy and first integrals").
+"""First integrals, evaluated on arrays of states (``docs/model.md``, "Energy and first integrals").
 
 Each function takes the body and states ``Y`` of shape ``(..., 18)`` and returns shape ``(...)``.
 Which integrals hold for which model and body is declared by the contact models

@@ -47,8 +47,8 @@ def default_alpha(gamma: np.ndarray) -> np.ndarray:
     """Default fixed ``x`` axis: the horizontal projection of the symmetry axis ``e3``.
 
     In the body frame this is ``nu = (e3 - gamma3 gamma)/s``, so the azimuth of the axis starts at
-    ``psi = atan2(beta3, alpha3) = 0`` (``MODEL.md``, "Motion in absolute space"). When the axis
-    is vertical, the horizontal projection of ``e1`` is used instead.
+    ``psi = atan2(beta3, alpha3) = 0`` (``docs/model.md``, "Motion in absolute space"). When the
+    axis is vertical, the horizontal projection of ``e1`` is used instead.
     """
     for e in np.eye(3)[[2, 0, 1]]:
         h = e - (e @ gamma) * gamma

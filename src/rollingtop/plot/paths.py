@@ -7,8 +7,6 @@ from matplotlib.figure import Figure
 
 __all__ = ["path_figure", "timeseries_figure", "compare_figure"]
 
-_MODEL_COLOURS = {"meridian": "#1f77b4", "smooth": "#2ca02c", "rough": "#d62728"}
-
 
 def _title(traj) -> str:
     b = traj.body
@@ -117,7 +115,7 @@ def compare_figure(runs: dict, *, figsize=(10.0, 8.0)) -> Figure:
     shown = [n for n in ("energy", "F6", "momentum_x", "routh") if n in names] or names[:4]
     axes = [fig.add_subplot(grid[i, 1]) for i in range(len(shown))]
     for model, run in runs.items():
-        colour = _MODEL_COLOURS.get(model)
+        colour = run.model.colour
         ax.plot(run.position[:, 0], run.position[:, 1], lw=0.9, color=colour, label=model)
         ax.plot(*run.position[0], "s", color="black", ms=4)
         values = evaluate(run.body, run.y, shown, pole=run.pole_case)

@@ -1,7 +1,7 @@
 """Level sets of the integrals and the effective potential (paper Sec. 3.3, eqs. 3.8-3.11).
 
 On a level set ``(M3, C1, C2)`` of the Lagrange, area and F6 integrals the meridian model reduces
-to one degree of freedom (``MODEL.md``, "One degree of freedom"):
+to one degree of freedom (``docs/model.md``, "One degree of freedom"):
 
     w_n(gamma3)      = (M3 gamma3 - C1) / (I1 s)
     I1 v_tau(gamma3) = [R (M3 - C1 gamma3) + a3 (M3 gamma3 - C1)] / s + C2 + M3 a3 arccos(gamma3)
@@ -211,7 +211,7 @@ class LevelSet:
         return self.P(theta) / self.body.I1
 
     def U(self, theta):
-        """Effective potential ``U`` (eq. 3.11, ``MODEL.md``) at ``theta``."""
+        """Effective potential ``U`` (eq. 3.11, ``docs/model.md``) at ``theta``."""
         b = self.body
         q1, _, _, _ = self._q(theta)
         P = self.P(theta)
@@ -235,7 +235,7 @@ class LevelSet:
         return self.body.rho(np.cos(theta))
 
     def psi_dot(self, theta):
-        """Precession rate ``psi' = -w_n / s`` (``MODEL.md``, "Motion in absolute space"),
+        """Precession rate ``psi' = -w_n / s`` (``docs/model.md``, "Motion in absolute space"),
         finite at the pole in a pole case."""
         I1 = self.body.I1
         if self.pole == "both":
@@ -255,8 +255,8 @@ class LevelSet:
         return np.arccos(np.clip(g, -1.0, 1.0))
 
     def U_gamma3(self, gamma3):
-        """``U(gamma3)`` exactly as ``MODEL.md`` defines it, for ``gamma3`` in ``(-1, 1)`` (and at
-        the pole of a pole case)."""
+        """``U(gamma3)`` exactly as ``docs/model.md`` defines it, for ``gamma3`` in ``(-1, 1)``
+        (and at the pole of a pole case)."""
         return self.U(self.theta_of(gamma3))
 
     def energy(self, theta, w_tau):

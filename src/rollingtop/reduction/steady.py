@@ -35,7 +35,7 @@ class SteadyMotion:
     gamma3, theta : float
         Where (``gamma3 = cos theta``).
     U : float
-        Effective potential there (``MODEL.md`` definition): the reduced energy ``h``.
+        Effective potential there (``docs/model.md`` definition): the reduced energy ``h``.
     type : {"center", "saddle", "degenerate"}
         From the sign of ``U''``.
     U2 : float

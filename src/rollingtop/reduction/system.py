@@ -47,7 +47,7 @@ def reduced_rhs(body: SphericalTop, M3: float, x):
 
 
 def reduced_integrals_of(body: SphericalTop, M3: float, x) -> dict[str, np.ndarray]:
-    """``h, C1, C2`` of reduced states ``x`` (shape ``(4, ...)``), MODEL.md definitions."""
+    """``h, C1, C2`` of reduced states ``x`` (shape ``(4, ...)``), ``docs/model.md`` definitions."""
     g3, v_tau, w_n, w_tau = np.asarray(x, dtype=float)
     R, m, g, a3, I1 = body.R, body.m, body.g, body.a3, body.I1
     s = np.sqrt(1 - g3 * g3)

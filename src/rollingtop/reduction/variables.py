@@ -7,7 +7,7 @@ constraint-consistent state.
 The orientation left free by the reduced variables is fixed by the Euler angles of the
 3-1-3 convention: the vertical in the body frame is ``gamma = (s sin phi, s cos phi, gamma3)``
 (``phi``: proper rotation about the symmetry axis), and ``psi = atan2(beta3, alpha3)`` is the
-azimuth of the horizontal projection of the axis in the fixed frame (``MODEL.md``, "Motion in
+azimuth of the horizontal projection of the axis in the fixed frame (``docs/model.md``, "Motion in
 absolute space"), so that ``nu = cos(psi) alpha + sin(psi) beta`` and
 ``tau = sin(psi) alpha - cos(psi) beta``.
 """
