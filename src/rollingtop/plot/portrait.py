@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 
 from rollingtop.dynamics import _kernel
 from rollingtop.reduction import LevelSet, LevelSetError, orbits, state_from_level, steady_motions
-from rollingtop.reduction.orbits import _gap
+from rollingtop.reduction._quadrature import energy_gap
 
 __all__ = ["phase_portrait", "default_h_levels"]
 
@@ -57,7 +57,7 @@ def _orbit_curve(level: LevelSet, h: float, orbit, n: int = 400):
         return np.concatenate([theta, [np.nan], theta]), np.concatenate([w, [np.nan], -w])
     phi = np.linspace(-math.pi / 2, math.pi / 2, n)
     theta = (t1 + t2) / 2 + (t2 - t1) / 2 * np.sin(phi)
-    w = np.sqrt(np.maximum(2 * _gap(level, h, t1, t2, phi) / level.rho(theta), 0.0))
+    w = np.sqrt(np.maximum(2 * energy_gap(level, h, t1, t2, phi) / level.rho(theta), 0.0))
     x = _abscissa(level, theta)
     return np.concatenate([x, x[::-1]]), np.concatenate([w, -w[::-1]])
 

@@ -4,7 +4,9 @@
 - :mod:`.system`: the reduced system (eq. 3.3).
 - :mod:`.level`: level sets ``(M3, C1, C2)`` and the effective potential ``U``.
 - :mod:`.steady`: steady motions (critical points of ``U``).
-- :mod:`.orbits`: orbits on ``(M3, C1, C2, h)``, turning points, periods.
+- :mod:`.orbits`: orbits on ``(M3, C1, C2, h)``, turning points, periods; the quadrature of
+  the time along an orbit is the private :mod:`._quadrature`.
+- :mod:`.no_spin`, :mod:`.near_pole`: the no-spin level and levels near a pole level.
 """
 
 from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError

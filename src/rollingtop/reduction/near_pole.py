@@ -32,17 +32,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from rollingtop._json import json_ready
+from rollingtop.reduction._quadrature import WALL_RATIO, half_integral, half_map, period
 from rollingtop.reduction.level import LevelSet, LevelSetError
-from rollingtop.reduction.orbits import (
-    WALL_RATIO,
-    Orbit,
-    _half_map,
-    canonical_orbit,
-    half_integral,
-    near_north,
-    orbits,
-    period,
-)
+from rollingtop.reduction.orbits import Orbit, canonical_orbit, near_north, orbits
 
 __all__ = ["NEAR_POLE", "NearPole", "near_pole", "friction_needed"]
 
@@ -124,7 +116,7 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400):
     mid = (t1 + t2) / 2
     ends = []
     for t_end, left in ((t1, True), (t2, False)):  # the quadrature's wall variable at each end
-        u_max, theta_of = _half_map(t_end, mid, True, left)[:2]
+        u_max, theta_of = half_map(t_end, mid, True, left)[:2]
         ends.append(theta_of(np.linspace(0.0, u_max, samples)))
     thetas = np.unique(np.concatenate([*ends, np.linspace(t1, t2, samples)]))
     thetas = thetas[(thetas >= t1) & (thetas <= t2)]

@@ -25,15 +25,13 @@ import math
 
 import numpy as np
 
+from rollingtop.reduction._quadrature import PERIOD_RTOL, graded_gauss, period
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.orbits import (
-    PERIOD_RTOL,
     SEPARATRIX_TOLERANCE,
     STEADY_TOLERANCE,
     Orbit,
-    _graded_gauss,
-    _root,
-    period,
+    turning_point,
 )
 from rollingtop.reduction.steady import steady_motion
 
@@ -70,8 +68,8 @@ def rolling_over_period(level: LevelSet, h: float, weight=None) -> tuple[float, 
             return cur, abs(cur - prev)
         prev = cur
     # slow: a logarithmic peak at the saddle (just above the separatrix)
-    coarse = _graded_gauss(f, start, start + 2 * math.pi, [], 20)
-    fine = _graded_gauss(f, start, start + 2 * math.pi, [], 30)
+    coarse = graded_gauss(f, start, start + 2 * math.pi, [], 20)
+    fine = graded_gauss(f, start, start + 2 * math.pi, [], 30)
     return fine, abs(fine - coarse)
 
 
@@ -127,7 +125,7 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
         return [Orbit(-1.0, 1.0, saddle - math.pi, saddle + math.pi, T, err, "periodic", True,
                       w_max, "rolls over: passes through both poles each period")]  # fmt: skip
     # rocking about the centre, between turning points symmetric about it
-    t1 = _root(level, h, centre - math.pi + 1e-300, centre)
+    t1 = turning_point(level, h, centre - math.pi + 1e-300, centre)
     t2 = 2 * centre - t1
     T, err = period(level, h, t1, t2)
     g_turn = math.cos(t1)
