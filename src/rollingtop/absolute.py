@@ -5,7 +5,7 @@
 through the pole in a pole case), ``Z = X + i Y`` the CoM position and the signed nutation angle
 ``theta`` of :mod:`rollingtop.reduction.level`,
 
-    theta' = -w_tau,    w_tau' = (U'(theta) + rho_theta w_tau^2 / 2) / rho     (from h conserved)
+    theta' = -w_tau,    w_tau' = (U'(theta) + rho_theta w_tau^2 / 2) / rho  (LevelSet.flow)
     psi'   = -w_n / s  (a function of theta on the level set)
     Z'     = exp(i psi) (-(R + a3 gamma3) w_tau - i v_tau)
     contact point = Z - a3 s exp(i psi).
@@ -45,14 +45,13 @@ def _path_rhs(level: LevelSet):
 
     def f(t, z):
         theta, w_tau, psi = z[0], z[1], z[2]
-        rho = level.rho(theta)
-        rho_theta = -2 * b.m * b.a3 * b.R * np.sin(theta)
+        theta_dot, w_tau_dot = level.flow(theta, w_tau)
         k = (b.R + b.a3 * np.cos(theta)) * w_tau
         v_tau = level.v_tau(theta)
         c, s = np.cos(psi), np.sin(psi)
         return [
-            -w_tau,
-            (level.dU(theta) + 0.5 * rho_theta * w_tau**2) / rho,
+            theta_dot,
+            w_tau_dot,
             level.psi_dot(theta),
             -k * c + v_tau * s,
             -k * s - v_tau * c,
@@ -192,7 +191,7 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
         theta0, w_tau0 = start_theta(orbit), 0.0
         if orbit.rolls_over:  # no turning point: start where theta' is known, moving forwards
             theta0 = orbit.theta_min
-            w_tau0 = -math.sqrt(2 * (h - float(level.U(theta0))) / float(level.rho(theta0)))
+            w_tau0 = -float(level.w_tau(theta0, h))
         path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
     else:
         exact_level, exact_orbit = canonical_orbit(level, h, orbit)  # near north: its mirror

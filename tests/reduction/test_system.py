@@ -7,6 +7,7 @@ import pytest
 
 from rollingtop import load_scenario, simulate
 from rollingtop.reduction import (
+    LevelSet,
     integrate_reduced,
     reduce_state,
     reduced_integrals,
@@ -70,3 +71,23 @@ def test_full_simulation_follows_the_reduced_system():
     for name in ("h", "C1", "C2"):
         assert np.ptp(ints[name]) < 1e-11, name
         assert ints[name][0] == pytest.approx(float(full[name][0]), abs=1e-14)
+
+
+def test_level_set_is_the_reduced_system_on_a_level(paper_body):
+    """LevelSet's one-degree-of-freedom description (``P``, ``w_n``, ``flow``, ``energy``,
+    ``w_tau``) is eq. (3.3) restricted to ``(M3, C1, C2)``: the integrals of its states are the
+    level's, and its flow is ``reduced_rhs`` there (``gamma3 = cos theta``, ``theta' = -w_tau``)."""
+    level = LevelSet(paper_body, M3=1.0, C1=0.5, C2=-2.0)
+    for theta in (0.4, 1.1, 2.0, 2.7):
+        h = float(level.U(theta)) + 0.8
+        w_tau = float(level.w_tau(theta, h))
+        assert float(level.energy(theta, w_tau)) == pytest.approx(h, rel=1e-14)
+        x = np.array([np.cos(theta), level.v_tau(theta), level.w_n(theta), -w_tau])
+        ints = reduced_integrals_of(paper_body, level.M3, x)
+        assert float(ints["C1"]) == pytest.approx(level.C1, rel=1e-13)
+        assert float(ints["C2"]) == pytest.approx(level.C2, rel=1e-13)
+        assert float(ints["h"]) == pytest.approx(h, rel=1e-13)
+        theta_dot, w_tau_dot = level.flow(theta, -w_tau)
+        g3_dot, _, _, w_tau_dot_33 = reduced_rhs(paper_body, level.M3, x)
+        assert -np.sin(theta) * theta_dot == pytest.approx(g3_dot, rel=1e-13)
+        assert w_tau_dot == pytest.approx(w_tau_dot_33, rel=1e-12)

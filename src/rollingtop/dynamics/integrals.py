@@ -12,7 +12,7 @@ import numpy as np
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, V, W
 
-__all__ = ["INTEGRALS", "evaluate"]
+__all__ = ["INTEGRALS", "F6_reduced", "evaluate"]
 
 
 def _arm(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
@@ -90,20 +90,39 @@ def reduced_components(Y: np.ndarray, pole: str | None = None) -> dict[str, np.n
     }
 
 
+def F6_reduced(
+    body: SphericalTop,
+    M3: np.ndarray | float,
+    gamma3: np.ndarray | float,
+    s: np.ndarray | float,
+    theta: np.ndarray | float,
+    v_tau: np.ndarray | float,
+    w_n: np.ndarray | float,
+) -> np.ndarray:
+    """The paper's new linear integral in the reduced variables (eq. 3.9), the one definition:
+
+    ``F6 = I1 (v_tau - (R gamma3 + a3) w_n) - M3 (R s + a3 theta)``,
+
+    with ``s = sqrt(1 - gamma3^2)`` and ``theta = arccos(gamma3)`` in the paper's unsigned
+    variables, or the signed ``s`` and ``theta`` of a pole case (:func:`F6`). Arguments
+    broadcast together; the result has their common shape. Its inverse on a level set (``I1
+    v_tau`` from ``C2``) is :meth:`rollingtop.reduction.LevelSet.P`.
+    """
+    return body.I1 * (v_tau - (body.R * gamma3 + body.a3) * w_n) - M3 * (
+        body.R * s + body.a3 * theta
+    )
+
+
 def F6(body: SphericalTop, Y: np.ndarray, pole: str | None = None) -> np.ndarray:
-    """The paper's new linear integral (symmetric body, meridian model, eq. 3.9):
-
-    ``F6 = I1 (v_tau - (R gamma3 + a3) w_n) - M3 (R sqrt(1 - gamma3^2) + a3 arccos(gamma3))``,
-
-    evaluated in the basis of :func:`reduced_components` (``sqrt(1 - gamma3^2)`` and
-    ``arccos(gamma3)`` become the signed ``s`` and ``theta``), so that it stays constant through
-    the pole passages of a pole case, where the paper's unsigned expression changes sign.
+    """The paper's new linear integral (symmetric body, meridian model, eq. 3.9) of states ``Y``:
+    :func:`F6_reduced` of the reduced variables of :func:`reduced_components`, where
+    ``sqrt(1 - gamma3^2)`` and ``arccos(gamma3)`` are the signed ``s`` and ``theta``, so that it
+    stays constant through the pole passages of a pole case, where the paper's unsigned
+    expression changes sign.
     """
     c = reduced_components(Y, pole)
     M3 = body.I3 * Y[..., 5]
-    return body.I1 * (c["v_tau"] - (body.R * c["gamma3"] + body.a3) * c["w_n"]) - M3 * (
-        body.R * c["s"] + body.a3 * c["theta"]
-    )
+    return F6_reduced(body, M3, c["gamma3"], c["s"], c["theta"], c["v_tau"], c["w_n"])
 
 
 def momentum_x(body: SphericalTop, Y: np.ndarray) -> np.ndarray:

@@ -53,11 +53,11 @@ def _orbit_curve(level: LevelSet, h: float, orbit, n: int = 400):
         # rolling over (no spin): theta runs round the circle; draw w_tau > 0 and < 0 branches
         # over the plotted window, separated by a NaN so that they are not joined
         theta = np.linspace(*level.theta_domain, 2 * n)
-        w = np.sqrt(np.maximum(2 * (h - level.U(theta)) / level.rho(theta), 0.0))
+        w = level.w_tau(theta, h)
         return np.concatenate([theta, [np.nan], theta]), np.concatenate([w, [np.nan], -w])
     phi = np.linspace(-math.pi / 2, math.pi / 2, n)
     theta = (t1 + t2) / 2 + (t2 - t1) / 2 * np.sin(phi)
-    w = np.sqrt(np.maximum(2 * energy_gap(level, h, t1, t2, phi) / level.rho(theta), 0.0))
+    w = level.w_tau(theta, h, gap=energy_gap(level, h, t1, t2, phi))
     x = _abscissa(level, theta)
     return np.concatenate([x, x[::-1]]), np.concatenate([w, -w[::-1]])
 
@@ -67,9 +67,8 @@ def _normal_force_grid(level: LevelSet, g3: np.ndarray, w: np.ndarray) -> np.nda
     states = []
     for gg in g3:
         theta = math.acos(gg)
-        U, rho = float(level.U(theta)), float(level.rho(theta))
         for ww in w:
-            h = U + 0.5 * rho * ww * ww
+            h = float(level.energy(theta, ww))
             states.append(state_from_level(level, h, gg, branch=1 if ww >= 0 else -1))
     Y = np.ascontiguousarray(states)
     out = np.empty((len(Y), 8))

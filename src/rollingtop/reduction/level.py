@@ -197,7 +197,12 @@ class LevelSet:
         )
 
     def P(self, theta):
-        """``I1 v_tau`` as a function of ``theta`` (eq. 3.8), signed-``s`` convention."""
+        """``I1 v_tau`` as a function of ``theta`` (eq. 3.8), signed-``s`` convention.
+
+        The integral ``F6 = C2`` (:func:`rollingtop.dynamics.integrals.F6_reduced`) solved for
+        ``I1 v_tau`` with :meth:`w_n` substituted, in the cancellation-free form of :meth:`_q`
+        (tested against ``F6_reduced``).
+        """
         _, q2, _, _ = self._q(theta)
         return q2 + self.C2 + self.M3 * self.body.a3 * theta
 
@@ -234,6 +239,11 @@ class LevelSet:
         """Invariant-measure density, also the reduced motion's mass: ``rho(cos theta)`` (3.5)."""
         return self.body.rho(np.cos(theta))
 
+    def drho(self, theta):
+        """``d rho(cos theta) / dtheta = -2 m a3 R sin(theta)``."""
+        b = self.body
+        return -2 * b.m * b.a3 * b.R * np.sin(theta)
+
     def psi_dot(self, theta):
         """Precession rate ``psi' = -w_n / s`` (``docs/model.md``, "Motion in absolute space"),
         finite at the pole in a pole case."""
@@ -259,9 +269,33 @@ class LevelSet:
         (and at the pole of a pole case)."""
         return self.U(self.theta_of(gamma3))
 
+    # ---- the one-degree-of-freedom system: h = rho w_tau^2 / 2 + U(theta), theta' = -w_tau ------
     def energy(self, theta, w_tau):
-        """Reduced energy ``h = rho w_tau^2 / 2 + U``."""
-        return 0.5 * self.rho(theta) * np.asarray(w_tau) ** 2 + self.U(theta)
+        """Reduced energy ``h = rho w_tau^2 / 2 + U`` at ``(theta, w_tau)`` (arrays broadcast)."""
+        w_tau = np.asarray(w_tau)
+        return self.U(theta) + 0.5 * self.rho(theta) * w_tau * w_tau
+
+    def w_tau(self, theta, h: float, gap=None):
+        """``|w_tau| = sqrt(2 (h - U) / rho)`` at ``theta`` on the orbit of reduced energy ``h``
+        (:meth:`energy` solved for ``w_tau``; the sign is the branch), 0 where ``h < U``.
+
+        ``gap`` replaces ``h - U(theta)`` where it is known more accurately (next to a turning
+        point, :func:`rollingtop.reduction._quadrature.energy_gap`).
+        """
+        if gap is None:
+            gap = h - self.U(theta)
+        return np.sqrt(np.maximum(2 * gap / self.rho(theta), 0.0))
+
+    def flow(self, theta, w_tau):
+        """The equations of motion ``(theta', w_tau')`` on the level set:
+
+            theta' = -w_tau,    w_tau' = (U'(theta) + rho'(theta) w_tau^2 / 2) / rho,
+
+        from ``h = rho theta'^2 / 2 + U`` conserved; regular through the pole of a pole case. The
+        same motion as the reduced system :func:`rollingtop.reduction.reduced_rhs` (eq. 3.3), in
+        the variables of the level set.
+        """
+        return -w_tau, (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from rollingtop.reduction._quadrature import PERIOD_RTOL, graded_gauss, period
+from rollingtop.reduction._quadrature import PERIOD_RTOL, graded_gauss, period, time_density
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.orbits import (
     SEPARATRIX_TOLERANCE,
@@ -54,11 +54,8 @@ def rolling_over_period(level: LevelSet, h: float, weight=None) -> tuple[float, 
     poles = _poles(level)
     start = poles[1] if poles else 0.0
 
-    def f(theta):
-        gap = np.maximum(h - level.U(theta), 0.0)
-        with np.errstate(divide="ignore"):
-            val = np.sqrt(level.rho(theta) / (2.0 * gap))
-        return val if weight is None else val * weight(theta)
+    def f(theta):  # dt/dtheta (times the weight); jac = 1/2 undoes time_density's factor 2
+        return time_density(level, theta, h - level.U(theta), 0.5, weight)
 
     prev = None
     for n in (2**k for k in range(4, 17)):
@@ -114,7 +111,7 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
         return [Orbit(g_c, g_c, centre, centre, m.period, 0.0, "steady", False, 0.0,
                       "at rest at the pole (h at the minimum of U); period of small "
                       "oscillations")]  # fmt: skip
-    w_max = math.sqrt(2 * (h - Uc) / float(level.rho(centre)))
+    w_max = float(level.w_tau(centre, h))
     if abs(h - Us) <= SEPARATRIX_TOLERANCE * scale:
         return [Orbit(-1.0, 1.0, saddle - math.pi, saddle + math.pi, math.inf, math.inf,
                       "separatrix", True, w_max,

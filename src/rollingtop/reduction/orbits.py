@@ -222,7 +222,7 @@ def _make_orbit(level, h, t1, t2, crit, steadies, scale) -> Orbit:
         g_max = 1.0 if level.pole == "south" else g_max
         g_min = -1.0 if level.pole == "north" else g_min
     thetas = np.linspace(t1, t2, 2001)
-    w_tau_max = float(np.sqrt(np.max(np.maximum(2 * (h - level.U(thetas)) / level.rho(thetas), 0))))
+    w_tau_max = float(np.max(level.w_tau(thetas, h)))
     note = "passes through the pole" if passage else ""
     # steady motion: a centre with h at (or within round-off of) its potential
     if t2 - t1 < 1e-7 or any(

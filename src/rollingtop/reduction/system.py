@@ -19,6 +19,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rollingtop.body import SphericalTop
+from rollingtop.dynamics.integrals import F6_reduced
 
 __all__ = ["reduced_rhs", "reduced_integrals_of", "integrate_reduced"]
 
@@ -28,7 +29,7 @@ def reduced_rhs(body: SphericalTop, M3: float, x):
     g3, v_tau, w_n, w_tau = x
     R, m, g, a3, I1 = body.R, body.m, body.g, body.a3, body.I1
     s = np.sqrt(1 - g3 * g3)
-    rho = I1 + m * (a3 * a3 + R * R + 2 * a3 * R * g3)
+    rho = body.rho(g3)
     k = R + a3 * g3
     return np.array(
         [
@@ -49,13 +50,12 @@ def reduced_rhs(body: SphericalTop, M3: float, x):
 def reduced_integrals_of(body: SphericalTop, M3: float, x) -> dict[str, np.ndarray]:
     """``h, C1, C2`` of reduced states ``x`` (shape ``(4, ...)``), ``docs/model.md`` definitions."""
     g3, v_tau, w_n, w_tau = np.asarray(x, dtype=float)
-    R, m, g, a3, I1 = body.R, body.m, body.g, body.a3, body.I1
+    m, g, a3, I1 = body.m, body.g, body.a3, body.I1
     s = np.sqrt(1 - g3 * g3)
-    rho = I1 + m * (a3 * a3 + R * R + 2 * a3 * R * g3)
     return {
-        "h": m * v_tau**2 / 2 + I1 * w_n**2 / 2 + rho * w_tau**2 / 2 + m * g * a3 * g3,
+        "h": m * v_tau**2 / 2 + I1 * w_n**2 / 2 + body.rho(g3) * w_tau**2 / 2 + m * g * a3 * g3,
         "C1": g3 * M3 - I1 * s * w_n,
-        "C2": I1 * (v_tau - (R * g3 + a3) * w_n) - M3 * (R * s + a3 * np.arccos(g3)),
+        "C2": F6_reduced(body, M3, g3, s, np.arccos(g3), v_tau, w_n),
     }
 
 

@@ -111,8 +111,7 @@ def state_from_level(
             f"h = {h:.12g} is below the effective potential U({gamma3:g}) = {U:.12g}: "
             "no motion passes through this gamma3"
         )
-    rho = float(level.rho(theta))
-    w_tau = branch * math.sqrt(max(2.0 * (h - U) / rho, 0.0))  # 0 at a turning point
+    w_tau = branch * float(level.w_tau(theta, h))  # 0 at a turning point
     w_n = float(level.w_n(theta))
     v_tau = float(level.v_tau(theta))
     s = math.sin(theta)
