@@ -1,7 +1,9 @@
 """rollingtop benchmarks: side-by-side timings against scipy.integrate.solve_ivp.
 
-Run:  python benchmarks/run_benchmarks.py [--quick] [--readme] [--only W1,W2,W3,cold_start]
+Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs] [--only W1,W2,W3,cold_start]
                                           [--out benchmarks/results.json]
+
+--write-docs (old name: --readme) rewrites the results block of docs/guide/performance.md.
 
 W1  one long trajectory (paper's body, examples/paper.toml, t = 1e4, rtol 1e-10, atol 1e-12):
     rollingtop vs solve_ivp(DOP853) with a plain NumPy right-hand side and with rollingtop's
@@ -347,12 +349,15 @@ def table(res) -> str:
     return "\n".join(rows)
 
 
-README_START = "<!-- benchmark-results:start (written by benchmarks/run_benchmarks.py --readme) -->"
-README_END = "<!-- benchmark-results:end -->"
+DOCS_PAGE = ROOT / "docs" / "guide" / "performance.md"
+DOCS_START = (
+    "<!-- benchmark-results:start (written by benchmarks/run_benchmarks.py --write-docs) -->"
+)
+DOCS_END = "<!-- benchmark-results:end -->"
 
 
-def readme_block(res) -> str:
-    """The machine, the date and the tables, for the README."""
+def docs_block(res) -> str:
+    """The machine, the date and the tables, for the performance page."""
     m = res["machine"]
     dates = res.get("dates", {})
     if len(set(dates.values())) > 1:
@@ -366,15 +371,20 @@ def readme_block(res) -> str:
     )
 
 
-def write_readme(res, path: Path) -> None:
-    """Replace the block between the README's markers with the new results (atomically)."""
-    text = path.read_text()
-    head, sep, rest = text.partition(README_START)
-    _, sep2, tail = rest.partition(README_END)
+def replace_block(text: str, block: str, where: object = DOCS_PAGE) -> str:
+    """``text`` with the lines between its benchmark markers replaced by ``block``."""
+    head, sep, rest = text.partition(DOCS_START)
+    _, sep2, tail = rest.partition(DOCS_END)
     if not sep or not sep2:
-        raise SystemExit(f"{path}: benchmark markers not found")
+        raise SystemExit(f"{where}: benchmark markers not found")
+    return f"{head}{DOCS_START}\n{block}\n{DOCS_END}{tail}"
+
+
+def write_docs(res, path: Path = DOCS_PAGE) -> None:
+    """Replace the block between the page's markers with the new results (atomically)."""
+    text = replace_block(path.read_text(), docs_block(res), path)
     tmp = path.with_suffix(".md.tmp")
-    tmp.write_text(f"{head}{README_START}\n{readme_block(res)}\n{README_END}{tail}")
+    tmp.write_text(text)
     os.replace(tmp, path)
 
 
@@ -383,14 +393,17 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smaller sizes, for a smoke test")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results.json"))
     ap.add_argument(
+        "--write-docs",
         "--readme",
+        dest="write_docs",
         action="store_true",
-        help="also write the tables into README.md (between its markers)",
+        help="also write the tables into docs/guide/performance.md (between its markers); "
+        "--readme is the old name",
     )
     ap.add_argument(
         "--from-json",
         metavar="FILE",
-        help="do not measure: (re)write the README block from saved results",
+        help="do not measure: (re)write the docs block from saved results",
     )
     ap.add_argument(
         "--only",
@@ -401,7 +414,8 @@ def main() -> None:
     if args.from_json:
         res = json.loads(Path(args.from_json).read_text())
         res["table_markdown"] = table(res)
-        write_readme(res, ROOT / "README.md")
+        write_docs(res)
+        print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
         return
     quick = args.quick
     parts = {"W2", "W3", "cold_start", "W1"}
@@ -431,9 +445,9 @@ def main() -> None:
     Path(args.out).write_text(json.dumps(res, indent=2))
     print(res["table_markdown"])
     print(f"wrote {args.out}")
-    if args.readme and not quick:
-        write_readme(res, ROOT / "README.md")
-        print("wrote README.md")
+    if args.write_docs and not quick:
+        write_docs(res)
+        print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
 
 
 if __name__ == "__main__":
