@@ -20,6 +20,8 @@ import contextlib
 import signal
 import threading
 from collections.abc import Iterator
+from types import FrameType
+from typing import NoReturn
 
 from rollingtop._errors import Interrupted
 
@@ -38,7 +40,7 @@ class Signalled(BaseException):
         self.signum = int(signum)
 
 
-def _raise(signum, frame):
+def _raise(signum: int, frame: FrameType | None) -> NoReturn:
     raise Signalled(signum)
 
 

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import overload
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rollingtop._errors import BodyError
 
@@ -118,17 +120,22 @@ class SphericalTop:
         return self.I1 == self.I2
 
     @property
-    def inertia(self) -> np.ndarray:
+    def inertia(self) -> NDArray[np.float64]:
         """Central inertia diagonal ``(I1, I2, I3)``, shape (3,)."""
         return np.array([self.I1, self.I2, self.I3])
 
     @property
-    def params(self) -> np.ndarray:
+    def params(self) -> NDArray[np.float64]:
         """Parameters ``(R, m, g, a3, I1, I2, I3)`` for the compiled kernels, shape (7,)."""
         return np.array([self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3], dtype=float)
 
-    def rho(self, gamma3):
-        """Invariant-measure density ``rho = I1 + m (a3^2 + R^2 + 2 a3 R gamma3)`` (eq. 3.3)."""
+    @overload
+    def rho(self, gamma3: float) -> float: ...
+    @overload
+    def rho(self, gamma3: NDArray[np.float64]) -> NDArray[np.float64]: ...
+    def rho(self, gamma3: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
+        """Invariant-measure density ``rho = I1 + m (a3^2 + R^2 + 2 a3 R gamma3)`` (eq. 3.3), of
+        the shape of ``gamma3`` (a numpy float for a float)."""
         return self.I1 + self.m * (
             self.a3**2 + self.R**2 + 2 * self.a3 * self.R * np.asarray(gamma3)
         )

@@ -20,8 +20,13 @@ import tempfile
 import threading
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING, TypeAlias
 
 from rollingtop._errors import OutputError
+
+if TYPE_CHECKING:
+    from _typeshed import ReadableBuffer
+    from xarray import Dataset
 
 __all__ = [
     "WriteFailed",
@@ -33,6 +38,9 @@ __all__ = [
     "write_bytes_atomic",
 ]
 
+#: A file name: a string or a path-like object.
+PathArg: TypeAlias = str | os.PathLike[str]
+
 #: Largest piece handed to one ``os.write`` call.
 _CHUNK = 1 << 20
 
@@ -42,7 +50,7 @@ class WriteFailed(OSError):
     lost during the run. A runtime failure (the command line exits with status 1), not an input
     error; the target is left as it was and no temporary file remains."""
 
-    def __init__(self, path: str | os.PathLike, errno: int | None, reason: str) -> None:
+    def __init__(self, path: PathArg, errno: int | None, reason: str) -> None:
         super().__init__(errno, reason, os.fspath(path))
 
     def __str__(self) -> str:
@@ -65,7 +73,7 @@ def _reason(exc: BaseException) -> tuple[int | None, str]:
     return None, text if len(text) <= 200 else text[:199] + "…"
 
 
-def _write_error(exc: BaseException) -> BaseException | None:
+def _write_error(exc: BaseException | None) -> BaseException | None:
     """The ``OSError`` (or failed encoder process) behind ``exc``, if any: a writer that fails
     while cleaning up after a failed write (matplotlib's PDF backend raises ``zlib.error``) still
     counts as a write failure."""
@@ -89,7 +97,7 @@ def _ignore_sigxfsz() -> None:
             signal.signal(sig, signal.SIG_IGN)
 
 
-def check_output_path(path: str | os.PathLike, suffixes: Iterable[str]) -> Path:
+def check_output_path(path: PathArg, suffixes: Iterable[str]) -> Path:
     """Check, before any work, that ``path`` can be written; return it as a :class:`Path`.
 
     Raises
@@ -162,7 +170,7 @@ def _publish(fd: int, tmp: Path, path: Path, data: memoryview | None = None) -> 
             os.close(dir_fd)
 
 
-def write_bytes_atomic(path: str | os.PathLike, data) -> Path:
+def write_bytes_atomic(path: PathArg, data: ReadableBuffer) -> Path:
     """Write the bytes ``data`` (any buffer) to ``path`` atomically.
 
     Raises
@@ -182,7 +190,7 @@ def write_bytes_atomic(path: str | os.PathLike, data) -> Path:
 
 
 def atomic_write(
-    path: str | os.PathLike, write: Callable[[Path], None], *, keep_suffix: bool = False
+    path: PathArg, write: Callable[[Path], None], *, keep_suffix: bool = False
 ) -> Path:
     """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it onto ``path``.
 
@@ -211,7 +219,7 @@ def atomic_write(
     return path
 
 
-def netcdf_bytes(ds) -> memoryview:
+def netcdf_bytes(ds: Dataset) -> memoryview:
     """The NetCDF-4 file of the :class:`xarray.Dataset` ``ds`` (engine ``h5netcdf``), in memory.
 
     HDF5 then never writes to disk itself: the bytes go out through :func:`write_bytes_atomic`.
@@ -221,10 +229,11 @@ def netcdf_bytes(ds) -> memoryview:
 
 def format_bytes(n: float) -> str:
     """``n`` bytes in B, KiB, MiB, GiB, TiB or PiB, to one decimal (``"4.8 MiB"``)."""
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if n < 1024 or unit == "PiB":
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if n < 1024:
             return f"{n:.1f}".removesuffix(".0") + f" {unit}"
         n /= 1024
+    return f"{n:.1f}".removesuffix(".0") + " PiB"
 
 
 _KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
@@ -232,7 +241,7 @@ _KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
 
 
 def read_input_text(
-    path: str | os.PathLike, what: str, limit: int, error: type[Exception] = ValueError
+    path: PathArg, what: str, limit: int, error: type[Exception] = ValueError
 ) -> str:
     """The UTF-8 text of the input file ``path`` (a scenario, a table), read safely.
 

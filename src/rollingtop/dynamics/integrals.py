@@ -1,53 +1,69 @@
 """First integrals, evaluated on arrays of states (``docs/model.md``, "Energy and first integrals").
 
-Each function takes the body and states ``Y`` of shape ``(..., 18)`` and returns shape ``(...)``.
+Each function takes the body and states ``Y`` of shape ``(..., 18)`` and returns shape ``(...)``
+(a numpy scalar for a single state, as numpy's own reductions do).
 Which integrals hold for which model and body is declared by the contact models
 (:meth:`rollingtop.contact.ContactModel.integrals`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
+from typing import TypeAlias
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, V, W
 
 __all__ = ["INTEGRALS", "F6_reduced", "evaluate"]
 
+FloatArray: TypeAlias = NDArray[np.float64]
+#: An integral: ``(body, Y)`` with states ``Y`` of shape ``(..., 18)`` -> values, shape ``(...)``.
+Integral: TypeAlias = Callable[[SphericalTop, FloatArray], FloatArray]
 
-def _arm(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
-    r = -body.R * Y[..., GAMMA]
+
+def _arm(body: SphericalTop, Y: FloatArray) -> FloatArray:
+    """Contact point seen from the CoM, ``r = -R gamma - a``, shape ``(..., 3)``."""
+    r: FloatArray = -body.R * Y[..., GAMMA]
     r[..., 2] -= body.a3
     return r
 
 
-def _Iw(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
-    return Y[..., W] * body.inertia
+def _Iw(body: SphericalTop, Y: FloatArray) -> FloatArray:
+    """Angular momentum about the CoM, ``I w``, shape ``(..., 3)``."""
+    Iw: FloatArray = Y[..., W] * body.inertia
+    return Iw
 
 
-def energy(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def energy(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """``E = m (v, v)/2 + (w, I w)/2 - m g (r, gamma)``; zero with the CoM on the plane."""
     v, w, gamma = Y[..., V], Y[..., W], Y[..., GAMMA]
     kinetic = 0.5 * body.m * np.sum(v * v, axis=-1) + 0.5 * np.sum(w * _Iw(body, Y), axis=-1)
-    return kinetic - body.m * body.g * np.sum(_arm(body, Y) * gamma, axis=-1)
+    E: FloatArray = kinetic - body.m * body.g * np.sum(_arm(body, Y) * gamma, axis=-1)
+    return E
 
 
-def lagrange(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def lagrange(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """Lagrange's integral ``F3 = I3 w3 = M3`` (symmetric body)."""
-    return body.I3 * Y[..., 5]
+    F3: FloatArray = body.I3 * Y[..., 5]
+    return F3
 
 
-def jellett(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def jellett(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """Jellett's integral ``F4 = (I w, r)``."""
-    return np.sum(_Iw(body, Y) * _arm(body, Y), axis=-1)
+    F4: FloatArray = np.sum(_Iw(body, Y) * _arm(body, Y), axis=-1)
+    return F4
 
 
-def area(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def area(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """Area integral ``F5 = (I w, gamma)``: vertical angular momentum about the CoM."""
-    return np.sum(_Iw(body, Y) * Y[..., GAMMA], axis=-1)
+    F5: FloatArray = np.sum(_Iw(body, Y) * Y[..., GAMMA], axis=-1)
+    return F5
 
 
-def reduced_components(Y: np.ndarray, pole: str | None = None) -> dict[str, np.ndarray]:
+def reduced_components(Y: ArrayLike, pole: str | None = None) -> dict[str, FloatArray]:
     """Reduced variables of states ``Y`` (paper Sec. 3.1), each of shape ``(...)``.
 
     Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``. The basis is the one of the
@@ -63,6 +79,7 @@ def reduced_components(Y: np.ndarray, pole: str | None = None) -> dict[str, np.n
     """
     Y = np.asarray(Y, dtype=float)
     g1, g2, g3 = Y[..., 12], Y[..., 13], Y[..., 14]
+    nu: FloatArray
     if Y.shape[-1] > 17:
         c, sn = np.cos(Y[..., 17]), np.sin(Y[..., 17])
         nu = c[..., None] * Y[..., ALPHA] + sn[..., None] * Y[..., BETA]
@@ -92,28 +109,30 @@ def reduced_components(Y: np.ndarray, pole: str | None = None) -> dict[str, np.n
 
 def F6_reduced(
     body: SphericalTop,
-    M3: np.ndarray | float,
-    gamma3: np.ndarray | float,
-    s: np.ndarray | float,
-    theta: np.ndarray | float,
-    v_tau: np.ndarray | float,
-    w_n: np.ndarray | float,
-) -> np.ndarray:
+    M3: float | FloatArray,
+    gamma3: FloatArray,
+    s: FloatArray,
+    theta: FloatArray,
+    v_tau: FloatArray,
+    w_n: FloatArray,
+) -> FloatArray:
     """The paper's new linear integral in the reduced variables (eq. 3.9), the one definition:
 
     ``F6 = I1 (v_tau - (R gamma3 + a3) w_n) - M3 (R s + a3 theta)``,
 
     with ``s = sqrt(1 - gamma3^2)`` and ``theta = arccos(gamma3)`` in the paper's unsigned
-    variables, or the signed ``s`` and ``theta`` of a pole case (:func:`F6`). Arguments
-    broadcast together; the result has their common shape. Its inverse on a level set (``I1
-    v_tau`` from ``C2``) is :meth:`rollingtop.reduction.LevelSet.P`.
+    variables, or the signed ``s`` and ``theta`` of a pole case (:func:`F6`). The arrays of
+    reduced components broadcast together (numpy scalars for one state); the result has their
+    common shape. Its inverse on a level set (``I1 v_tau`` from ``C2``) is
+    :meth:`rollingtop.reduction.LevelSet.P`.
     """
-    return body.I1 * (v_tau - (body.R * gamma3 + body.a3) * w_n) - M3 * (
+    F6: FloatArray = body.I1 * (v_tau - (body.R * gamma3 + body.a3) * w_n) - M3 * (
         body.R * s + body.a3 * theta
     )
+    return F6
 
 
-def F6(body: SphericalTop, Y: np.ndarray, pole: str | None = None) -> np.ndarray:
+def F6(body: SphericalTop, Y: FloatArray, pole: str | None = None) -> FloatArray:
     """The paper's new linear integral (symmetric body, meridian model, eq. 3.9) of states ``Y``:
     :func:`F6_reduced` of the reduced variables of :func:`reduced_components`, where
     ``sqrt(1 - gamma3^2)`` and ``arccos(gamma3)`` are the signed ``s`` and ``theta``, so that it
@@ -121,34 +140,40 @@ def F6(body: SphericalTop, Y: np.ndarray, pole: str | None = None) -> np.ndarray
     expression changes sign.
     """
     c = reduced_components(Y, pole)
-    M3 = body.I3 * Y[..., 5]
+    M3: FloatArray = body.I3 * Y[..., 5]
     return F6_reduced(body, M3, c["gamma3"], c["s"], c["theta"], c["v_tau"], c["w_n"])
 
 
-def momentum_x(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def momentum_x(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """Horizontal momentum along the fixed axis of ``alpha``: ``m (v, alpha)``."""
-    return body.m * np.sum(Y[..., V] * Y[..., ALPHA], axis=-1)
+    p: FloatArray = body.m * np.sum(Y[..., V] * Y[..., ALPHA], axis=-1)
+    return p
 
 
-def momentum_y(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def momentum_y(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """Horizontal momentum along the fixed axis of ``beta``: ``m (v, beta)``."""
-    return body.m * np.sum(Y[..., V] * Y[..., BETA], axis=-1)
+    p: FloatArray = body.m * np.sum(Y[..., V] * Y[..., BETA], axis=-1)
+    return p
 
 
-def routh(body: SphericalTop, Y: np.ndarray) -> np.ndarray:
+def routh(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """Routh's integral ``w3 sqrt(I1 I3 + m I1 (r1^2 + r2^2) + m I3 r3^2)`` (rough plane)."""
     r = _arm(body, Y)
     q = body.I1 * body.I3 + body.m * body.I1 * (r[..., 0] ** 2 + r[..., 1] ** 2)
     q = q + body.m * body.I3 * r[..., 2] ** 2
-    return Y[..., 5] * np.sqrt(q)
+    routh_: FloatArray = Y[..., 5] * np.sqrt(q)
+    return routh_
 
 
-INTEGRALS = {
+#: Every integral by name.
+INTEGRALS: dict[str, Integral] = {
     f.__name__: f for f in (energy, lagrange, jellett, area, F6, momentum_x, momentum_y, routh)
 }
 
 
-def evaluate(body: SphericalTop, Y: np.ndarray, names, pole: str | None = None) -> dict:
+def evaluate(
+    body: SphericalTop, Y: ArrayLike, names: Iterable[str], pole: str | None = None
+) -> dict[str, FloatArray]:
     """Evaluate the integrals ``names`` on states ``Y`` (shape ``(..., 18)``); ``pole`` is the
     meridian pole case the states belong to, if any (see :func:`F6`)."""
     Y = np.asarray(Y, dtype=float)

@@ -21,13 +21,17 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable, Sequence
+from typing import NamedTuple, TypeAlias
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from rollingtop.reduction.level import LevelSet
 
 __all__ = [
+    "HalfMap",
     "PERIOD_RTOL",
     "WALL_RATIO",
     "energy_gap",
@@ -41,11 +45,19 @@ __all__ = [
 #: Target relative accuracy of the period quadrature (two successive rules agree to this).
 PERIOD_RTOL = 1e-12
 
+FloatArray: TypeAlias = NDArray[np.float64]
+#: A vectorised function of one variable: an integrand, a substitution, its Jacobian.
+ArrayFn: TypeAlias = Callable[[FloatArray], FloatArray]
+#: A weight ``w(theta)`` of the time integral (``psi'`` for ``Delta psi``), or ``None`` (time).
+Weight: TypeAlias = Callable[[FloatArray], FloatArray] | None
+
 
 @functools.lru_cache(maxsize=16)
-def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1], kept (numpy computes them by an ``n x n``
-    eigenvalue problem: 0.2 s for ``n = 4096``)."""
+def _leggauss(n: int) -> tuple[FloatArray, FloatArray]:
+    """Gauss-Legendre nodes and weights on [-1, 1], each of shape ``(n,)``, kept (numpy computes
+    them by an ``n x n`` eigenvalue problem: 0.2 s for ``n = 4096``); read-only."""
+    x: FloatArray
+    w: FloatArray
     x, w = np.polynomial.legendre.leggauss(n)
     x.flags.writeable = w.flags.writeable = False
     return x, w
@@ -57,9 +69,9 @@ _GAP_NODES, _GAP_WEIGHTS = _leggauss(20)
 _GAP_NEAR = 0.1
 
 
-def energy_gap(level: LevelSet, h: float, t1: float, t2: float, phi) -> np.ndarray:
-    """``h - U(theta)`` at ``theta = c + d sin(phi)`` on ``[t1, t2]``, accurate to a few ulps
-    *relative* to itself.
+def energy_gap(level: LevelSet, h: float, t1: float, t2: float, phi: FloatArray) -> FloatArray:
+    """``h - U(theta)`` at ``theta = c + d sin(phi)`` on ``[t1, t2]`` (``phi`` of any shape; the
+    result has its shape), accurate to a few ulps *relative* to itself.
 
     Far from the turning points it is the plain difference. Near them the plain difference
     loses all digits (``h`` and ``U`` agree there), so it is computed as
@@ -73,7 +85,7 @@ def energy_gap(level: LevelSet, h: float, t1: float, t2: float, phi) -> np.ndarr
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     d = (t2 - t1) / 2
     theta = (t1 + t2) / 2 + d * np.sin(phi)
-    out = h - level.U(theta)
+    out: FloatArray = h - level.U(theta)
     for end, dist in (
         (t2, 2 * d * np.sin(np.pi / 4 - phi / 2) ** 2),
         (t1, -2 * d * np.sin(np.pi / 4 + phi / 2) ** 2),
@@ -84,30 +96,38 @@ def energy_gap(level: LevelSet, h: float, t1: float, t2: float, phi) -> np.ndarr
     return out.reshape(shape)
 
 
-def _gap_from_slope(level: LevelSet, end: float, half: np.ndarray) -> np.ndarray:
+def _gap_from_slope(level: LevelSet, end: float, half: FloatArray) -> FloatArray:
     """``U(end) - U(theta) = integral_theta^end U'`` by a 20-point Gauss-Legendre rule, with
-    ``half = (end - theta) / 2`` (signed) given without cancellation: the energy gap next to
-    the turning point ``end`` to its full relative accuracy."""
-    x = end - half[:, None] * (1 + _GAP_NODES[None, :])
-    return np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half
+    ``half = (end - theta) / 2`` (signed, shape ``(n,)``) given without cancellation: the
+    energy gap next to the turning point ``end`` to its full relative accuracy, shape ``(n,)``."""
+    x: FloatArray = end - half[:, None] * (1 + _GAP_NODES[None, :])
+    gap: FloatArray = np.sum(_GAP_WEIGHTS * level.dU(x), axis=1) * half
+    return gap
 
 
-def time_density(level: LevelSet, theta, gap, jac, weight):
+def time_density(
+    level: LevelSet, theta: FloatArray, gap: FloatArray, jac: float | FloatArray, weight: Weight
+) -> FloatArray:
     """``2 sqrt(rho / (2 gap)) |dtheta/du| weight(theta)``: twice ``dt/du`` (times the weight)
     in an integration variable ``u`` with Jacobian ``jac``; 0 where it is not finite (at a
-    turning point the substitutions make the limit finite, the rule never samples it)."""
+    turning point the substitutions make the limit finite, the rule never samples it).
+
+    ``theta``, ``gap = h - U(theta)`` and ``jac`` broadcast together (shape ``(n,)``); so does
+    the result.
+    """
     with np.errstate(divide="ignore", invalid="ignore"):
         val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * np.maximum(gap, 0.0))) * jac
         if weight is not None:
             val = val * weight(theta)
-    return np.where(np.isfinite(val), val, 0.0)
+    density: FloatArray = np.where(np.isfinite(val), val, 0.0)
+    return density
 
 
-def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight=None):
+def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight: Weight = None) -> ArrayFn:
     """``2 weight(theta) dt/dtheta`` in the variable ``phi`` (``theta = c + d sin phi``)."""
     c, d = (t1 + t2) / 2, (t2 - t1) / 2
 
-    def f(phi):
+    def f(phi: FloatArray) -> FloatArray:
         theta = c + d * np.sin(phi)
         gap = energy_gap(level, h, t1, t2, phi)
         return time_density(level, theta, gap, d * np.cos(phi), weight)
@@ -115,11 +135,11 @@ def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight=None):
     return f
 
 
-def _doubled_gauss(f, a: float, b: float) -> tuple[float, float] | None:
+def _doubled_gauss(f: ArrayFn, a: float, b: float) -> tuple[float, float] | None:
     """Gauss-Legendre rules of 32, 64, ..., 2048 nodes on ``[a, b]`` until two successive
     values agree to :data:`PERIOD_RTOL` of the integral of ``|f|`` (the weighted integrals may
     vanish); returns ``(value, their difference)``, or ``None`` without convergence."""
-    prev = None
+    prev: float | None = None
     for n in (32, 64, 128, 256, 512, 1024, 2048):
         x, w = _leggauss(n)
         values = f(a + (b - a) * (x + 1) / 2) * w * ((b - a) / 2)
@@ -130,12 +150,12 @@ def _doubled_gauss(f, a: float, b: float) -> tuple[float, float] | None:
     return None
 
 
-def graded_gauss(f, a: float, b: float, points, n: int) -> float:
+def graded_gauss(f: ArrayFn, a: float, b: float, points: Sequence[float], n: int) -> float:
     """Composite Gauss-Legendre on ``[a, b]``, graded geometrically (ratio 0.2, 24 levels)
     towards ``a``, ``b`` and each of ``points``: resolves peaks of width down to ~1e-17 there."""
     x, w = _leggauss(n)
     knots = np.unique(np.clip([a, *points, b], a, b))
-    edges = []
+    edges: list[FloatArray] = []
     ratios = 0.2 ** np.arange(24, -1, -1)
     for u, v in zip(knots[:-1], knots[1:], strict=True):
         m = (u + v) / 2
@@ -160,7 +180,12 @@ _GAP_NEAR_WALL = 0.1
 
 
 def period(
-    level: LevelSet, h: float, theta1: float, theta2: float, peaks=(), weight=None
+    level: LevelSet,
+    h: float,
+    theta1: float,
+    theta2: float,
+    peaks: Sequence[float] = (),
+    weight: Weight = None,
 ) -> tuple[float, float]:
     """Period of the orbit between the simple turning points ``theta1 < theta2``.
 
@@ -197,12 +222,27 @@ def _walls(level: LevelSet, theta1: float, theta2: float) -> tuple[bool, bool]:
     return (theta1 < WALL_RATIO * width, math.pi - theta2 < WALL_RATIO * width)
 
 
-def half_map(t_end: float, mid: float, wall: bool, left: bool):
+class HalfMap(NamedTuple):
+    """The substitution ``theta(u)``, ``u in [0, u_max]``, on a half orbit (:func:`half_map`)."""
+
+    #: End of the variable's range (``u = 0`` at the turning point).
+    u_max: float
+    #: ``theta(u)``.
+    theta: ArrayFn
+    #: ``|dtheta/du|(u)``.
+    jac: ArrayFn
+    #: ``|theta(u) - t_end|``, without cancellation.
+    dist: ArrayFn
+    #: The length on which ``U`` varies near the turning point.
+    scale: float
+
+
+def half_map(t_end: float, mid: float, wall: bool, left: bool) -> HalfMap:
     """The substitution for the half orbit between the turning point ``t_end`` and ``mid``.
 
-    Returns ``(u_max, theta(u), |dtheta/du|(u), dist(u), scale)`` with ``u in [0, u_max]``,
-    ``u = 0`` at the turning point, ``dist = |theta - t_end|`` without cancellation and
-    ``scale`` the length on which ``U`` varies near the turning point.
+    Returns ``(u_max, theta(u), |dtheta/du|(u), dist(u), scale)`` (a :class:`HalfMap`) with
+    ``u in [0, u_max]``, ``u = 0`` at the turning point, ``dist = |theta - t_end|`` without
+    cancellation and ``scale`` the length on which ``U`` varies near the turning point.
 
     - At a wall (``dist_pole`` = distance of ``t_end`` from its pole, 0 or pi):
       ``dist_pole(theta) = dist_pole cosh u``. The inverse square root at the turning point
@@ -217,31 +257,39 @@ def half_map(t_end: float, mid: float, wall: bool, left: bool):
         pole = 0.0 if left else math.pi
         u_max = math.acosh(abs(mid - pole) / p)
 
-        def theta(u):
-            return pole + sign * p * np.cosh(u)
+        def wall_theta(u: FloatArray) -> FloatArray:
+            value: FloatArray = pole + sign * p * np.cosh(u)
+            return value
 
-        def jac(u):
-            return p * np.sinh(u)
+        def wall_jac(u: FloatArray) -> FloatArray:
+            value: FloatArray = p * np.sinh(u)
+            return value
 
-        def dist(u):
-            return 2 * p * np.sinh(u / 2) ** 2
+        def wall_dist(u: FloatArray) -> FloatArray:
+            value: FloatArray = 2 * p * np.sinh(u / 2) ** 2
+            return value
 
-        return u_max, theta, jac, dist, p
+        return HalfMap(u_max, wall_theta, wall_jac, wall_dist, p)
     L = abs(mid - t_end)
 
-    def theta(u):
-        return mid - sign * L * np.cos(u)
+    def theta(u: FloatArray) -> FloatArray:
+        value: FloatArray = mid - sign * L * np.cos(u)
+        return value
 
-    def jac(u):
-        return L * np.sin(u)
+    def jac(u: FloatArray) -> FloatArray:
+        value: FloatArray = L * np.sin(u)
+        return value
 
-    def dist(u):
-        return 2 * L * np.sin(u / 2) ** 2
+    def dist(u: FloatArray) -> FloatArray:
+        value: FloatArray = 2 * L * np.sin(u / 2) ** 2
+        return value
 
-    return math.pi / 2, theta, jac, dist, L
+    return HalfMap(math.pi / 2, theta, jac, dist, L)
 
 
-def _half_integrand(level: LevelSet, h: float, t_end: float, half, left: bool, weight):
+def _half_integrand(
+    level: LevelSet, h: float, t_end: float, half: HalfMap, left: bool, weight: Weight
+) -> ArrayFn:
     """``2 sqrt(rho / (2 (h - U))) |dtheta/du| weight`` on one half orbit (see :func:`half_map`).
 
     ``h - U`` within :data:`_GAP_NEAR_WALL` of the local scale from the turning point is
@@ -251,11 +299,11 @@ def _half_integrand(level: LevelSet, h: float, t_end: float, half, left: bool, w
     _, theta_of, jac, dist_of, scale = half
     sign = 1.0 if left else -1.0
 
-    def f(u):
+    def f(u: FloatArray) -> FloatArray:
         u = np.asarray(u, dtype=float)
         theta = theta_of(u)
         dist = dist_of(u)
-        gap = h - level.U(theta)
+        gap: FloatArray = h - level.U(theta)
         near = dist < _GAP_NEAR_WALL * scale
         if np.any(near):
             gap[near] = _gap_from_slope(level, t_end, -sign * dist[near] / 2)
@@ -264,7 +312,15 @@ def _half_integrand(level: LevelSet, h: float, t_end: float, half, left: bool, w
     return f
 
 
-def _wall_period(level, h, theta1, theta2, walls, peaks, weight) -> tuple[float, float]:
+def _wall_period(
+    level: LevelSet,
+    h: float,
+    theta1: float,
+    theta2: float,
+    walls: tuple[bool, bool],
+    peaks: Sequence[float],
+    weight: Weight,
+) -> tuple[float, float]:
     """:func:`period` split at the middle, each half by :func:`half_integral`."""
     mid = (theta1 + theta2) / 2
     total, error = 0.0, 0.0
@@ -275,7 +331,14 @@ def _wall_period(level, h, theta1, theta2, walls, peaks, weight) -> tuple[float,
 
 
 def half_integral(
-    level: LevelSet, h, t_end, mid, wall: bool, left: bool, peaks=(), weight=None
+    level: LevelSet,
+    h: float,
+    t_end: float,
+    mid: float,
+    wall: bool,
+    left: bool,
+    peaks: Sequence[float] = (),
+    weight: Weight = None,
 ) -> tuple[float, float]:
     """Twice the time (or the integral of ``weight dt``) from the turning point ``t_end`` to the
     interior point ``mid`` (in the variable of :func:`half_map`). Returns ``(value, error)``.
@@ -287,12 +350,12 @@ def half_integral(
     """
     half = half_map(t_end, mid, wall, left)
     f = _half_integrand(level, h, t_end, half, left, weight)
-    u_max = half[0]
+    u_max = half.u_max
     done = _doubled_gauss(f, 0.0, u_max)
     if done is not None:
         return done
     breaks = [
-        float(brentq(lambda u, p=p: half[1](u) - p, 0.0, u_max))
+        float(brentq(lambda u, p=p: half.theta(u) - p, 0.0, u_max))
         for p in peaks
         if min(t_end, mid) < p < max(t_end, mid)
     ]

@@ -23,15 +23,27 @@ variables such a passage flips the signs of ``tau, n, w_tau, w_n, v_tau`` and ma
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any, TypeAlias, TypeVar, overload
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
 
-__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE"]
+__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real"]
+
+FloatArray: TypeAlias = NDArray[np.float64]
+#: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
+#: a float gives a float (a numpy float) and an array of shape ``(...)`` an array of that shape.
+Real = TypeVar("Real", float, FloatArray)
+ComplexArray: TypeAlias = NDArray[np.complex128]
+#: ``theta`` for :meth:`LevelSet.dU`, also complex (the complex step of ``d2U``).
+_Analytic: TypeAlias = float | FloatArray | ComplexArray
+#: What numpy's stubs make of arithmetic on ``_Analytic`` (complex of unspecified precision).
+_AnalyticResult: TypeAlias = float | FloatArray | NDArray[np.complexfloating[Any, Any]]
 
 #: ``|C1 -+ M3|`` below this times ``max(|M3|, |C1|)`` is a pole case: the simulator's tolerance
 #: (:data:`rollingtop.contact.meridian.POLE_CASE_TOLERANCE`), one decision for every command.
@@ -90,6 +102,8 @@ class LevelSet:
     C1: float
     C2: float
     scale: float = 0.0
+    #: Set from ``(M3, C1)`` at construction (see Attributes).
+    pole: str | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         for name in ("M3", "C1", "C2"):
@@ -156,15 +170,20 @@ class LevelSet:
     def pole_theta(self) -> float | None:
         """``theta`` of the pole the motion can pass (0 or pi), or ``None`` (also for ``"both"``:
         see :attr:`pole_thetas`)."""
-        return {"south": 0.0, "north": math.pi}.get(self.pole)
+        return None if self.pole is None else {"south": 0.0, "north": math.pi}.get(self.pole)
 
     @property
     def pole_thetas(self) -> tuple[float, ...]:
         """``theta`` of every pole the motion can pass: ``()``, ``(0,)``, ``(pi,)`` or both."""
-        return {"south": (0.0,), "north": (math.pi,), "both": (0.0, math.pi)}.get(self.pole, ())
+        poles = {"south": (0.0,), "north": (math.pi,), "both": (0.0, math.pi)}
+        return () if self.pole is None else poles.get(self.pole, ())
 
     # ---- the reduced quantities -------------------------------------------------------------
-    def _q(self, theta):
+    @overload
+    def _q(self, theta: Real) -> tuple[Real, Real, Real, Real]: ...
+    @overload
+    def _q(self, theta: ComplexArray) -> tuple[ComplexArray, ...]: ...
+    def _q(self, theta: _Analytic) -> tuple[_Analytic, ...]:
         """``q1 = (C1 - M3 cos)/sin`` and ``q2 = N/sin`` with their theta-derivatives."""
         b = self.body
         M3, C1 = self.M3, self.C1
@@ -196,7 +215,7 @@ class LevelSet:
             (b.R * C1 - b.a3 * M3) - N * c / s**2,
         )
 
-    def P(self, theta):
+    def P(self, theta: Real) -> Real:
         """``I1 v_tau`` as a function of ``theta`` (eq. 3.8), signed-``s`` convention.
 
         The integral ``F6 = C2`` (:func:`rollingtop.dynamics.integrals.F6_reduced`) solved for
@@ -206,23 +225,28 @@ class LevelSet:
         _, q2, _, _ = self._q(theta)
         return q2 + self.C2 + self.M3 * self.body.a3 * theta
 
-    def w_n(self, theta):
+    def w_n(self, theta: Real) -> Real:
         """``w_n = (M3 gamma3 - C1) / (I1 s)`` (eq. 3.8)."""
         q1, _, _, _ = self._q(theta)
         return -q1 / self.body.I1
 
-    def v_tau(self, theta):
+    def v_tau(self, theta: Real) -> Real:
         """``v_tau`` (eq. 3.8)."""
         return self.P(theta) / self.body.I1
 
-    def U(self, theta):
+    def U(self, theta: Real) -> Real:
         """Effective potential ``U`` (eq. 3.11, ``docs/model.md``) at ``theta``."""
         b = self.body
         q1, _, _, _ = self._q(theta)
         P = self.P(theta)
-        return q1**2 / (2 * b.I1) + b.m * P**2 / (2 * b.I1**2) + b.m * b.g * b.a3 * np.cos(theta)
+        U: Real = q1**2 / (2 * b.I1) + b.m * P**2 / (2 * b.I1**2) + b.m * b.g * b.a3 * np.cos(theta)
+        return U
 
-    def dU(self, theta):
+    @overload
+    def dU(self, theta: Real) -> Real: ...
+    @overload
+    def dU(self, theta: ComplexArray) -> ComplexArray: ...
+    def dU(self, theta: _Analytic) -> _AnalyticResult:
         """``dU/dtheta`` (analytic)."""
         b = self.body
         q1, q2, dq1, dq2 = self._q(theta)
@@ -230,52 +254,71 @@ class LevelSet:
         dP = dq2 + self.M3 * b.a3
         return q1 * dq1 / b.I1 + b.m * P * dP / b.I1**2 - b.m * b.g * b.a3 * np.sin(theta)
 
-    def d2U(self, theta):
+    @overload
+    def d2U(self, theta: float) -> float: ...
+    @overload
+    def d2U(self, theta: FloatArray) -> FloatArray: ...
+    def d2U(self, theta: float | FloatArray) -> float | FloatArray:
         """``d^2U/dtheta^2`` by the complex step ``Im dU(theta + i h)/h`` (exact to round-off)."""
-        theta = np.asarray(theta, dtype=float)
-        return np.imag(self.dU(theta + 1j * _COMPLEX_STEP)) / _COMPLEX_STEP
+        z: ComplexArray = np.asarray(theta, dtype=float) + 1j * _COMPLEX_STEP
+        return np.imag(self.dU(z)) / _COMPLEX_STEP  # a numpy float for a float theta
 
-    def rho(self, theta):
+    def rho(self, theta: Real) -> Real:
         """Invariant-measure density, also the reduced motion's mass: ``rho(cos theta)`` (3.5)."""
-        return self.body.rho(np.cos(theta))
+        rho: Real = self.body.rho(np.cos(theta))
+        return rho
 
-    def drho(self, theta):
+    def drho(self, theta: Real) -> Real:
         """``d rho(cos theta) / dtheta = -2 m a3 R sin(theta)``."""
         b = self.body
-        return -2 * b.m * b.a3 * b.R * np.sin(theta)
+        drho: Real = -2 * b.m * b.a3 * b.R * np.sin(theta)
+        return drho
 
-    def psi_dot(self, theta):
+    @overload
+    def psi_dot(self, theta: float) -> float: ...
+    @overload
+    def psi_dot(self, theta: FloatArray) -> FloatArray: ...
+    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:
         """Precession rate ``psi' = -w_n / s`` (``docs/model.md``, "Motion in absolute space"),
         finite at the pole in a pole case."""
         I1 = self.body.I1
+        rate: float | FloatArray
         if self.pole == "both":
-            return np.zeros_like(np.asarray(theta, dtype=float))
+            return np.zeros_like(np.asarray(theta, dtype=float))  # a numpy float for a float
         if self.pole == "south":
-            return self.M3 / (I1 * (1 + np.cos(theta)))
-        if self.pole == "north":
-            return -self.M3 / (I1 * (1 - np.cos(theta)))
-        q1, _, _, _ = self._q(theta)
-        return q1 / (I1 * np.sin(theta))
+            rate = self.M3 / (I1 * (1 + np.cos(theta)))
+        elif self.pole == "north":
+            rate = -self.M3 / (I1 * (1 - np.cos(theta)))
+        else:
+            q1, _, _, _ = self._q(theta)
+            rate = q1 / (I1 * np.sin(theta))
+        return rate
 
     # ---- in gamma3 (the paper's variables) ---------------------------------------------------
+    @overload
     @staticmethod
-    def theta_of(gamma3):
+    def theta_of(gamma3: float) -> float: ...
+    @overload
+    @staticmethod
+    def theta_of(gamma3: FloatArray) -> FloatArray: ...
+    @staticmethod
+    def theta_of(gamma3: float | FloatArray) -> float | FloatArray:
         """``theta = arccos(gamma3)`` in ``[0, pi]`` (unsigned, the paper's branch)."""
         g = np.asarray(gamma3, dtype=float)
-        return np.arccos(np.clip(g, -1.0, 1.0))
+        theta: float | FloatArray = np.arccos(np.clip(g, -1.0, 1.0))  # numpy float for a float
+        return theta
 
-    def U_gamma3(self, gamma3):
+    def U_gamma3(self, gamma3: Real) -> Real:
         """``U(gamma3)`` exactly as ``docs/model.md`` defines it, for ``gamma3`` in ``(-1, 1)``
         (and at the pole of a pole case)."""
         return self.U(self.theta_of(gamma3))
 
     # ---- the one-degree-of-freedom system: h = rho w_tau^2 / 2 + U(theta), theta' = -w_tau ------
-    def energy(self, theta, w_tau):
+    def energy(self, theta: Real, w_tau: Real) -> Real:
         """Reduced energy ``h = rho w_tau^2 / 2 + U`` at ``(theta, w_tau)`` (arrays broadcast)."""
-        w_tau = np.asarray(w_tau)
         return self.U(theta) + 0.5 * self.rho(theta) * w_tau * w_tau
 
-    def w_tau(self, theta, h: float, gap=None):
+    def w_tau(self, theta: Real, h: float, gap: Real | None = None) -> Real:
         """``|w_tau| = sqrt(2 (h - U) / rho)`` at ``theta`` on the orbit of reduced energy ``h``
         (:meth:`energy` solved for ``w_tau``; the sign is the branch), 0 where ``h < U``.
 
@@ -284,9 +327,10 @@ class LevelSet:
         """
         if gap is None:
             gap = h - self.U(theta)
-        return np.sqrt(np.maximum(2 * gap / self.rho(theta), 0.0))
+        w_tau: Real = np.sqrt(np.maximum(2 * gap / self.rho(theta), 0.0))
+        return w_tau
 
-    def flow(self, theta, w_tau):
+    def flow(self, theta: Real, w_tau: Real) -> tuple[Real, Real]:
         """The equations of motion ``(theta', w_tau')`` on the level set:
 
             theta' = -w_tau,    w_tau' = (U'(theta) + rho'(theta) w_tau^2 / 2) / rho,
@@ -295,7 +339,8 @@ class LevelSet:
         same motion as the reduced system :func:`rollingtop.reduction.reduced_rhs` (eq. 3.3), in
         the variables of the level set.
         """
-        return -w_tau, (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
+        w_tau_dot: Real = (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
+        return -w_tau, w_tau_dot
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
@@ -76,7 +77,7 @@ class NearPole:
     friction_needed: float
     min_normal_force: float
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite values become ``None``)."""
         return json_ready(asdict(self))
 
@@ -92,7 +93,9 @@ class NearPole:
         )
 
 
-def friction_needed(level: LevelSet, h: float, orbit: Orbit, samples: int = 400):
+def friction_needed(
+    level: LevelSet, h: float, orbit: Orbit, samples: int = 400
+) -> tuple[float, float]:
     """``(max |F_t| / N, min N)`` over the orbit: the friction coefficient the meridian
     constraint needs and the smallest normal force, from the contact reaction of the full
     equations at states of the orbit (both senses of motion).
@@ -104,7 +107,7 @@ def friction_needed(level: LevelSet, h: float, orbit: Orbit, samples: int = 400)
     return _friction(lv, h, o, samples)
 
 
-def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400):
+def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[float, float]:
     """:func:`friction_needed` on the canonical level and orbit (``canonical_orbit``)."""
     from rollingtop.contact.meridian import MODEL
     from rollingtop.dynamics import _kernel
@@ -116,8 +119,8 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400):
     mid = (t1 + t2) / 2
     ends = []
     for t_end, left in ((t1, True), (t2, False)):  # the quadrature's wall variable at each end
-        u_max, theta_of = half_map(t_end, mid, True, left)[:2]
-        ends.append(theta_of(np.linspace(0.0, u_max, samples)))
+        half = half_map(t_end, mid, True, left)
+        ends.append(half.theta(np.linspace(0.0, half.u_max, samples)))
     thetas = np.unique(np.concatenate([*ends, np.linspace(t1, t2, samples)]))
     thetas = thetas[(thetas >= t1) & (thetas <= t2)]
     states = []

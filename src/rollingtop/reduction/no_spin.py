@@ -25,7 +25,14 @@ import math
 
 import numpy as np
 
-from rollingtop.reduction._quadrature import PERIOD_RTOL, graded_gauss, period, time_density
+from rollingtop.reduction._quadrature import (
+    PERIOD_RTOL,
+    FloatArray,
+    Weight,
+    graded_gauss,
+    period,
+    time_density,
+)
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.orbits import (
     SEPARATRIX_TOLERANCE,
@@ -47,14 +54,14 @@ def _poles(level: LevelSet) -> tuple[float, float] | None:
     return (math.pi, 0.0) if k > 0 else (0.0, math.pi)
 
 
-def rolling_over_period(level: LevelSet, h: float, weight=None) -> tuple[float, float]:
+def rolling_over_period(level: LevelSet, h: float, weight: Weight = None) -> tuple[float, float]:
     """Period of a rolling-over motion: ``integral over theta in [t_s, t_s + 2 pi]`` of
     ``sqrt(rho / (2 (h - U)))`` (``t_s`` the saddle, where the integrand peaks). Returns
     ``(value, estimated absolute error)``."""
     poles = _poles(level)
     start = poles[1] if poles else 0.0
 
-    def f(theta):  # dt/dtheta (times the weight); jac = 1/2 undoes time_density's factor 2
+    def f(theta: FloatArray) -> FloatArray:  # dt/dtheta (times the weight): jac 1/2 undoes the 2
         return time_density(level, theta, h - level.U(theta), 0.5, weight)
 
     prev = None

@@ -19,7 +19,9 @@ number that would be noise. The quadrature itself is :mod:`._quadrature`.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, replace
+from typing import Any
 
 import numpy as np
 from scipy.optimize import brentq
@@ -27,7 +29,7 @@ from scipy.optimize import brentq
 from rollingtop._json import json_ready
 from rollingtop.reduction._quadrature import PERIOD_RTOL, WALL_RATIO, half_integral, period
 from rollingtop.reduction.level import LevelSet, LevelSetError
-from rollingtop.reduction.steady import critical_points, steady_motion
+from rollingtop.reduction.steady import SteadyMotion, critical_points, steady_motion
 
 __all__ = ["Orbit", "orbits", "period", "half_integral", "canonical_orbit", "near_north"]
 __all__ += ["PERIOD_RTOL", "WALL_RATIO", "SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE"]
@@ -77,7 +79,7 @@ class Orbit:
     note: str = ""
     pole_distance: float = math.nan
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite values become ``None``)."""
         return json_ready(asdict(self))
 
@@ -89,8 +91,10 @@ class Orbit:
 
 
 def turning_point(level: LevelSet, h: float, a: float, b: float) -> float:
+    """The root of ``h = U(theta)`` in ``[a, b]`` (``U - h`` of opposite signs at the ends)."""
     # xtol tiny: the root is found to a relative 4 ulps also next to a pole (theta ~ 1e-12)
-    return brentq(lambda t: h - level.U(t), a, b, xtol=1e-300, rtol=8.9e-16, maxiter=500)
+    root: float = brentq(lambda t: h - level.U(t), a, b, xtol=1e-300, rtol=8.9e-16, maxiter=500)
+    return root
 
 
 def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
@@ -212,7 +216,17 @@ def _components(level: LevelSet, h: float) -> list[Orbit]:
     return sorted(physical or result, key=lambda o: (o.gamma3_min, o.theta_min))
 
 
-def _make_orbit(level, h, t1, t2, crit, steadies, scale) -> Orbit:
+def _make_orbit(
+    level: LevelSet,
+    h: float,
+    t1: float,
+    t2: float,
+    crit: Sequence[float],
+    steadies: dict[float, SteadyMotion],
+    scale: float,
+) -> Orbit:
+    """The orbit between the turning points ``t1 <= t2`` (steady, separatrix or periodic), given
+    the critical points ``crit`` of ``U``, their steady motions and the scale of ``U``."""
     pole = level.pole_theta
     passage = pole is not None and t1 < pole < t2
     g = np.cos(np.linspace(t1, t2, 2001))

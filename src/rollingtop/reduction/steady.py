@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from rollingtop._json import json_ready
@@ -69,12 +71,12 @@ class SteadyMotion:
     com_speed: float
     com_radius: float
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite values become ``None``)."""
         return json_ready(asdict(self))
 
 
-def _grid(level: LevelSet) -> np.ndarray:
+def _grid(level: LevelSet) -> NDArray[np.float64]:
     lo, hi = level.theta_domain
     # Chebyshev-like spacing clusters points near the barriers, where U varies fastest.
     x = np.cos(np.linspace(math.pi, 0.0, GRID_POINTS))
@@ -87,7 +89,7 @@ def _grid(level: LevelSet) -> np.ndarray:
     return grid
 
 
-def critical_points(level: LevelSet) -> np.ndarray:
+def critical_points(level: LevelSet) -> NDArray[np.float64]:
     """All zeros of ``dU/dtheta`` inside the theta domain, increasing.
 
     Sign changes of ``dU/dtheta`` on a fine grid (clustered at the ends), each refined by Brent's

@@ -15,7 +15,10 @@ It conserves ``h``, ``C1`` and ``C2`` (:func:`reduced_integrals_of`) and has the
 
 from __future__ import annotations
 
+from typing import TypeAlias
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
 from rollingtop.body import SphericalTop
@@ -23,9 +26,25 @@ from rollingtop.dynamics.integrals import F6_reduced
 
 __all__ = ["reduced_rhs", "reduced_integrals_of", "integrate_reduced"]
 
+FloatArray: TypeAlias = NDArray[np.float64]
 
-def reduced_rhs(body: SphericalTop, M3: float, x):
-    """Right-hand side of eq. (3.3); ``x`` of shape ``(4, ...)`` (vectorised over the rest)."""
+
+def reduced_rhs(body: SphericalTop, M3: float, x: FloatArray) -> FloatArray:
+    """Right-hand side of eq. (3.3).
+
+    Parameters
+    ----------
+    body : SphericalTop
+    M3 : float
+        Lagrange integral ``I3 w3``.
+    x : ndarray, shape (4, ...)
+        ``(gamma3, v_tau, w_n, w_tau)``, vectorised over the trailing axes.
+
+    Returns
+    -------
+    ndarray, shape (4, ...)
+        ``(gamma3', v_tau', w_n', w_tau')``.
+    """
     g3, v_tau, w_n, w_tau = x
     R, m, g, a3, I1 = body.R, body.m, body.g, body.a3, body.I1
     s = np.sqrt(1 - g3 * g3)
@@ -47,8 +66,9 @@ def reduced_rhs(body: SphericalTop, M3: float, x):
     )
 
 
-def reduced_integrals_of(body: SphericalTop, M3: float, x) -> dict[str, np.ndarray]:
-    """``h, C1, C2`` of reduced states ``x`` (shape ``(4, ...)``), ``docs/model.md`` definitions."""
+def reduced_integrals_of(body: SphericalTop, M3: float, x: ArrayLike) -> dict[str, FloatArray]:
+    """``h, C1, C2`` of reduced states ``x`` (shape ``(4, ...)``), ``docs/model.md`` definitions;
+    each of shape ``(...)``. ``C2`` is :func:`rollingtop.dynamics.integrals.F6_reduced`."""
     g3, v_tau, w_n, w_tau = np.asarray(x, dtype=float)
     m, g, a3, I1 = body.m, body.g, body.a3, body.I1
     s = np.sqrt(1 - g3 * g3)
@@ -59,8 +79,17 @@ def reduced_integrals_of(body: SphericalTop, M3: float, x) -> dict[str, np.ndarr
     }
 
 
-def integrate_reduced(body: SphericalTop, M3: float, x0, t_eval, *, rtol=1e-12, atol=1e-14):
-    """Integrate eq. (3.3) from ``x0`` with ``solve_ivp`` (DOP853); returns shape ``(4, n)``.
+def integrate_reduced(
+    body: SphericalTop,
+    M3: float,
+    x0: ArrayLike,
+    t_eval: ArrayLike,
+    *,
+    rtol: float = 1e-12,
+    atol: float = 1e-14,
+) -> FloatArray:
+    """Integrate eq. (3.3) from ``x0`` (shape ``(4,)``) with ``solve_ivp`` (DOP853) and return
+    the states at the increasing times ``t_eval`` (shape ``(n,)``), shape ``(4, n)``.
 
     A 4-dimensional smooth system away from the poles: SciPy's integrator is adequate here.
     """
@@ -76,4 +105,5 @@ def integrate_reduced(body: SphericalTop, M3: float, x0, t_eval, *, rtol=1e-12, 
     )
     if not sol.success:
         raise RuntimeError(f"reduced integration failed: {sol.message}")
-    return sol.y
+    y: FloatArray = sol.y
+    return y

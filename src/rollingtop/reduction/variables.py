@@ -15,8 +15,11 @@ absolute space"), so that ``nu = cos(psi) alpha + sin(psi) beta`` and
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import F6, area, energy, lagrange, reduced_components
@@ -24,8 +27,10 @@ from rollingtop.reduction.level import LevelSet, LevelSetError
 
 __all__ = ["reduce_state", "reduced_integrals", "euler_angles", "state_from_level"]
 
+FloatArray: TypeAlias = NDArray[np.float64]
 
-def reduce_state(Y, pole: str | None = None) -> dict[str, np.ndarray]:
+
+def reduce_state(Y: ArrayLike, pole: str | None = None) -> dict[str, FloatArray]:
     """Reduced variables of states ``Y`` (shape ``(..., 18)``), each of shape ``(...)``.
 
     Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``; see
@@ -34,8 +39,12 @@ def reduce_state(Y, pole: str | None = None) -> dict[str, np.ndarray]:
     return reduced_components(Y, pole)
 
 
-def reduced_integrals(body: SphericalTop, Y, pole: str | None = None) -> dict[str, np.ndarray]:
-    """``M3 = I3 w3``, ``C1 = F5``, ``C2 = F6``, ``h = E - I3 w3^2/2 - m g R`` of states ``Y``."""
+def reduced_integrals(
+    body: SphericalTop, Y: ArrayLike, pole: str | None = None
+) -> dict[str, FloatArray]:
+    """``M3 = I3 w3``, ``C1 = F5``, ``C2 = F6``, ``h = E - I3 w3^2/2 - m g R`` of states ``Y``
+    (shape ``(..., 18)``), each of shape ``(...)``; ``pole`` as in
+    :func:`rollingtop.dynamics.integrals.F6`."""
     Y = np.asarray(Y, dtype=float)
     M3 = lagrange(body, Y)
     return {
@@ -46,7 +55,7 @@ def reduced_integrals(body: SphericalTop, Y, pole: str | None = None) -> dict[st
     }
 
 
-def euler_angles(Y) -> dict[str, np.ndarray]:
+def euler_angles(Y: ArrayLike) -> dict[str, FloatArray]:
     """Euler angles ``psi, theta, phi`` (3-1-3) of states ``Y``, each shape ``(...)``:
     ``gamma = (sin theta sin phi, sin theta cos phi, cos theta)``,
     ``psi = atan2(beta3, alpha3)``."""
@@ -66,9 +75,9 @@ def state_from_level(
     branch: int = 1,
     phi: float = 0.0,
     psi: float = 0.0,
-    position=(0.0, 0.0),
+    position: Sequence[float] = (0.0, 0.0),
     theta: float | None = None,
-) -> np.ndarray:
+) -> FloatArray:
     """Full state on the level set ``(M3, C1, C2)`` with reduced energy ``h`` at ``gamma3``.
 
     Parameters
