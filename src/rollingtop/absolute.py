@@ -23,9 +23,12 @@ from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
+from typing import Any, TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
 from rollingtop.reduction.level import LevelSet, LevelSetError
@@ -39,11 +42,15 @@ RESONANCE_TOLERANCE = 1e-9
 #: of the sphere is flagged near-resonant.
 NEAR_RESONANT = 100.0
 
+FloatArray: TypeAlias = NDArray[np.float64]
 
-def _path_rhs(level: LevelSet):
+
+def _path_rhs(level: LevelSet) -> Callable[[float, FloatArray], list[float]]:
+    """The right-hand side for ``solve_ivp`` of ``z = (theta, w_tau, psi, X, Y)`` (module
+    docstring): :meth:`LevelSet.flow` with the quadratures for ``psi``, ``X`` and ``Y``."""
     b = level.body
 
-    def f(t, z):
+    def f(t: float, z: FloatArray) -> list[float]:
         theta, w_tau, psi = z[0], z[1], z[2]
         theta_dot, w_tau_dot = level.flow(theta, w_tau)
         k = (b.R + b.a3 * np.cos(theta)) * w_tau
@@ -62,15 +69,15 @@ def _path_rhs(level: LevelSet):
 
 def reconstruct(
     level: LevelSet,
-    t,
+    t: ArrayLike,
     *,
     theta0: float,
     w_tau0: float,
     psi0: float = 0.0,
-    position0=(0.0, 0.0),
+    position0: Sequence[float] = (0.0, 0.0),
     rtol: float = 1e-13,
     atol: float = 1e-14,
-) -> dict[str, np.ndarray]:
+) -> dict[str, FloatArray]:
     """Reconstruct the motion on the plane from the reduced one.
 
     Integrates ``(theta, w_tau)`` of the one-degree-of-freedom system together with the
@@ -152,7 +159,7 @@ class PeriodMap:
     start_theta: float
     delta_psi_error: float = math.nan
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
         d = asdict(self)
         for key in ("displacement", "center", "drift_velocity"):
@@ -160,7 +167,7 @@ class PeriodMap:
                 d[key] = list(d[key])
         return d
 
-    def center_from(self, psi0: float, position0) -> tuple[float, float] | None:
+    def center_from(self, psi0: float, position0: Sequence[float]) -> tuple[float, float] | None:
         """Centre of the circle for a motion started at the canonical point with azimuth ``psi0``
         and CoM position ``position0``."""
         if self.center is None:

@@ -13,18 +13,27 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
 
-from rollingtop.io import atomic_write, check_output_path
+from rollingtop.io import PathArg, atomic_write, check_output_path
+
+if TYPE_CHECKING:
+    from matplotlib.animation import AbstractMovieWriter
+
+    from rollingtop.trajectory import Trajectory
 
 __all__ = ["animate", "ANIMATION_SUFFIXES"]
 
 ANIMATION_SUFFIXES = (".mp4", ".gif")
 
 
-def _wireframe(n_meridians: int = 12, n_parallels: int = 5, n: int = 48) -> list[np.ndarray]:
+def _wireframe(
+    n_meridians: int = 12, n_parallels: int = 5, n: int = 48
+) -> list[NDArray[np.float64]]:
     """Unit-sphere curves in the body frame, each of shape (n, 3)."""
     curves = []
     t = np.linspace(0, np.pi, n)
@@ -40,15 +49,15 @@ def _wireframe(n_meridians: int = 12, n_parallels: int = 5, n: int = 48) -> list
 
 
 def animate(
-    traj,
-    path,
+    traj: Trajectory,
+    path: PathArg,
     *,
     fps: int = 25,
     duration: float | None = None,
     speed: float = 1.0,
     camera: str = "follow",
     dpi: int = 80,
-    size=(6.0, 6.0),
+    size: tuple[float, float] = (6.0, 6.0),
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
     """Render ``traj`` as an animation and write it atomically to ``path`` (.mp4 or .gif).
@@ -152,6 +161,7 @@ def animate(
             ax.set_zlim(0, 2.6 * R)
 
     def write(tmp: Path) -> None:
+        writer: AbstractMovieWriter
         if path.suffix.lower() == ".gif":
             from matplotlib.animation import PillowWriter
 

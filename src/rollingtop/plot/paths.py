@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from matplotlib.figure import Figure
+
+if TYPE_CHECKING:
+    from rollingtop.absolute import PeriodMap
+    from rollingtop.trajectory import Trajectory
 
 __all__ = ["path_figure", "timeseries_figure", "compare_figure"]
 
 
-def _title(traj) -> str:
+def _title(traj: Trajectory) -> str:
     b = traj.body
     return (
         f"{traj.model.name} model, t = 0 .. {traj.t[-1]:g}   "
@@ -16,7 +22,12 @@ def _title(traj) -> str:
     )
 
 
-def path_figure(traj, period_map=None, *, figsize=(7.0, 7.0)) -> Figure:
+def path_figure(
+    traj: Trajectory,
+    period_map: PeriodMap | None = None,
+    *,
+    figsize: tuple[float, float] = (7.0, 7.0),
+) -> Figure:
     """Contact-point and CoM paths on the plane.
 
     Parameters
@@ -39,12 +50,14 @@ def path_figure(traj, period_map=None, *, figsize=(7.0, 7.0)) -> Figure:
         ax.plot(P[:, 0], P[:, 1], "o", color="#ff7f0e", ms=4, zorder=4,
                 label="CoM once per period (min of $\\gamma_3$)")  # fmt: skip
         if period_map is not None and period_map.motion == "bounded":
-            c = period_map.center_from(traj.event_y[0, 17], P[0])
+            c, radius = period_map.center_from(traj.event_y[0, 17], P[0]), period_map.radius
+            assert c is not None and radius is not None  # a bounded motion has its circle
             phi = np.linspace(0, 2 * np.pi, 400)
-            ax.plot(c[0] + period_map.radius * np.cos(phi), c[1] + period_map.radius * np.sin(phi),
+            ax.plot(c[0] + radius * np.cos(phi), c[1] + radius * np.sin(phi),
                     "--", color="#ff7f0e", lw=0.8, label="predicted circle")  # fmt: skip
             ax.plot(*c, "+", color="#ff7f0e", ms=10, mew=1.5)
         elif period_map is not None:
+            assert period_map.drift_velocity is not None  # a drifting motion has its velocity
             vx, vy = period_map.drift_velocity
             psi0 = traj.event_y[0, 17]
             v = complex(vx, vy) * np.exp(1j * psi0)
@@ -53,10 +66,13 @@ def path_figure(traj, period_map=None, *, figsize=(7.0, 7.0)) -> Figure:
                     color="#ff7f0e", lw=0.8, label="predicted drift")  # fmt: skip
     kind = ""
     if period_map is not None:
-        kind = (f"\nbounded: circle of radius {period_map.radius:.4g}"
-                + (" (near-resonant)" if period_map.near_resonant else "")
-                if period_map.motion == "bounded"
-                else f"\ndrifting at {np.hypot(*period_map.drift_velocity):.4g}")  # fmt: skip
+        if period_map.motion == "bounded":
+            kind = f"\nbounded: circle of radius {period_map.radius:.4g}" + (
+                " (near-resonant)" if period_map.near_resonant else ""
+            )
+        else:
+            assert period_map.drift_velocity is not None  # a drifting motion has its velocity
+            kind = f"\ndrifting at {np.hypot(*period_map.drift_velocity):.4g}"
         kind += rf", $\Delta\psi = {period_map.delta_psi:.6g}$ per period {period_map.period:.6g}"
     ax.set_title(_title(traj) + kind, fontsize=9)
     ax.set_aspect("equal", adjustable="datalim")
@@ -67,7 +83,7 @@ def path_figure(traj, period_map=None, *, figsize=(7.0, 7.0)) -> Figure:
     return fig
 
 
-def timeseries_figure(traj, *, figsize=(8.0, 8.0)) -> Figure:
+def timeseries_figure(traj: Trajectory, *, figsize: tuple[float, float] = (8.0, 8.0)) -> Figure:
     """``gamma3(t)``, the first integrals' relative drift, and the contact reactions."""
     fig = Figure(figsize=figsize, layout="constrained")
     ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
@@ -97,7 +113,9 @@ def timeseries_figure(traj, *, figsize=(8.0, 8.0)) -> Figure:
     return fig
 
 
-def compare_figure(runs: dict, *, figsize=(10.0, 8.0)) -> Figure:
+def compare_figure(
+    runs: dict[str, Trajectory], *, figsize: tuple[float, float] = (10.0, 8.0)
+) -> Figure:
     """Paths and integrals of the same initial state under several contact models.
 
     ``runs``: ``{model name: Trajectory}`` (:func:`rollingtop.simulate_models`). Left: CoM paths.
@@ -109,7 +127,7 @@ def compare_figure(runs: dict, *, figsize=(10.0, 8.0)) -> Figure:
     fig = Figure(figsize=figsize, layout="constrained")
     grid = fig.add_gridspec(4, 2)
     ax = fig.add_subplot(grid[:, 0])
-    names = []
+    names: list[str] = []
     for run in runs.values():
         names += [n for n in run.integrals if n not in names]
     shown = [n for n in ("energy", "F6", "momentum_x", "routh") if n in names] or names[:4]

@@ -3,24 +3,38 @@
 from __future__ import annotations
 
 import math
+from typing import TypedDict
 
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.absolute import period_map
 from rollingtop.body import SphericalTop
 from rollingtop.reduction import LevelSet, orbits
-from rollingtop.reduction.near_pole import near_pole
+from rollingtop.reduction.near_pole import NearPole, near_pole
 
-__all__ = ["pole_limits_figure", "pole_limits_table"]
+__all__ = ["PoleLimits", "pole_limits_figure", "pole_limits_table"]
 
 
-def pole_limits_table(body: SphericalTop, M3: float, C2: float, h: float, exponents=None):
+class PoleLimits(TypedDict):
+    """What :func:`pole_limits_table` returns, per side ``+1`` (``C1 > M3``) and ``-1``."""
+
+    #: Rows ``(|C1 - M3|, T, Delta psi, friction needed)``, shape ``(n, 4)``.
+    rows: dict[int, NDArray[np.float64]]
+    #: The limits on the pole level, from the side's orbits next to the wall.
+    limits: dict[int, NearPole]
+
+
+def pole_limits_table(
+    body: SphericalTop, M3: float, C2: float, h: float, exponents: ArrayLike | None = None
+) -> PoleLimits:
     """``T``, ``Delta psi`` and the friction needed on the levels ``C1 = M3 + side 10^k`` next to
-    the south pole level, and the limits. Returns a dict of arrays and scalars."""
+    the south pole level (``k`` in ``exponents``, default ``-12, -11.5, ..., -1``), and the
+    limits (:class:`PoleLimits`)."""
     exponents = np.arange(-12.0, -0.9, 0.5) if exponents is None else np.asarray(exponents)
-    rows = {+1: [], -1: []}
-    info = {}
+    rows: dict[int, list[tuple[float, float, float, float]]] = {+1: [], -1: []}
+    info: dict[int, NearPole] = {}
     for side in (+1, -1):
         for k in exponents:
             level = LevelSet(body, M3, M3 + side * 10.0**k, C2)
@@ -34,7 +48,14 @@ def pole_limits_table(body: SphericalTop, M3: float, C2: float, h: float, expone
     return {"rows": {s: np.array(r) for s, r in rows.items()}, "limits": info}
 
 
-def pole_limits_figure(body: SphericalTop, M3: float, C2: float, h: float, *, figsize=(7, 8.5)):
+def pole_limits_figure(
+    body: SphericalTop,
+    M3: float,
+    C2: float,
+    h: float,
+    *,
+    figsize: tuple[float, float] = (7, 8.5),
+) -> Figure:
     """Three panels against ``|C1 - M3|`` (log scale), on each side of the south pole level
     ``C1 = M3``: the period with its limit and the pole level's own period, ``Delta psi`` with its
     two limits (``2 pi`` apart) and the pole level's value, and the friction coefficient the

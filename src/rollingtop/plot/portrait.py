@@ -14,15 +14,29 @@ In a pole case (``C1 = +-M3``) orbits pass through the pole, where the paper's `
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TypeAlias
 
 import numpy as np
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
 
+from rollingtop.contact.meridian import MODEL
 from rollingtop.dynamics import _kernel
-from rollingtop.reduction import LevelSet, LevelSetError, orbits, state_from_level, steady_motions
+from rollingtop.reduction import (
+    LevelSet,
+    LevelSetError,
+    Orbit,
+    orbits,
+    state_from_level,
+    steady_motions,
+)
 from rollingtop.reduction._quadrature import energy_gap
+from rollingtop.reduction.level import Real
 
 __all__ = ["phase_portrait", "default_h_levels"]
+
+FloatArray: TypeAlias = NDArray[np.float64]
 
 
 def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
@@ -42,12 +56,19 @@ def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
     return sorted({*map(float, levels), *saddles})
 
 
-def _abscissa(level: LevelSet, theta):
-    """``gamma3 = cos(theta)``, or ``theta`` itself in a pole case."""
-    return np.asarray(theta, dtype=float) if level.pole else np.cos(theta)
+def _abscissa(level: LevelSet, theta: Real) -> Real:
+    """``gamma3 = cos(theta)``, or ``theta`` itself in a pole case (same shape)."""
+    if level.pole:
+        return theta
+    x: Real = np.cos(theta)
+    return x
 
 
-def _orbit_curve(level: LevelSet, h: float, orbit, n: int = 400):
+def _orbit_curve(
+    level: LevelSet, h: float, orbit: Orbit, n: int = 400
+) -> tuple[FloatArray, FloatArray]:
+    """The closed curve ``(abscissa, w_tau)`` of ``orbit`` at energy ``h``, each of shape
+    ``(2 n,)`` (rolling over: two branches of ``2 n`` points joined by a NaN)."""
     t1, t2 = orbit.theta_min, orbit.theta_max
     if orbit.rolls_over:
         # rolling over (no spin): theta runs round the circle; draw w_tau > 0 and < 0 branches
@@ -62,7 +83,7 @@ def _orbit_curve(level: LevelSet, h: float, orbit, n: int = 400):
     return np.concatenate([x, x[::-1]]), np.concatenate([w, -w[::-1]])
 
 
-def _normal_force_grid(level: LevelSet, g3: np.ndarray, w: np.ndarray) -> np.ndarray:
+def _normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatArray:
     """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape (nw, ng)."""
     states = []
     for gg in g3:
@@ -72,16 +93,16 @@ def _normal_force_grid(level: LevelSet, g3: np.ndarray, w: np.ndarray) -> np.nda
             states.append(state_from_level(level, h, gg, branch=1 if ww >= 0 else -1))
     Y = np.ascontiguousarray(states)
     out = np.empty((len(Y), 8))
-    _kernel.diagnostics(0, level.body.params, Y, out)
+    _kernel.diagnostics(MODEL.code, level.body.params, Y, out)
     return out[:, 0].reshape(len(g3), len(w)).T
 
 
 def phase_portrait(
     level: LevelSet,
-    h_levels=None,
+    h_levels: Sequence[float] | None = None,
     *,
     show_contact: bool = True,
-    figsize=(7.0, 7.5),
+    figsize: tuple[float, float] = (7.0, 7.5),
 ) -> Figure:
     """Phase portrait on the level set ``(M3, C1, C2)``: orbits at ``h_levels``, separatrices,
     steady motions, the effective potential below.
@@ -149,13 +170,13 @@ def phase_portrait(
             ax.contourf(gg, ww, N, levels=[N.min() - 1, 0.0], colors=["#f4c7c3"], zorder=1)
             ax.plot([], [], color="#f4c7c3", lw=6, label="normal force < 0 (contact lost)")
     for m in motions:
-        x = float(_abscissa(level, m.theta))
-        if not g_lo <= x <= g_hi:
+        xm = float(_abscissa(level, m.theta))
+        if not g_lo <= xm <= g_hi:
             continue
         if m.type == "center":
-            ax.plot(x, 0, "o", color="black", ms=5, zorder=4)
+            ax.plot(xm, 0, "o", color="black", ms=5, zorder=4)
         else:
-            ax.plot(x, 0, "x", color="crimson", ms=8, mew=2, zorder=4)
+            ax.plot(xm, 0, "x", color="crimson", ms=8, mew=2, zorder=4)
     for pole_theta in level.pole_thetas:
         ax.axvline(pole_theta, color="0.5", ls="--", lw=0.8, zorder=0)
     if level.pole:
