@@ -286,7 +286,7 @@ def test_compare_progress_bar_follows_each_model(tmp_path, capsys, monkeypatch):
 def test_bare_command_prints_help(capsys):
     code, out, err = run_cli(capsys)
     assert code == 0 and err == "" and out.startswith("Usage: rollingtop [OPTIONS] COMMAND")
-    assert "simulate" in out
+    assert "warmup" in out and "simulate" in out
 
 
 @pytest.mark.parametrize(

@@ -7,7 +7,8 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._level`: ``equilibria``, ``orbits``, ``portrait`` (the reduction);
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;
-- :mod:`._verify`: ``verify``.
+- :mod:`._verify`: ``verify``;
+- :mod:`._warmup`: ``warmup``.
 """
 
 from __future__ import annotations
@@ -18,11 +19,12 @@ from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
 from rollingtop.cli._simulate import simulate
 from rollingtop.cli._verify import verify
+from rollingtop.cli._warmup import warmup
 
 __all__ = ["cli", "main"]
 
 for _command in (simulate, equilibria, orbits, portrait, path, plot, compare, animate, ensemble,
-                 verify):  # fmt: skip
+                 verify, warmup):  # fmt: skip
     cli.add_command(_command)
 
 
