@@ -1,7 +1,9 @@
 """rollingtop benchmarks: side-by-side timings against scipy.integrate.solve_ivp.
 
-Run:  python benchmarks/run_benchmarks.py [--quick] [--readme] [--only W1,W2,W3,cold_start]
+Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs] [--only W1,W2,W3,cold_start]
                                           [--out benchmarks/results.json]
+
+--write-docs (old name: --readme) rewrites the results block of docs/guide/performance.md.
 
 W1  one long trajectory (paper's body, examples/paper.toml, t = 1e4, rtol 1e-10, atol 1e-12):
     rollingtop vs solve_ivp(DOP853) with a plain NumPy right-hand side and with rollingtop's
@@ -280,7 +282,21 @@ def w3(t_end):
     return out
 
 
-def cold_start():
+#: The command timed for the start-up of the command line: a short run of the paper's scenario.
+SIMULATE_COMMAND = ["-m", "rollingtop.cli", "simulate", "examples/paper.toml", "--t-end", "1",
+                    "--json"]  # fmt: skip
+
+
+def _wall(argv, env) -> float:
+    start = time.perf_counter()
+    subprocess.run([sys.executable, *argv], env=env, cwd=ROOT, capture_output=True, check=True)
+    return time.perf_counter() - start
+
+
+def cold_start(warm_runs: int = 5):
+    """Import + compile in a fresh process, and the wall time of ``rollingtop simulate`` (a short
+    run of examples/paper.toml), each with an empty numba cache and with a warm one (the median
+    of ``warm_runs`` processes)."""
     code = ("import time; t = time.perf_counter(); import rollingtop; "
             "from rollingtop.integrate import compile_kernels; compile_kernels(); "
             "print(time.perf_counter() - t)")  # fmt: skip
@@ -291,6 +307,12 @@ def cold_start():
             proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                                   text=True, check=True)  # fmt: skip
             out[label] = float(proc.stdout.strip().splitlines()[-1])
+    with tempfile.TemporaryDirectory() as cache:
+        env = os.environ | {"NUMBA_CACHE_DIR": cache}
+        out["simulate_empty_cache_s"] = _wall(SIMULATE_COMMAND, env)
+        out["simulate_warm_cache_s"] = statistics.median(
+            _wall(SIMULATE_COMMAND, env) for _ in range(warm_runs)
+        )
     return out
 
 
@@ -344,15 +366,23 @@ def table(res) -> str:
     cs = res["cold_start"]
     rows += ["", f"Cold start (import + compile): {cs['empty_cache_s']:.1f} s with an empty numba "
              f"cache, {cs['warm_cache_s']:.1f} s with a warm one."]  # fmt: skip
+    if "simulate_empty_cache_s" in cs:
+        rows += ["", f"`rollingtop simulate examples/paper.toml --t-end 1 --json`, whole process: "
+                 f"{cs['simulate_empty_cache_s']:.1f} s with an empty numba cache (everything it "
+                 f"uses compiled), {cs['simulate_warm_cache_s']:.2f} s with a warm one (median of "
+                 f"5 processes)."]  # fmt: skip
     return "\n".join(rows)
 
 
-README_START = "<!-- benchmark-results:start (written by benchmarks/run_benchmarks.py --readme) -->"
-README_END = "<!-- benchmark-results:end -->"
+DOCS_PAGE = ROOT / "docs" / "guide" / "performance.md"
+DOCS_START = (
+    "<!-- benchmark-results:start (written by benchmarks/run_benchmarks.py --write-docs) -->"
+)
+DOCS_END = "<!-- benchmark-results:end -->"
 
 
-def readme_block(res) -> str:
-    """The machine, the date and the tables, for the README."""
+def docs_block(res) -> str:
+    """The machine, the date and the tables, for the performance page."""
     m = res["machine"]
     dates = res.get("dates", {})
     if len(set(dates.values())) > 1:
@@ -366,15 +396,20 @@ def readme_block(res) -> str:
     )
 
 
-def write_readme(res, path: Path) -> None:
-    """Replace the block between the README's markers with the new results (atomically)."""
-    text = path.read_text()
-    head, sep, rest = text.partition(README_START)
-    _, sep2, tail = rest.partition(README_END)
+def replace_block(text: str, block: str, where: object = DOCS_PAGE) -> str:
+    """``text`` with the lines between its benchmark markers replaced by ``block``."""
+    head, sep, rest = text.partition(DOCS_START)
+    _, sep2, tail = rest.partition(DOCS_END)
     if not sep or not sep2:
-        raise SystemExit(f"{path}: benchmark markers not found")
+        raise SystemExit(f"{where}: benchmark markers not found")
+    return f"{head}{DOCS_START}\n{block}\n{DOCS_END}{tail}"
+
+
+def write_docs(res, path: Path = DOCS_PAGE) -> None:
+    """Replace the block between the page's markers with the new results (atomically)."""
+    text = replace_block(path.read_text(), docs_block(res), path)
     tmp = path.with_suffix(".md.tmp")
-    tmp.write_text(f"{head}{README_START}\n{readme_block(res)}\n{README_END}{tail}")
+    tmp.write_text(text)
     os.replace(tmp, path)
 
 
@@ -383,14 +418,17 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smaller sizes, for a smoke test")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results.json"))
     ap.add_argument(
+        "--write-docs",
         "--readme",
+        dest="write_docs",
         action="store_true",
-        help="also write the tables into README.md (between its markers)",
+        help="also write the tables into docs/guide/performance.md (between its markers); "
+        "--readme is the old name",
     )
     ap.add_argument(
         "--from-json",
         metavar="FILE",
-        help="do not measure: (re)write the README block from saved results",
+        help="do not measure: (re)write the docs block from saved results",
     )
     ap.add_argument(
         "--only",
@@ -401,7 +439,8 @@ def main() -> None:
     if args.from_json:
         res = json.loads(Path(args.from_json).read_text())
         res["table_markdown"] = table(res)
-        write_readme(res, ROOT / "README.md")
+        write_docs(res)
+        print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
         return
     quick = args.quick
     parts = {"W2", "W3", "cold_start", "W1"}
@@ -431,9 +470,9 @@ def main() -> None:
     Path(args.out).write_text(json.dumps(res, indent=2))
     print(res["table_markdown"])
     print(f"wrote {args.out}")
-    if args.readme and not quick:
-        write_readme(res, ROOT / "README.md")
-        print("wrote README.md")
+    if args.write_docs and not quick:
+        write_docs(res)
+        print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
 
 
 if __name__ == "__main__":

@@ -1,8 +1,10 @@
-"""Measure the accuracy claims the README makes about long runs, and write them into its block.
+"""Measure the accuracy claims the docs make about long runs, and write them into their block.
 
 For the paper's state (examples/paper.toml) under each contact model, t = 1000, rtol = 1e-12,
 atol = 1e-14: the largest relative drift of every reported integral, the largest constraint
-residual, the steps and the wall time. Run: python docs/accuracy.py [--readme]
+residual, the steps and the wall time. Run: python docs/accuracy.py [--write-docs]
+(--write-docs replaces the block between the markers of docs/guide/accuracy.md; --readme is its
+old name).
 """
 
 from __future__ import annotations
@@ -13,8 +15,10 @@ from pathlib import Path
 import rollingtop as rt
 
 ROOT = Path(__file__).resolve().parents[1]
-START = "<!-- accuracy:start (written by docs/accuracy.py --readme) -->"
+TARGET = ROOT / "docs" / "guide" / "accuracy.md"
+START = "<!-- accuracy:start (written by docs/accuracy.py --write-docs) -->"
 END = "<!-- accuracy:end -->"
+WRITE_FLAGS = ("--write-docs", "--readme")
 
 
 def measure() -> list[dict]:
@@ -40,12 +44,21 @@ def block(rows) -> str:
     return "\n".join([*lines, "", END])
 
 
+def replace_block(text: str, new_block: str) -> str:
+    """``text`` with the block from ``START`` to ``END`` (markers included) replaced."""
+    i, j = text.find(START), text.find(END)
+    if i < 0 or j < i:
+        raise SystemExit(f"{TARGET}: accuracy markers not found")
+    return text[:i] + new_block + text[j + len(END) :]
+
+
+def write_docs(new_block: str, path: Path = TARGET) -> None:
+    path.write_text(replace_block(path.read_text(), new_block))
+
+
 if __name__ == "__main__":
-    rows = measure()
-    text = block(rows)
+    text = block(measure())
     print(text)
-    if "--readme" in sys.argv:
-        readme = ROOT / "README.md"
-        s = readme.read_text()
-        i, j = s.index(START), s.index(END) + len(END)
-        readme.write_text(s[:i] + text + s[j:])
+    if any(flag in sys.argv for flag in WRITE_FLAGS):
+        write_docs(text)
+        print(f"wrote {TARGET.relative_to(ROOT)}")

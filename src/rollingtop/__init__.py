@@ -7,7 +7,6 @@ Nonlinear Dynamics 19(1), 2023, 3-17 (doi:10.20537/nd221205), and its neighbour 
 
 from importlib import metadata as _metadata
 
-from rollingtop import _kernel_cache  # noqa: F401  (first: refreshes numba's kernel cache)
 from rollingtop._errors import (
     BodyError,
     ContactLostWarning,
@@ -18,6 +17,7 @@ from rollingtop._errors import (
     RollingTopError,
     ScenarioError,
 )
+from rollingtop._warmup import warmup
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.dynamics.integrals import INTEGRALS
@@ -54,4 +54,5 @@ __all__ = [
     "simulate",
     "simulate_ensemble",
     "simulate_models",
+    "warmup",
 ]

@@ -4,55 +4,49 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
-from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._errors import ScenarioError
+from rollingtop._output import NetCDFOutput
 from rollingtop.body import SphericalTop
-from rollingtop.contact import ContactModel, get_model, meridian
+from rollingtop.contact import ContactModel, get_model, kernel_by_code
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
+from rollingtop.ensemble_tables import (
+    MAX_TABLE_BYTES,
+    check_ensemble_memory,
+    grid_table,
+    read_table,
+    states_from_table,
+)
 from rollingtop.integrate._dop853 import STATUS_NAMES
 from rollingtop.integrate.driver import compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
-from rollingtop.io import check_output_path, netcdf_bytes, read_input_text, write_bytes_atomic
 from rollingtop.scenario import (
-    InitialConditions,
     Scenario,
-    check_memory,
-    short_name,
     short_repr,
 )
 
-__all__ = ["EnsembleResult", "simulate_ensemble", "states_from_table", "grid_table"]
+__all__ = [
+    "MAX_TABLE_BYTES",
+    "EnsembleResult",
+    "check_ensemble_memory",
+    "ensemble_from_scenario",
+    "grid_table",
+    "read_table",
+    "simulate_ensemble",
+    "states_from_table",
+]
 
 #: Per-trajectory status codes and their names (the compiled stepper's, :mod:`._dop853`).
 STATUS = dict(STATUS_NAMES)
 
-#: Largest CSV table of initial states read (bytes).
-MAX_TABLE_BYTES = 64 << 20
-#: Rough memory of one trajectory without samples (input and final states, statistics,
-#: integrals, the Python objects of its row), and of one kept sample of one trajectory (the
-#: samples array, the dataset and its serialised file), used to refuse ensembles that cannot fit
-#: in :func:`rollingtop.scenario.memory_limit` before anything is allocated.
-BYTES_PER_TRAJECTORY = 4096
-BYTES_PER_TRAJECTORY_SAMPLE = 3 * N_STATE * 8
-
-
-def check_ensemble_memory(n: int, samples: int | None, what: str = "the ensemble") -> None:
-    """Refuse (``ScenarioError``, with the size) an ensemble of ``n`` trajectories keeping
-    ``samples`` samples each whose memory exceeds :func:`rollingtop.scenario.memory_limit`."""
-    needed = n * (BYTES_PER_TRAJECTORY + (samples or 0) * BYTES_PER_TRAJECTORY_SAMPLE)
-    label = f"{what} ({n} trajectories" + (f" of {samples} samples)" if samples else ")")
-    check_memory(label, needed)
-
 
 @dataclass
-class EnsembleResult:
+class EnsembleResult(NetCDFOutput):
     """Per-trajectory results of an ensemble.
 
     Attributes
@@ -171,11 +165,6 @@ class EnsembleResult:
                      single_body=int(all(x == b for x in self.bodies)))  # fmt: skip
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def to_netcdf(self, path) -> Path:
-        """Write :meth:`to_xarray` to NetCDF-4, atomically."""
-        path = check_output_path(path, (".nc",))
-        return write_bytes_atomic(path, netcdf_bytes(self.to_xarray()))
-
 
 def simulate_ensemble(
     body: SphericalTop | Sequence[SphericalTop],
@@ -280,169 +269,17 @@ def _ensemble_integrals(model, bodies, codes, initial, final) -> dict:
         names = own if names is None else names & own
     names = [n for n in model.integrals(True) if n in names]
     result = {n: {"initial": np.empty(len(bodies)), "final": np.empty(len(bodies))} for n in names}
-    poles = {meridian.SOUTH_CODE: "south", meridian.NORTH_CODE: "north"}
     groups: dict = {}
     for k, (b, c) in enumerate(zip(bodies, codes, strict=True)):
         groups.setdefault((id(b), int(c)), (b, int(c), []))[2].append(k)
     for b, c, idx in groups.values():
         idx = np.array(idx)
         for key, Y in (("initial", initial[idx]), ("final", final[idx])):
-            for name, values in evaluate(b, Y, names, pole=poles.get(c)).items():
+            for name, values in evaluate(b, Y, names, pole=kernel_by_code(c).variant).items():
                 result[name][key][idx] = values
     for d in result.values():
         d["drift"] = d["final"] - d["initial"]
     return result
-
-
-# ---- building ensembles from tables ---------------------------------------------------------
-
-_VECTOR_KEYS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3, "v_horizontal": 2}
-
-
-def _column_map(model: ContactModel) -> dict[str, tuple[str, int | None]]:
-    """Column name -> (initial-condition key, component index or None)."""
-    cols = {}
-    for key, n in _VECTOR_KEYS.items():
-        if key == "v_horizontal" and "v_horizontal" not in model.free_velocity:
-            continue
-        for i in range(n):
-            cols[f"{key}{i + 1}"] = (key, i)
-    for key, n in model.free_velocity.items():
-        if n == 1:
-            cols[key] = (key, None)
-    cols["theta"] = ("theta", None)  # gamma = (0, sin theta, cos theta)
-    return cols
-
-
-def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -> np.ndarray:
-    """Initial states from the scenario's initial conditions with some values replaced per row.
-
-    ``columns`` maps names to equal-length sequences: ``gamma1..3, omega1..3, alpha1..3,
-    position1..2, v1..3`` (a full velocity), the model's free components (``v_tau``;
-    ``v_horizontal1..2``), or ``theta`` (``gamma = (0, sin theta, cos theta)``). Every row is
-    validated like a scenario's ``[initial]`` table; errors name the row.
-    """
-    model = scenario.model
-    allowed = _column_map(model)
-    unknown = [c for c in columns if c not in allowed]
-    if unknown:
-        shown = ", ".join(short_name(c) for c in unknown[:5]) + (
-            ", ..." if len(unknown) > 5 else ""
-        )
-        raise ScenarioError(
-            f"unknown column {shown} for model {model.name!r} (allowed: {', '.join(allowed)})"
-        )
-    lengths = {len(v) for v in columns.values()}
-    if len(lengths) != 1:
-        raise ScenarioError("columns of the ensemble table have different lengths")
-    (n,) = lengths
-    base = scenario.initial
-    if base is None:
-        base = InitialConditions.from_state(scenario.require_state())
-    from rollingtop.dynamics.state import initial_state
-
-    states = np.empty((n, N_STATE))
-    for row in range(n):
-        fields = {
-            "gamma": list(base.gamma), "omega": list(base.omega),
-            "alpha": None if base.alpha is None else list(base.alpha),
-            "position": list(base.position), "v": None if base.v is None else list(base.v),
-        }  # fmt: skip
-        free = {k: (list(v) if np.ndim(v) else v) for k, v in base.free.items()}
-        for name, values in columns.items():
-            key, i = allowed[name]
-            x = float(values[row])
-            if key == "theta":
-                fields["gamma"] = [0.0, math.sin(x), math.cos(x)]
-                if "alpha" not in {allowed[c][0] for c in columns}:
-                    fields["alpha"] = None
-            elif key in model.free_velocity:
-                if i is None:
-                    free[key] = x
-                else:
-                    vec = list(free.get(key, [0.0] * model.free_velocity[key]))
-                    vec[i] = x
-                    free[key] = vec
-            else:
-                if fields[key] is None:
-                    raise ScenarioError(f"row {row + 1}: column {name} needs a base value of {key}")
-                fields[key][i] = x
-        if any(allowed[c][0] == "v" for c in columns):
-            free = {}
-        elif any(allowed[c][0] in model.free_velocity for c in columns):
-            fields["v"] = None
-        try:
-            states[row] = initial_state(scenario.body, model, free=free, **fields)
-        except RollingTopError as exc:  # name the row
-            raise type(exc)(f"ensemble row {row + 1}: {exc}") from None
-    return states
-
-
-_GRID = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*([^:]+):([^:]+):(\d+)\s*$")
-
-
-def grid_table(spec: str, samples: int | None = None) -> dict[str, np.ndarray]:
-    """Columns of a Cartesian grid from ``"name=start:stop:count,name=..."``.
-
-    The grid's size is checked against the memory limit (with ``samples`` kept per
-    trajectory, if given) before anything is allocated.
-    """
-    axes = []
-    for part in spec.split(","):
-        shown = short_repr(part.strip())
-        m = _GRID.match(part)
-        if not m:
-            raise ScenarioError(f"--grid {shown}: expected name=start:stop:count")
-        name, a, b, count = m.groups()
-        try:
-            a, b = float(a), float(b)
-        except ValueError:
-            raise ScenarioError(f"--grid {shown}: start and stop must be numbers") from None
-        if len(count) > 18:
-            raise ScenarioError(f"--grid {shown}: count is too large")
-        count = int(count)
-        if not (math.isfinite(a) and math.isfinite(b)):
-            raise ScenarioError(f"--grid {shown}: start and stop must be finite")
-        if count < 1:
-            raise ScenarioError(f"--grid {shown}: count must be >= 1")
-        axes.append((name, a, b, count))
-    names = [a[0] for a in axes]
-    if len(set(names)) != len(names):
-        raise ScenarioError("--grid names a column twice")
-    check_ensemble_memory(math.prod(a[3] for a in axes), samples, "--grid")
-    mesh = np.meshgrid(*[np.linspace(a, b, n) for _, a, b, n in axes], indexing="ij")
-    return {name: m.ravel() for name, m in zip(names, mesh, strict=True)}
-
-
-def read_table(path) -> dict[str, np.ndarray]:
-    """Columns of a CSV file with a header row (``#`` comment lines allowed)."""
-    path = Path(path)
-    text = read_input_text(path, "table", MAX_TABLE_BYTES, ScenarioError)
-    lines = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
-             if ln.strip() and not ln.lstrip().startswith("#")]  # fmt: skip
-    if len(lines) < 2:
-        raise ScenarioError(f"{path}: expected a header row and at least one data row")
-    header = [h.strip() for h in lines[0][1].split(",")]
-    if len(set(header)) != len(header):
-        raise ScenarioError(f"{path}: the header names a column twice")
-    check_ensemble_memory(len(lines) - 1, None, f"{path}")
-    data = np.empty((len(lines) - 1, len(header)))
-    for row, (k, line) in enumerate(lines[1:]):
-        cells = line.split(",")
-        if len(cells) != len(header):
-            raise ScenarioError(f"{path}: line {k} has {len(cells)} values, header {len(header)}")
-        for i, cell in enumerate(cells):
-            try:
-                data[row, i] = x = float(cell)
-            except ValueError:
-                raise ScenarioError(
-                    f"{path}: line {k}: {short_repr(cell.strip())} is not a number"
-                ) from None
-            if not math.isfinite(x):
-                raise ScenarioError(
-                    f"{path}: line {k}: {short_repr(cell.strip())} is not a finite number"
-                )
-    return {h: data[:, i] for i, h in enumerate(header)}
 
 
 def ensemble_from_scenario(scenario: Scenario, columns: dict, **kwargs) -> EnsembleResult:

@@ -11,12 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from rollingtop._json import finite_or_none
+from rollingtop._output import NetCDFOutput
 from rollingtop.body import SphericalTop
-from rollingtop.contact import ContactModel, meridian
+from rollingtop.contact import ContactModel, kernel_by_code
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop.dynamics.integrals import evaluate
-from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
+from rollingtop.io import check_output_path, write_bytes_atomic
 
 __all__ = ["Trajectory", "OUTPUT_SUFFIXES"]
 
@@ -47,7 +48,7 @@ _UNITS = {
 
 
 @dataclass
-class Trajectory:
+class Trajectory(NetCDFOutput):
     """Samples of one motion with everything measured along it.
 
     Attributes
@@ -92,8 +93,9 @@ class Trajectory:
 
     @property
     def pole_case(self) -> str | None:
-        """``"south"``/``"north"`` when integrated as a meridian pole case, else ``None``."""
-        return {meridian.SOUTH_CODE: "south", meridian.NORTH_CODE: "north"}.get(self.kernel_code)
+        """``"south"``/``"north"`` when integrated as a meridian pole case (the kernel's variant),
+        else ``None``."""
+        return kernel_by_code(self.kernel_code).variant
 
     # ---- state components -------------------------------------------------------------------
     @property
@@ -346,11 +348,6 @@ class Trajectory:
         text.write(",".join(cols) + "\n")
         np.savetxt(text, table, delimiter=",", fmt="%.17g")
         return write_bytes_atomic(path, text.getvalue().encode("utf-8"))
-
-    def to_netcdf(self, path) -> Path:
-        """Write the samples as NetCDF-4 (engine ``h5netcdf``), atomically."""
-        path = check_output_path(path, (".nc",))
-        return write_bytes_atomic(path, netcdf_bytes(self.to_xarray()))
 
     def save(self, path) -> Path:
         """Write to ``.nc`` (NetCDF) or ``.csv``, chosen by the suffix."""

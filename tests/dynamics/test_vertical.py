@@ -33,6 +33,9 @@ from rollingtop.reduction import LevelSet
 
 from ..conftest import PAPER_BODY
 
+#: Kernel codes of the meridian model's pole variants.
+SOUTH_CODE, NORTH_CODE = (k.code for k in meridian.MODEL.kernels[1:])
+
 EXACT = 1e-14  # round-off level for constructed states
 D2U_RTOL = 1e-9  # closed form against LevelSet.d2U (complex step: exact to round-off)
 SEED = 1e-6  # horizontal angular velocity that seeds the departure from the vertical
@@ -108,13 +111,13 @@ def residuals(body, code, y):
 
 def sleeping_run(body, gamma3, w3, t_end, seed=SEED, samples=501):
     y0 = initial_state(body, "meridian", gamma=(0, 0, gamma3), omega=(seed, 0.0, w3))
-    code = meridian.kernel_code(body, y0)
+    code = meridian.MODEL.kernel_code(body, y0)
     res = integrate(code, body.params, y0, np.linspace(0, t_end, samples), rtol=RTOL, atol=ATOL)
     return y0, code, res.y
 
 
 def assert_integrals_conserved(body, Y, code, drift=DRIFT):
-    pole = {meridian.SOUTH_CODE: "south", meridian.NORTH_CODE: "north"}[code]
+    pole = {SOUTH_CODE: "south", NORTH_CODE: "north"}[code]
     names = meridian.MODEL.integrals(True)
     for name, values in integrals.evaluate(body, Y, names, pole).items():
         assert np.ptp(values) < (NEAR_POLE_DRIFT if name == "F6" else drift), name
@@ -131,7 +134,7 @@ def test_fast_spin_stays_vertical(body, gamma3):
     b = SphericalTop(**body)
     w3 = 1.5 * critical_w3(b, gamma3)
     y0, code, Y = sleeping_run(b, gamma3, w3, t_end=50.0)
-    assert code == (meridian.SOUTH_CODE if gamma3 > 0 else meridian.NORTH_CODE)
+    assert code == (SOUTH_CODE if gamma3 > 0 else NORTH_CODE)
     dev = 1 - gamma3 * Y[:, 14]
     assert dev.max() < 1e-9
     rho = b.I1 + b.m * (b.R + b.a3 * gamma3) ** 2
@@ -207,7 +210,7 @@ def test_spin_above_both_thresholds_stays_vertical_long(paper_body):
 def test_exact_sleeping_top_is_an_equilibrium(paper_body):
     """No seed: the state is exactly stationary in the pole variant, even below the threshold."""
     _, code, Y = sleeping_run(paper_body, 1.0, 0.1, t_end=20.0, seed=0.0)
-    assert code == meridian.SOUTH_CODE
+    assert code == SOUTH_CODE
     assert np.all(Y[:, 12:15] == (0.0, 0.0, 1.0))
 
 
@@ -218,11 +221,11 @@ def test_vertical_state_is_on_a_pole_level(paper_body, gamma3, omega):
     y = initial_state(paper_body, "meridian", gamma=(0, 0, gamma3), omega=omega,
                       free={"v_tau": 0.2})  # fmt: skip
     assert tuple(y[12:15]) == (0.0, 0.0, gamma3)
-    code = meridian.kernel_code(paper_body, y)
+    code = meridian.MODEL.kernel_code(paper_body, y)
     if omega[2] == 0.0:  # no spin: both poles at once, the south variant
-        assert code == meridian.SOUTH_CODE
+        assert code == SOUTH_CODE
     else:
-        assert code == (meridian.SOUTH_CODE if gamma3 > 0 else meridian.NORTH_CODE)
+        assert code == (SOUTH_CODE if gamma3 > 0 else NORTH_CODE)
     assert np.max(np.abs(residuals(paper_body, code, y))) < EXACT
     np.testing.assert_array_equal(y[3:6], omega)
     c = reduced_components(y)
@@ -239,7 +242,7 @@ def test_nu_is_the_direction_in_which_the_axis_leaves(paper_body, gamma3):
     """After the start the geometric meridian (e3 - gamma3 gamma)/s is the carried nu."""
     y0 = initial_state(paper_body, "meridian", gamma=(0, 0, gamma3), omega=(0.3, -0.4, 1.0),
                        alpha=(0.6, 0.8, 0.0))  # fmt: skip
-    code = meridian.kernel_code(paper_body, y0)
+    code = meridian.MODEL.kernel_code(paper_body, y0)
     Y = integrate(code, paper_body.params, y0, np.array([0.0, 1e-3, 0.3]), rtol=RTOL,
                   atol=ATOL).y  # fmt: skip
     for y in Y[1:]:
@@ -264,7 +267,7 @@ def test_axis_within_pole_tolerance_is_set_vertical(paper_body):
     y = initial_state(paper_body, "meridian", gamma=gamma, omega=(0, 0.2, 1.0), alpha=alpha)
     assert tuple(y[12:15]) == (0.0, 0.0, 1.0)
     assert y[8] == 0.0 and y[11] == 0.0
-    assert meridian.kernel_code(paper_body, y) == meridian.SOUTH_CODE
+    assert meridian.MODEL.kernel_code(paper_body, y) == SOUTH_CODE
     # beyond the tolerance: kept as given
     tilt = 2 * meridian.POLE_TOLERANCE
     gamma = (tilt, 0.0, math.sqrt(1 - tilt**2))
@@ -281,8 +284,8 @@ def test_project_state_at_the_vertical(paper_body):
     y = initial_state(paper_body, "smooth", gamma=(0, 0, 1), omega=(0.3, 0.1, 2.0),
                       free={"v_horizontal": (0.2, -0.1)})  # fmt: skip
     p = project_state(paper_body, "meridian", y)
-    code = meridian.kernel_code(paper_body, p)
-    assert code == meridian.SOUTH_CODE
+    code = meridian.MODEL.kernel_code(paper_body, p)
+    assert code == SOUTH_CODE
     assert np.max(np.abs(residuals(paper_body, code, p))) < EXACT
     assert reduced_components(p)["w_n"] == pytest.approx(0.0, abs=EXACT)
 

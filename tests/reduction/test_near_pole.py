@@ -11,7 +11,7 @@ import pytest
 
 from rollingtop import SphericalTop
 from rollingtop.absolute import period_map
-from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, kernel_code, pole_case
+from rollingtop.contact.meridian import MODEL, POLE_CASE_TOLERANCE, pole_case
 from rollingtop.reduction import POLE_TOLERANCE, LevelSet, orbits
 from rollingtop.reduction.near_pole import near_pole
 
@@ -178,12 +178,12 @@ def test_one_pole_tolerance_at_its_boundary(paper_body):
     assert LevelSet(paper_body, M3, outside, -0.3).pole is None
     # the simulator's kernel choice follows the same decision for states on those levels (C1
     # recomputed from a state moves by ~1e-16, far less than the margins 0.5e-13 and 1e-13)
-    from rollingtop.contact.meridian import CODE, SOUTH_CODE
+    own, south = MODEL.kernels[:2]
     from rollingtop.reduction import state_from_level
 
-    for C1, expected in ((inside, SOUTH_CODE), (outside, CODE)):
+    for C1, expected in ((inside, south), (outside, own)):
         y = state_from_level(LevelSet(paper_body, M3, C1, -0.3), 1.1, 0.8)
-        assert kernel_code(paper_body, y) == expected
+        assert MODEL.kernel(paper_body, y) == expected
 
 
 def test_mirror_image_is_the_same_motion(paper_body):
@@ -220,7 +220,7 @@ def test_full_simulation_near_the_pole_level(paper_body):
                   IntegrationOptions(t_end=8.0, rtol=1e-12, atol=1e-14, samples=11),
                   level=LevelSpec(M3, C1, C2, h=h))  # fmt: skip
     traj = simulate(sc, events="w_tau", event_direction=1)
-    assert traj.kernel_code == 0  # no pole case: the paper's geometric direction nu
+    assert traj.kernel_code == MODEL.code  # no pole case: the paper's geometric direction nu
     periods = np.diff(traj.event_t)
     assert len(periods) >= 2
     np.testing.assert_allclose(periods, orbit.period, rtol=1e-8)

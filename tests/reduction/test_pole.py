@@ -13,6 +13,9 @@ from rollingtop.integrate import integrate
 from rollingtop.reduction import LevelSet, orbits
 from rollingtop.scenario import IntegrationOptions, LevelSpec, Scenario
 
+#: Kernel codes of the meridian model's pole variants.
+SOUTH_CODE, NORTH_CODE = (k.code for k in meridian.MODEL.kernels[1:])
+
 CASES = [  # (C1, C2): south pole (C1 = M3) and north pole (C1 = -M3) cases, M3 = 1
     (1.0, -0.3),
     (1.0, 0.5),
@@ -131,8 +134,13 @@ def test_geometric_direction_cannot_pass_the_pole(paper_body):
         IntegrationOptions(t_end=10.0),
         level=LevelSpec(1.0, 1.0, -0.3, h=pole_h(level)),
     )
-    assert meridian.kernel_code(paper_body, sc.y0) == meridian.SOUTH_CODE
+    assert meridian.MODEL.kernel_code(paper_body, sc.y0) == SOUTH_CODE
     with pytest.raises(IntegrationError, match="step size underflow"):
         integrate(
-            meridian.CODE, paper_body.params, sc.y0, np.array([0.0, 10.0]), rtol=1e-12, atol=1e-14
+            meridian.MODEL.code,
+            paper_body.params,
+            sc.y0,
+            np.array([0.0, 10.0]),
+            rtol=1e-12,
+            atol=1e-14,
         )

@@ -1,18 +1,53 @@
-"""Contact models, chosen by name.
+"""Contact models, chosen by name: the registry.
 
-Each module declares one model: its compiled constraint rows (``rows``) and a
-:class:`~rollingtop.contact._base.ContactModel` describing it. Adding a model means adding a
-module here, its entry in :data:`MODELS` and one branch in
-:func:`rollingtop.dynamics._kernel.constraint_rows`.
+Each module of this package declares one model, and is the only place that knows it: its
+:class:`~rollingtop.contact._base.ContactModel` (constraints, free velocity components,
+integrals, initial-state construction, pole handling, symbolic constraint, whether it has a
+reduction) and its compiled functions, all with the same signatures:
+
+- ``rows(p, y, J, bias, dirs, variant)`` (required): the constraint rows, their bias and force
+  directions; returns their number. The general path of the dynamics solves with them.
+- ``accel(p, y, dy, ws, variant)`` and ``project_velocity(p, y, variant)`` (optional): closed
+  forms of the accelerations and of the velocity projection, several times faster than the
+  general path (the tests hold them to it).
+- ``direction_rate(p, y, variant)`` and ``sync_direction(y, variant)`` (optional, for models with
+  variants that carry a constraint direction in ``psi_nu``).
+
+**Adding a model** is one module here plus one line in :data:`MODULES`, then
+``python -m rollingtop.contact._codegen`` rewrites the compiled dispatch
+(:mod:`rollingtop.contact._dispatch`, generated; a test fails while it is stale). The shared
+model battery (``tests/contact/test_models.py``) then runs for it.
 """
+
+from __future__ import annotations
+
+from types import ModuleType
 
 from rollingtop._errors import ContactModelError
 from rollingtop.contact import meridian, rough, smooth
-from rollingtop.contact._base import ContactModel
+from rollingtop.contact._base import ContactModel, Kernel
 
-MODELS: dict[str, ContactModel] = {m.name: m for m in (meridian.MODEL, smooth.MODEL, rough.MODEL)}
+#: The registry: the model modules, one line each. Kernel codes follow this order (each model's
+#: own kernel first, then the variants).
+MODULES: tuple[ModuleType, ...] = (
+    meridian,
+    smooth,
+    rough,
+)
 
-__all__ = ["MODELS", "ContactModel", "get_model"]
+MODELS: dict[str, ContactModel] = {m.MODEL.name: m.MODEL for m in MODULES}
+
+
+def _kernels() -> tuple[Kernel, ...]:
+    own = [(m.MODEL.name, None) for m in MODULES]
+    variants = [(m.MODEL.name, v) for m in MODULES for v in m.MODEL.variants]
+    return tuple(Kernel(name, v, code) for code, (name, v) in enumerate(own + variants))
+
+
+#: Every compiled kernel, indexed by its code.
+KERNELS: tuple[Kernel, ...] = _kernels()
+
+__all__ = ["KERNELS", "MODELS", "MODULES", "ContactModel", "Kernel", "get_model", "kernel_by_code"]
 
 
 def get_model(name: str | ContactModel) -> ContactModel:
@@ -25,3 +60,14 @@ def get_model(name: str | ContactModel) -> ContactModel:
         raise ContactModelError(
             f"unknown contact model {name!r} (known: {', '.join(MODELS)})"
         ) from None
+
+
+def kernels_of(model: ContactModel) -> tuple[Kernel, ...]:
+    """The kernels of ``model``: its own first, then its variants in declaration order."""
+    by_variant = {k.variant: k for k in KERNELS if k.model == model.name}
+    return tuple(by_variant[v] for v in (None, *model.variants))
+
+
+def kernel_by_code(code: int) -> Kernel:
+    """The kernel with compiled selector ``code``."""
+    return KERNELS[code]

@@ -1,23 +1,64 @@
-"""What every contact model declares: its name, constraints, free velocities and integrals."""
+"""What every contact model declares: its name, constraints, free velocities, integrals, and the
+compiled kernels (model x variant) that integrate it."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from rollingtop.body import SphericalTop
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Kernel:
+    """One compiled variant of a contact model's equations: the model, and the variant of its
+    constraint directions.
+
+    Attributes
+    ----------
+    model : str
+        Name of the model (:attr:`ContactModel.name`).
+    variant : str or None
+        ``None`` for the model's own equations; else the name of a variant that carries a
+        constraint direction through an orientation where the model's geometric one is undefined
+        (the meridian model's ``"south"`` and ``"north"`` pole cases: the direction's azimuth is
+        the state's ``psi_nu``, see :mod:`rollingtop.contact.meridian`).
+    code : int
+        Selector of this kernel in the compiled dispatch (:mod:`rollingtop.contact._dispatch`),
+        assigned by the registry (:mod:`rollingtop.contact`).
+    """
+
+    model: str
+    variant: str | None
+    code: int
+
+    @property
+    def carries_direction(self) -> bool:
+        """Whether the state's ``psi_nu`` is a carried constraint direction (a variant)."""
+        return self.variant is not None
 
 
 @dataclass(frozen=True)
 class ContactModel:
-    """A set of ideal constraints at the contact point, with what follows from it.
+    """A set of ideal constraints at the contact point, with everything that follows from it.
+
+    A model lives in one module of :mod:`rollingtop.contact`, which also defines its compiled
+    constraint rows (``rows``) and, optionally, their closed forms (``accel``,
+    ``project_velocity``) and the carried direction of its variants (``direction_rate``,
+    ``sync_direction``); the registry (:data:`rollingtop.contact.MODELS`) lists it. Everything
+    else in the package asks the model.
 
     Attributes
     ----------
     name : str
         Name used in scenario files and on the command line.
-    code : int
-        Selector of the model's constraint kernel in the compiled right-hand side.
     description : str
         One line, for help texts.
     constraints : tuple of str
@@ -30,6 +71,16 @@ class ContactModel:
     velocity : callable
         ``velocity(body, gamma, omega, alpha, beta, free) -> v``: the body-frame CoM velocity,
         shape (3,), that satisfies the constraints for the given free components.
+    symbolic_directions : callable
+        ``symbolic_directions(sp, gamma) -> list of sympy 3-vectors``: the directions ``d_k`` of
+        the constraints ``(vp, d_k) = 0`` in the body frame, as functions of the sympy symbols
+        ``gamma`` (the symbolic layer, :mod:`rollingtop.symbolic`, derives the equations from
+        them; sympy is passed in, so that the model does not import it).
+    symbolic_velocity : callable
+        ``symbolic_velocity(gamma, tau, wxr, free) -> v``: the centre-of-mass velocity on the
+        constraint manifold in terms of the free components ``free`` (sympy symbols), the unit
+        vector ``tau = e3 x gamma / s`` and ``w x r`` (the symbolic analogue of
+        :attr:`velocity`).
     singular : callable or None
         ``singular(body, gamma) -> str | None``: why no motion of this model can start at this
         orientation (``None`` where one can).
@@ -44,10 +95,11 @@ class ContactModel:
         exactly vertical axis, given the angular velocity and the frame; ``psi_nu`` is the value
         to keep where the model leaves the direction free. ``None``: the state's ``psi_nu`` is
         the axis azimuth, 0 at the vertical (unused by the model).
-    select_code : callable or None
-        ``select_code(body, y) -> int``: the kernel code for a motion from state ``y`` where the
-        model has variants (:func:`rollingtop.contact.meridian.kernel_code`); ``None``: always
-        :attr:`code`. See :meth:`kernel_code`.
+    variants : tuple of str
+        Names of the model's variants (:class:`Kernel`), each compiled as a kernel of its own.
+    select_variant : callable or None
+        ``select_variant(body, y) -> str | None``: the variant for a motion from state ``y``
+        (:func:`rollingtop.contact.meridian.select_variant`); ``None``: never a variant.
     has_reduction : bool
         Whether the model's motions of a dynamically symmetric body reduce to one degree of
         freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
@@ -57,17 +109,19 @@ class ContactModel:
     """
 
     name: str
-    code: int
     description: str
     constraints: tuple[str, ...]
     free_velocity: dict[str, int]
     integrals_symmetric: tuple[str, ...]
     integrals_general: tuple[str, ...]
-    velocity: Callable[..., np.ndarray]
-    singular: Callable[..., str | None] | None = None
+    velocity: Callable[..., FloatArray]
+    symbolic_directions: Callable[[Any, Any], list[Any]]
+    symbolic_velocity: Callable[[Any, Any, Any, Any], Any]
+    singular: Callable[[SphericalTop, FloatArray], str | None] | None = None
     vertical_tolerance: float = 0.0
     vertical_direction: Callable[..., float] | None = None
-    select_code: Callable[..., int] | None = None
+    variants: tuple[str, ...] = ()
+    select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
     has_reduction: bool = False
     colour: str = "#7f7f7f"
 
@@ -75,12 +129,33 @@ class ContactModel:
         """Names of the first integrals of this model for a (non-)symmetric body."""
         return self.integrals_symmetric if symmetric else self.integrals_general
 
-    def kernel_code(self, body, y: np.ndarray) -> int:
-        """The kernel code for a motion of ``body`` from state ``y`` (:attr:`code` unless the
-        model has variants, see :attr:`select_code`)."""
-        return self.code if self.select_code is None else int(self.select_code(body, y))
+    @property
+    def kernels(self) -> tuple[Kernel, ...]:
+        """The model's compiled kernels: its own (first), then one per variant."""
+        from rollingtop.contact import kernels_of
+
+        return kernels_of(self)
+
+    @property
+    def code(self) -> int:
+        """Kernel code of the model's own equations (no variant)."""
+        return self.kernels[0].code
+
+    def kernel(self, body: SphericalTop, y: FloatArray) -> Kernel:
+        """The kernel for a motion of ``body`` from state ``y``: the model's own, or the variant
+        :attr:`select_variant` picks."""
+        variant = None if self.select_variant is None else self.select_variant(body, y)
+        for k in self.kernels:
+            if k.variant == variant:
+                return k
+        raise ValueError(f"model {self.name!r} has no variant {variant!r}")  # pragma: no cover
+
+    def kernel_code(self, body: SphericalTop, y: FloatArray) -> int:
+        """The code of :meth:`kernel`."""
+        return self.kernel(body, y).code
 
 
-def contact_arm(body, gamma: np.ndarray) -> np.ndarray:
+def contact_arm(body: SphericalTop, gamma: FloatArray) -> FloatArray:
     """Contact point seen from the centre of mass, ``r = -R gamma - a``, shape (3,)."""
-    return -body.R * np.asarray(gamma, dtype=float) - np.array([0.0, 0.0, body.a3])
+    out: FloatArray = -body.R * np.asarray(gamma, dtype=float) - np.array([0.0, 0.0, body.a3])
+    return out

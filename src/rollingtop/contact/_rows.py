@@ -6,6 +6,8 @@ time derivative of the condition along the motion adds the *bias* ``dJ/dt . u`` 
 acceleration equation (``docs/model.md``, "Dynamics").
 """
 
+import math
+
 from rollingtop._jit import inline
 
 
@@ -75,3 +77,43 @@ def normal_row(p, y, k, J, bias, dirs):
         bias,
         dirs,
     )
+
+
+@inline
+def free_forces(p, y):
+    """The free forces ``f = (m v x w - m g gamma, (I w) x w)`` as six scalars."""
+    m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
+    v1, v2, v3 = y[0], y[1], y[2]
+    w1, w2, w3 = y[3], y[4], y[5]
+    return (
+        m * (v2 * w3 - v3 * w2) - m * g * y[12],
+        m * (v3 * w1 - v1 * w3) - m * g * y[13],
+        m * (v1 * w2 - v2 * w1) - m * g * y[14],
+        (I2 - I3) * w2 * w3,
+        (I3 - I1) * w3 * w1,
+        (I1 - I2) * w1 * w2,
+    )
+
+
+@inline
+def sync_azimuth(y, period):
+    """Set ``psi_nu = y[17]`` to the axis azimuth ``psi = atan2(beta3, alpha3)``, the value
+    nearest to the present one modulo ``period`` (``2 pi``: continuous; ``pi``: keeping the side
+    of a pole, see :mod:`rollingtop.contact.meridian`)."""
+    psi = math.atan2(y[11], y[8])
+    y[17] = psi + period * round((y[17] - psi) / period)
+
+
+@inline
+def sync_direction(y, variant):
+    """``psi_nu`` follows the axis azimuth (:func:`sync_azimuth`, modulo ``2 pi``) wherever it is
+    defined (``s > 1e-12``): the default of a model that carries no direction."""
+    if math.sqrt(y[8] * y[8] + y[11] * y[11]) > 1e-12:
+        sync_azimuth(y, 2.0 * math.pi)
+
+
+@inline
+def direction_rate(p, y, variant):
+    """``psi_nu'`` of a model that carries no direction: 0 (``psi_nu`` is re-synchronised with
+    the axis azimuth after every step)."""
+    return 0.0

@@ -23,7 +23,7 @@ on which side of the pole the motion is, which is what keeps ``F6`` (odd under t
 continuous in the monitoring.
 
 **No spin.** On ``M3 = C1 = 0`` both poles are pole levels at once (:func:`pole_case` says
-``"both"``, :func:`kernel_code` takes the south variant) and the exact rate is ``psi_nu' = 0``:
+``"both"``, :func:`select_variant` takes the south variant) and the exact rate is ``psi_nu' = 0``:
 the motion is planar rocking in a fixed vertical plane, through either pole. ``M3 = I3 w3`` read
 from the state is exactly 0 only in special orientations (round-off of the torque about ``e3``
 gives ``|w3|`` of a few ulps of ``|w|`` otherwise), and the variant's rate
@@ -55,20 +55,23 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop.contact._base import ContactModel, contact_arm
-from rollingtop.contact._rows import contact_row, normal_row
+from rollingtop.contact._closed import project_contact, rhs_contact
+from rollingtop.contact._rows import contact_row, normal_row, sync_azimuth
+from rollingtop.contact._rows import sync_direction as sync_geometric
 
-CODE = 0
-#: Kernel codes of the pole cases (carried constraint direction), chosen by :func:`kernel_code`.
-SOUTH_CODE = 3
-NORTH_CODE = 4
+#: The variants (kernels of their own, :class:`~rollingtop.contact._base.Kernel`): the pole
+#: cases, with the constraint direction carried in ``psi_nu``; chosen by :func:`select_variant`.
+#: In compiled code a variant is its index: 0 the geometric ``nu``, 1 south, 2 north.
+VARIANTS = ("south", "north")
+GEOMETRIC, SOUTH, NORTH = 0, 1, 2
 #: Below this ``sqrt(gamma1^2 + gamma2^2)`` the axis counts as vertical: the geometric ``nu`` is
 #: undefined (or sweeps through all directions), and an initial state there is set exactly
 #: vertical and started with the carried direction (module docstring, "Vertical start").
 POLE_TOLERANCE = 1e-8
 #: ``|C1 -+ M3|`` at most this times ``max(|M3|, |C1|)`` is a pole case: the one decision used by
-#: the simulator (:func:`kernel_code`), the reduction and every command (:func:`pole_case`). Small
-#: enough that the near-pole levels ``|C1 -+ M3| >= 1e-12 max(|M3|, |C1|)`` are resolved as what
-#: they are (orbits reflected at a thin wall next to the pole), large enough to absorb the
+#: the simulator (:func:`select_variant`), the reduction and every command (:func:`pole_case`).
+#: Small enough that the near-pole levels ``|C1 -+ M3| >= 1e-12 max(|M3|, |C1|)`` are resolved
+#: as what they are (orbits reflected at a thin wall next to the pole), large enough to absorb the
 #: round-off of ``C1`` computed from a state (a few ulps).
 POLE_CASE_TOLERANCE = 1e-13
 #: Above this ``s`` the carried azimuth is re-synchronised with the geometric one (modulo pi).
@@ -140,29 +143,71 @@ def nu_carried(p, y, north):
 
 
 @inline
-def nu_of(p, y, code):
-    """The constraint direction and its derivative for kernel ``code`` (geometric or carried)."""
-    if code == CODE:
+def nu_of(p, y, variant):
+    """The constraint direction and its derivative for ``variant`` (geometric or carried)."""
+    if variant == GEOMETRIC:
         return nu_geometric(y)
-    return nu_carried(p, y, code == NORTH_CODE)
+    return nu_carried(p, y, variant == NORTH)
 
 
 @kernel
-def rows(p, y, J, bias, dirs):
-    """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``); returns their number, 2."""
+def rows(p, y, J, bias, dirs, variant):
+    """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``, geometric or carried by
+    ``variant``); returns their number, 2."""
     normal_row(p, y, 0, J, bias, dirs)
-    n1, n2, n3, nd1, nd2, nd3 = nu_geometric(y)
+    n1, n2, n3, nd1, nd2, nd3 = nu_of(p, y, variant)
     contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
     return 2
 
 
-@kernel
-def rows_pole(p, y, J, bias, dirs, north):
-    """Rows ``f1`` and ``(vp, nu) = 0`` with the carried ``nu`` (:func:`nu_carried`). Returns 2."""
-    normal_row(p, y, 0, J, bias, dirs)
-    n1, n2, n3, nd1, nd2, nd3 = nu_carried(p, y, north)
-    contact_row(p, y, 1, n1, n2, n3, nd1, nd2, nd3, J, bias, dirs)
-    return 2
+@inline
+def accel(p, y, dy, ws, variant):
+    """Closed form of the accelerations (:func:`.rhs_contact` with the row along ``nu``)."""
+    n1, n2, n3, nd1, nd2, nd3 = nu_of(p, y, variant)
+    return rhs_contact(p, y, dy, ws, True, n1, n2, n3, nd1, nd2, nd3)
+
+
+@inline
+def project_velocity(p, y, variant):
+    """Closed form of the velocity projection (:func:`.project_contact` with the row along
+    ``nu``)."""
+    n1, n2, n3, _, _, _ = nu_of(p, y, variant)
+    project_contact(p, y, True, n1, n2, n3)
+
+
+@inline
+def direction_rate(p, y, variant):
+    """``psi_nu'``: :func:`psi_nu_rate` in a pole case, 0 otherwise (``psi_nu`` then follows the
+    axis azimuth, :func:`sync_direction`)."""
+    if variant == GEOMETRIC:
+        return 0.0
+    return psi_nu_rate(p, y, variant == NORTH)
+
+
+@inline
+def sync_direction(y, variant):
+    """Re-synchronise ``psi_nu`` with the axis azimuth after a step: modulo ``2 pi`` with the
+    geometric ``nu`` (where the azimuth is defined); in a pole case modulo ``pi`` (keeping the
+    side of the pole), only away from the pole (``s > RESYNC_S``) or where the axis moves across
+    its meridian (module docstring)."""
+    if variant == GEOMETRIC:
+        sync_geometric(y, variant)
+        return
+    s = math.sqrt(y[8] * y[8] + y[11] * y[11])
+    if s <= RESYNC_S:
+        # Near the pole only where the axis moves across its meridian rather than towards the
+        # pole (RESYNC_ANGLE): there the geometric direction is well defined although s is
+        # small (a sleeping top's precession), while along a passage it would carry the
+        # numerical miss distance of the pole.
+        if s <= RESYNC_S_MIN:
+            return
+        w1, w2 = y[3], y[4]
+        da = y[6] * w2 - y[7] * w1  # alpha3' (alpha' = alpha x w): the tilt's rate
+        db = y[9] * w2 - y[10] * w1  # beta3'
+        across = abs(y[8] * db - y[11] * da)
+        if across <= RESYNC_ANGLE * s * math.sqrt(da * da + db * db):
+            return
+    sync_azimuth(y, math.pi)
 
 
 def pole_case(M3: float, C1: float, scale: float = 0.0) -> str | None:
@@ -186,23 +231,23 @@ def pole_case(M3: float, C1: float, scale: float = 0.0) -> str | None:
     return None
 
 
-def kernel_code(body, y: np.ndarray) -> int:
-    """Kernel code for a motion from state ``y``: :data:`SOUTH_CODE` / :data:`NORTH_CODE` on the
-    pole level sets ``C1 = +-M3`` of a symmetric body (within :data:`POLE_CASE_TOLERANCE`), else
-    :data:`CODE`. A vertical axis is always on a pole level (``C1 = +-M3`` there, see the module
-    docstring); no spin (``M3 = C1 = 0`` to round-off of ``|I w|``) takes the south variant, whose
-    direction then does not turn."""
+def select_variant(body, y: np.ndarray) -> str | None:
+    """The variant for a motion from state ``y``: ``"south"`` / ``"north"`` on the pole level
+    sets ``C1 = +-M3`` of a symmetric body (within :data:`POLE_CASE_TOLERANCE`), else ``None``
+    (the geometric ``nu``). A vertical axis is always on a pole level (``C1 = +-M3`` there, see
+    the module docstring); no spin (``M3 = C1 = 0`` to round-off of ``|I w|``) takes the south
+    variant, whose direction then does not turn."""
     if not body.symmetric:
-        return CODE
+        return None
     Iw = body.inertia * np.asarray(y[3:6], dtype=float)
     M3 = body.I3 * y[5]
     C1 = float(np.dot(Iw, y[12:15]))
     pole = pole_case(M3, C1, float(np.linalg.norm(Iw)))
     if pole == "north":
-        return NORTH_CODE
+        return "north"
     if pole is not None:  # "south", or "both" (no spin: the carried direction does not turn)
-        return SOUTH_CODE
-    return CODE
+        return "south"
+    return None
 
 
 def tau_nu(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -252,19 +297,29 @@ def _velocity(body, gamma, omega, alpha, beta, free):
     return -wxr + slip * tau
 
 
+def _symbolic_directions(sp, gamma):
+    return [gamma, sp.Matrix([0, 0, 1]) - gamma[2] * gamma]
+
+
+def _symbolic_velocity(gamma, tau, wxr, free):
+    return -wxr + free[0] * tau  # contact velocity along tau only
+
+
 MODEL = ContactModel(
     name="meridian",
-    code=CODE,
     description="contact kept, no slip along the horizontal projection of the axis (the paper)",
     constraints=("contact (vp, gamma) = 0", "no slip along the axis projection (vp, nu) = 0"),
     free_velocity={"v_tau": 1},
     integrals_symmetric=("energy", "lagrange", "jellett", "area", "F6"),
     integrals_general=("energy", "area"),
     velocity=_velocity,
+    symbolic_directions=_symbolic_directions,
+    symbolic_velocity=_symbolic_velocity,
     singular=_singular,
     vertical_tolerance=POLE_TOLERANCE,
     vertical_direction=vertical_direction,
-    select_code=kernel_code,
+    variants=VARIANTS,
+    select_variant=select_variant,
     has_reduction=True,
     colour="#1f77b4",
 )

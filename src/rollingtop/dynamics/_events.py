@@ -3,14 +3,14 @@
 ``W_TAU``: ``s * w_tau = (w, e3 x gamma) = gamma1 w2 - gamma2 w1``, zero exactly when
 ``w_tau = 0`` (for ``s > 0``): the turning points of ``gamma3`` (paper eq. 3.3,
 ``gamma3' = s w_tau``). In the meridian model's pole cases ``s`` vanishes at a pole passage
-while ``w_tau`` does not, so there the event function is ``w_tau = (w, nu x gamma)`` with the
-carried direction ``nu`` (continuous through the pole).
+while ``w_tau`` does not, so under a kernel that carries its direction the event function is
+``w_tau = (w, nu x gamma)`` with the carried direction ``nu`` (continuous through the pole).
 """
 
 import math
 
 from rollingtop._jit import kernel
-from rollingtop.contact import meridian
+from rollingtop.contact import _dispatch
 
 NONE = 0
 W_TAU = 1
@@ -23,7 +23,7 @@ EVENTS = {"w_tau": W_TAU}
 def event_value(code, model_code, y):
     """Value of event function ``code`` at state ``y`` under kernel ``model_code``."""
     if code == W_TAU:
-        if model_code == meridian.SOUTH_CODE or model_code == meridian.NORTH_CODE:
+        if _dispatch.carries_direction(model_code):
             c, s = math.cos(y[17]), math.sin(y[17])
             n1 = c * y[6] + s * y[9]
             n2 = c * y[7] + s * y[10]

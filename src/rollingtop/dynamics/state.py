@@ -75,7 +75,7 @@ def _horizontal(alpha: np.ndarray, gamma: np.ndarray) -> np.ndarray:
 
 def _start_code(body: SphericalTop, model: ContactModel, y: np.ndarray) -> int:
     """Kernel code used to project a new state: the model's own, except at a vertical axis, where
-    a model's variant (:meth:`ContactModel.kernel_code`: the meridian model's pole variant, which
+    a model's variant (:meth:`ContactModel.kernel`: the meridian model's pole variant, which
     carries ``nu``) is the only one defined. Away from the vertical the model's own code keeps the
     constructed states exactly as they were before vertical starts existed."""
     if y[12] == 0.0 and y[13] == 0.0:
@@ -142,7 +142,8 @@ def initial_state(
     (:func:`rollingtop.contact.meridian.vertical_direction`) the direction in which the axis
     leaves the vertical, ``(w x e3)/|w x e3|``, or ``nu = alpha`` (``psi_nu = 0``) when
     ``w1 = w2 = 0``; the state lies on a pole level ``C1 = +-M3`` and
-    :func:`rollingtop.contact.meridian.kernel_code` picks the pole variant that carries ``nu``.
+    :func:`rollingtop.contact.meridian.select_variant` picks the pole variant that carries
+    ``nu``.
     Other models: ``psi_nu = 0`` (unused).
     """
     model = get_model(model)

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rollingtop._errors import IntegrationError
+from rollingtop.contact import KERNELS
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._events import EVENTS
 from rollingtop.dynamics._layout import N_STATE
@@ -88,7 +89,7 @@ def compile_kernels() -> float:
     y = np.zeros(N_STATE)
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
-    for code in (0, 1, 2, 3, 4):
+    for code in (k.code for k in KERNELS):
         yy = y.copy()
         _kernel.project(code, p, yy, _kernel.new_workspace())
         _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
@@ -201,8 +202,8 @@ def integrate(
     Parameters
     ----------
     code : int
-        Kernel code: ``ContactModel.code``, or a pole variant of the meridian model
-        (:func:`rollingtop.contact.meridian.kernel_code`).
+        Kernel code (:class:`rollingtop.contact.Kernel`): ``model.kernel(body, y0).code``, the
+        model's own or the variant it picks for this state.
     params : ndarray, shape (7,)
         ``SphericalTop.params``.
     y0 : ndarray, shape (18,)

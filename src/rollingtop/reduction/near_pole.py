@@ -114,7 +114,7 @@ def friction_needed(level: LevelSet, h: float, orbit: Orbit, samples: int = 400)
 
 def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400):
     """:func:`friction_needed` on the canonical level and orbit (``canonical_orbit``)."""
-    from rollingtop.contact.meridian import CODE
+    from rollingtop.contact.meridian import MODEL
     from rollingtop.dynamics import _kernel
     from rollingtop.reduction.variables import state_from_level
 
@@ -135,7 +135,7 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400):
             states.append(state_from_level(lv, hh, 0.0, theta=float(theta), branch=branch))
     Y = np.ascontiguousarray(states)
     out = np.zeros((Y.shape[0], 8))
-    _kernel.diagnostics(CODE, lv.body.params, Y, out)
+    _kernel.diagnostics(MODEL.code, lv.body.params, Y, out)
     N, F = out[:, 0], out[:, 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(N > 0, np.abs(F) / N, np.inf)

@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import random
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from fractions import Fraction
 
 import sympy as sp
 
+from rollingtop.contact import MODELS, get_model
 from rollingtop.symbolic.equations import SYMBOLS, derive
 
 __all__ = ["Claim", "ClaimResult", "claims_for", "decide", "verify"]
@@ -87,14 +89,7 @@ def _manifold(model: str) -> dict:
     tau = e3.cross(gamma) / sq  # unit, rational
     r = -S.R * gamma - sp.Matrix([0, 0, S.a3])
     wxr = S.w.cross(r)
-    if model == "meridian":
-        v = -wxr + free[0] * tau  # contact velocity along tau only
-    elif model == "smooth":
-        v = -wxr + free[0] * tau + free[1] * gamma.cross(tau)  # contact velocity horizontal
-    elif model == "rough":
-        v = -wxr
-    else:
-        raise ValueError(model)
+    v = get_model(model).symbolic_velocity(gamma, tau, wxr, free)
     nu = (e3 - gamma[2] * gamma) / sq  # unit, rational
     alpha = ((1 - j**2) * tau + 2 * j * nu) / (1 + j**2)  # generic horizontal unit vector
     beta = gamma.cross(alpha)
@@ -209,18 +204,15 @@ def claims_for(model: str) -> list[Claim]:
     """The claims checked for ``model``."""
     F = _integrals()
     out = []
-    names = {
-        "meridian": ("energy", "lagrange", "jellett", "area", "F6"),
-        "smooth": ("energy", "lagrange", "jellett", "area", "momentum_x", "momentum_y"),
-        "rough": ("energy", "jellett", "routh^2"),
-    }[model]
+    # the integrals the model claims (the routh integral is proved through its square)
+    names = [n + "^2" if n == "routh" else n for n in get_model(model).integrals_symmetric]
     for name in names:
         label = "routh integral conserved (its square)" if name == "routh^2" else (
             f"{name} integral conserved")  # fmt: skip
         out.append(Claim(label, model, F[name]))
     out.append(Claim("energy integral conserved, general body (I1 != I2)", model, F["energy"],
                      symmetric=False))  # fmt: skip
-    if model == "meridian":
+    if get_model(model).has_reduction:
         out.append(
             Claim(
                 "identity jellett + a3 lagrange + R area = 0",
@@ -251,13 +243,14 @@ def check(claim: Claim, seed: int = 1) -> ClaimResult:
                        time.perf_counter() - start)  # fmt: skip
 
 
-def verify(models=("meridian", "smooth", "rough")) -> list[ClaimResult]:
-    """Check every claim of ``models`` (and the invariant measure with the meridian model)."""
+def verify(models: Sequence[str] = tuple(MODELS)) -> list[ClaimResult]:
+    """Check every claim of ``models`` (and the invariant measure of the reduced system with a
+    model that has a reduction)."""
     results = []
     for model in models:
         for claim in claims_for(model):
             results.append(check(claim))
-        if model == "meridian":
+        if get_model(model).has_reduction:
             start = time.perf_counter()
             holds, method = invariant_measure_claim()
             results.append(ClaimResult("invariant measure rho(gamma3) of the reduced system",

@@ -29,6 +29,8 @@ from functools import cache
 
 import sympy as sp
 
+from rollingtop.contact import get_model
+
 __all__ = ["Symbols", "SYMBOLS", "derive", "Derivation"]
 
 
@@ -79,15 +81,7 @@ def constraints(model: str, S: Symbols = SYMBOLS) -> list:
     """The model's constraints ``c_k(u, gamma) = (vp, d_k)``, linear in ``u``."""
     r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
     vp = S.v + _cross(S.w, r)
-    e3 = sp.Matrix([0, 0, 1])
-    if model == "smooth":
-        dirs = [S.gamma]
-    elif model == "meridian":
-        dirs = [S.gamma, e3 - S.gamma[2] * S.gamma]
-    elif model == "rough":
-        dirs = [sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0]), sp.Matrix([0, 0, 1])]
-    else:
-        raise ValueError(f"no symbolic constraints for model {model!r}")
+    dirs = get_model(model).symbolic_directions(sp, S.gamma)
     return [sp.expand(vp.dot(d)) for d in dirs]
 
 

@@ -1,0 +1,22 @@
+"""What every result with an xarray form shares: writing it as NetCDF-4, atomically."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
+
+
+class NetCDFOutput:
+    """Mixin: :meth:`to_netcdf` from the class's ``to_xarray()``."""
+
+    def to_xarray(self) -> Any:  # pragma: no cover - every subclass defines it
+        raise NotImplementedError
+
+    def to_netcdf(self, path: str | os.PathLike[str]) -> Path:
+        """Write :meth:`to_xarray` as NetCDF-4 (engine ``h5netcdf``), atomically: the file
+        appears complete or not at all (:func:`rollingtop.io.write_bytes_atomic`)."""
+        out = check_output_path(path, (".nc",))
+        return write_bytes_atomic(out, netcdf_bytes(self.to_xarray()))

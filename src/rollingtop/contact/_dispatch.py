@@ -1,0 +1,101 @@
+"""Compiled dispatch: kernel code -> its model's functions (GENERATED: do not edit).
+
+Written by ``python -m rollingtop.contact._codegen`` from the registry
+(:data:`rollingtop.contact.MODULES`); see that generator for why. Kernel codes:
+
+- 0: ``meridian``
+- 1: ``smooth``
+- 2: ``rough``
+- 3: ``meridian``, variant ``south``
+- 4: ``meridian``, variant ``north``
+"""
+
+from rollingtop._jit import inline, kernel
+from rollingtop.contact import _rows, meridian, rough, smooth
+
+
+@kernel
+def rows(code, p, y, J, bias, dirs):
+    """The constraint rows of kernel ``code``; returns their number (-1: unknown code)."""
+    if code == 0:
+        return meridian.rows(p, y, J, bias, dirs, 0)
+    if code == 1:
+        return smooth.rows(p, y, J, bias, dirs, 0)
+    if code == 2:
+        return rough.rows(p, y, J, bias, dirs, 0)
+    if code == 3:
+        return meridian.rows(p, y, J, bias, dirs, 1)
+    if code == 4:
+        return meridian.rows(p, y, J, bias, dirs, 2)
+    return -1
+
+
+@inline
+def accel(code, p, y, dy, ws):
+    """Closed-form accelerations of kernel ``code``; returns the number of rows, or -1 where the
+    model has no closed form (then the general path applies)."""
+    if code == 0:
+        return meridian.accel(p, y, dy, ws, 0)
+    if code == 1:
+        return smooth.accel(p, y, dy, ws, 0)
+    if code == 2:
+        return rough.accel(p, y, dy, ws, 0)
+    if code == 3:
+        return meridian.accel(p, y, dy, ws, 1)
+    if code == 4:
+        return meridian.accel(p, y, dy, ws, 2)
+    return -1
+
+
+@inline
+def project_velocity(code, p, y):
+    """Closed-form velocity projection of kernel ``code``; ``False`` where the model has none."""
+    if code == 0:
+        meridian.project_velocity(p, y, 0)
+        return True
+    if code == 1:
+        smooth.project_velocity(p, y, 0)
+        return True
+    if code == 2:
+        rough.project_velocity(p, y, 0)
+        return True
+    if code == 3:
+        meridian.project_velocity(p, y, 1)
+        return True
+    if code == 4:
+        meridian.project_velocity(p, y, 2)
+        return True
+    return False
+
+
+@inline
+def direction_rate(code, p, y):
+    """``psi_nu'`` under kernel ``code`` (0 unless it carries a constraint direction)."""
+    if code == 0:
+        return meridian.direction_rate(p, y, 0)
+    if code == 3:
+        return meridian.direction_rate(p, y, 1)
+    if code == 4:
+        return meridian.direction_rate(p, y, 2)
+    return _rows.direction_rate(p, y, 0)
+
+
+@inline
+def sync_direction(code, y):
+    """Re-synchronise ``psi_nu`` with the axis azimuth after a step, as kernel ``code`` does."""
+    if code == 0:
+        meridian.sync_direction(y, 0)
+        return
+    if code == 3:
+        meridian.sync_direction(y, 1)
+        return
+    if code == 4:
+        meridian.sync_direction(y, 2)
+        return
+    _rows.sync_direction(y, 0)
+
+
+@inline
+def carries_direction(code):
+    """Whether kernel ``code`` carries its constraint direction in ``psi_nu``."""
+    return code == 3 or code == 4

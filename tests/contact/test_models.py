@@ -1,0 +1,165 @@
+"""The model battery: every registered contact model (and every kernel variant) must pass it.
+
+A new model gets these tests by being registered (:data:`rollingtop.contact.MODULES`). Each test
+holds the model to something independent of the code under test: the general constraint-row
+path against the closed forms, a conservation law, the constraint residuals, time reversibility,
+the registry's generated dispatch against its generator.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from rollingtop import InitialStateError, SphericalTop, initial_state
+from rollingtop.contact import KERNELS, MODELS, _codegen
+from rollingtop.dynamics import _kernel
+from rollingtop.dynamics.integrals import evaluate
+from rollingtop.dynamics.state import constraint_residuals
+from rollingtop.integrate.driver import integrate
+
+#: A symmetric body with the centre of mass below the centre, and a general (I1 != I2) one.
+SYMMETRIC = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5)
+GENERAL = SphericalTop(R=1.0, m=1.2, g=1.0, a3=-0.15, I1=0.3, I2=0.4, I3=0.5)
+#: Relative drift of an integral over the runs below (rtol = 1e-11, t = 5).
+DRIFT = 1e-8
+#: Constraint residual |J u| after every accepted (projected) step, relative to |u|.
+RESIDUAL = 1e-12
+#: Closed forms against the general row path (the same equations, other round-off).
+CLOSED_FORM = 1e-11
+
+model_names = pytest.mark.parametrize("name", list(MODELS))
+
+
+def _free(model, scale=0.2):
+    """A non-zero value for each free velocity component of ``model``."""
+    return {k: scale if n == 1 else [scale, -scale / 2][:n] for k, n in model.free_velocity.items()}
+
+
+#: The axis tilted by 0.6 rad.
+TILTED = (0.0, math.sin(0.6), math.cos(0.6))
+
+
+def _state(body, model, gamma=TILTED, omega=(0.7, -0.3, 2.0)):
+    return initial_state(body, model, gamma=gamma, omega=omega, free=_free(model))
+
+
+def _run(body, code, y0, t_end, n=201):
+    return integrate(code, body.params, y0, np.linspace(0.0, t_end, n), rtol=1e-11, atol=1e-13)
+
+
+def _max_drift(values):
+    v = np.asarray(values)
+    return float(np.max(np.abs(v - v[0])) / max(1.0, abs(v[0])))
+
+
+def test_the_dispatch_is_generated_from_the_registry():
+    """Adding a model is one module plus one registry line, then the generator: the committed
+    dispatch must be what the generator writes from the registry."""
+    assert _codegen.TARGET.read_text() == _codegen.source(), (
+        "src/rollingtop/contact/_dispatch.py is stale: run python -m rollingtop.contact._codegen"
+    )
+
+
+def test_kernel_codes_are_the_registry_order():
+    assert [k.code for k in KERNELS] == list(range(len(KERNELS)))
+    for model in MODELS.values():
+        assert model.kernels[0].variant is None and model.kernels[0].code == model.code
+        assert [k.variant for k in model.kernels[1:]] == list(model.variants)
+
+
+@model_names
+@pytest.mark.parametrize("body", [SYMMETRIC, GENERAL], ids=["symmetric", "general"])
+def test_constraints_and_claimed_integrals_are_preserved(name, body):
+    model = MODELS[name]
+    y0 = _state(body, model)
+    kernel = model.kernel(body, y0)
+    res = _run(body, kernel.code, y0, 5.0)
+    scale = np.linalg.norm(res.y[:, :6], axis=1)
+    residuals = np.array([np.max(np.abs(constraint_residuals(body, model, y))) for y in res.y])
+    assert np.all(residuals <= RESIDUAL * scale)
+    names = model.integrals(body.symmetric)
+    assert "energy" in names
+    values = evaluate(body, res.y, names, pole=kernel.variant)
+    for integral in names:
+        assert _max_drift(values[integral]) < DRIFT, integral
+
+
+@pytest.mark.parametrize("kernel", KERNELS, ids=[f"{k.model}-{k.variant}" for k in KERNELS])
+def test_closed_form_matches_the_general_rows(kernel, rng):
+    """``rhs`` (the model's closed form, where it has one) against ``rhs_rows`` (its constraint
+    rows and a Cholesky solve), and the same for the velocity projection."""
+    model = MODELS[kernel.model]
+    for _ in range(20):
+        gamma = rng.normal(size=3)
+        y = _state(SYMMETRIC, model, gamma=gamma / np.linalg.norm(gamma), omega=rng.normal(size=3))
+        y[17] = rng.uniform(-math.pi, math.pi)  # a carried direction anywhere
+        p, ws = SYMMETRIC.params, _kernel.new_workspace()
+        fast, rows = np.zeros(18), np.zeros(18)
+        assert _kernel.rhs(kernel.code, p, y, fast, ws) == _kernel.rhs_rows(
+            kernel.code, p, y, rows, ws
+        )
+        assert np.allclose(fast, rows, rtol=CLOSED_FORM, atol=CLOSED_FORM)
+        # velocity projection of a state pushed off the constraints
+        off = y.copy()
+        off[:6] += rng.normal(size=6)
+        a, b = off.copy(), off.copy()
+        _kernel.project(kernel.code, p, a, ws)
+        b[6:15] = a[6:15]  # the same frame and psi_nu as the full projection produced
+        b[17] = a[17]
+        _kernel.project_velocity_rows(kernel.code, p, b, ws)
+        assert np.allclose(a, b, rtol=CLOSED_FORM, atol=CLOSED_FORM)
+
+
+@pytest.mark.parametrize("kernel", KERNELS, ids=[f"{k.model}-{k.variant}" for k in KERNELS])
+def test_projection_is_idempotent(kernel, rng):
+    model = MODELS[kernel.model]
+    p, ws = SYMMETRIC.params, _kernel.new_workspace()
+    for _ in range(20):
+        y = _state(SYMMETRIC, model, omega=rng.normal(size=3))
+        y[:6] += 1e-3 * rng.normal(size=6)
+        y[6:15] += 1e-9 * rng.normal(size=9)
+        _kernel.project(kernel.code, p, y, ws)
+        again = y.copy()
+        _kernel.project(kernel.code, p, again, ws)
+        assert np.allclose(again, y, rtol=1e-14, atol=1e-14)
+        assert np.max(np.abs(constraint_residuals(SYMMETRIC, model, y))) < 1e-14 * np.linalg.norm(
+            y[:6]
+        )
+
+
+@model_names
+def test_pole_passage(name):
+    """Through the vertical and on: a motion leaving the vertical, reversed in time (the
+    equations are reversible: ``u -> -u`` maps solutions to solutions), passes the pole at
+    ``t = 0.3`` and goes on with its constraints and integrals intact."""
+    model = MODELS[name]
+    y0 = initial_state(SYMMETRIC, model, gamma=(0.0, 0.0, 1.0), omega=(1.0, 0.5, 3.0),
+                       free=_free(model))  # fmt: skip
+    kernel = model.kernel(SYMMETRIC, y0)
+    out = _run(SYMMETRIC, kernel.code, y0, 0.3, n=2).y[-1]
+    back = out.copy()
+    back[:6] *= -1.0
+    res = _run(SYMMETRIC, kernel.code, back, 0.6, n=601)
+    s = np.hypot(res.y[:, 12], res.y[:, 13])
+    k = int(np.argmin(s))
+    assert abs(res.t[k] - 0.3) < 2e-3 and s[k] < 2e-3  # it passed through the pole
+    assert 0.05 < s[-1]  # and left it again
+    back_at_start = res.y[300]
+    assert np.allclose(back_at_start[:6], -y0[:6], atol=1e-8)  # reversed motion retraced
+    values = evaluate(SYMMETRIC, res.y, model.integrals(True), pole=kernel.variant)
+    for integral, v in values.items():
+        assert _max_drift(v) < DRIFT, integral
+
+
+@model_names
+def test_bad_free_components_are_refused_with_their_name(name):
+    model = MODELS[name]
+    with pytest.raises(InitialStateError, match="v_nonsense"):
+        initial_state(SYMMETRIC, model, gamma=(0.0, 0.6, 0.8), omega=(0.0, 0.0, 1.0),
+                      free={"v_nonsense": 1.0})  # fmt: skip
+    for key, n in model.free_velocity.items():
+        wrong = [0.1] * (n + 1)
+        with pytest.raises(InitialStateError, match=key):
+            initial_state(SYMMETRIC, model, gamma=(0.0, 0.6, 0.8), omega=(0.0, 0.0, 1.0),
+                          free={key: wrong})  # fmt: skip
