@@ -100,7 +100,10 @@ def test_compare_command_runs_every_model_from_the_scenarios_state(capsys, tmp_p
         assert np.max(np.abs(change[:, 1])) < ENERGY_DRIFT
 
 
-@pytest.mark.parametrize(("suffix", "fps", "duration"), [(".gif", 8, 1.5), (".mp4", 10, 1.2)])
+@pytest.mark.parametrize(
+    ("suffix", "fps", "duration"),
+    [(".gif", 8, 1.5), pytest.param(".mp4", 10, 1.2, marks=pytest.mark.slow)],
+)
 def test_animation_frame_count(capsys, tmp_path, suffix, fps, duration):
     out = tmp_path / f"roll{suffix}"
     code, stdout, err = run_cli(capsys, "animate", str(EXAMPLES / "paper.toml"), "-o", str(out),

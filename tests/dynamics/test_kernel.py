@@ -104,7 +104,7 @@ def residual_rate(model, p, y, dy, h=1e-6):
 
 
 @pytest.mark.parametrize("model", MODELS)
-@pytest.mark.parametrize("I2", [None, 0.4])
+@pytest.mark.parametrize("I2", [None, pytest.param(0.4, marks=pytest.mark.slow)])
 def test_final_state_matches_solve_ivp(model, I2):
     """Package (compiled DOP853 + projection) vs solve_ivp(DOP853) on the NumPy reference."""
     body = SphericalTop(**PAPER_BODY, I2=I2)

@@ -80,6 +80,7 @@ def test_a_state_started_at_a_centre_stays_there(fig5):
     np.testing.assert_allclose(np.hypot(X - cx / 2, Y - cy / 2), radius, rtol=1e-4)
 
 
+@pytest.mark.slow
 def test_small_oscillation_period_is_the_limit_of_orbit_periods(fig5):
     for m in steady_motions(fig5):
         if m.type != "center":
