@@ -6,9 +6,9 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 from PIL import Image, ImageSequence
 
-import rollingtop.plot
 from rollingtop import SphericalTop
 from rollingtop.reduction import LevelSet, orbits
 
@@ -27,13 +27,13 @@ ENERGY_DRIFT = 1e-9
 def saved(monkeypatch):
     """The figures the command line saves, in order (they are saved as well)."""
     figures = []
-    save = rollingtop.plot.save_figure
+    savefig = Figure.savefig
 
-    def record(fig, path, **kwargs):
+    def record(fig, *args, **kwargs):
         figures.append(fig)
-        return save(fig, path, **kwargs)
+        return savefig(fig, *args, **kwargs)
 
-    monkeypatch.setattr(rollingtop.plot, "save_figure", record)
+    monkeypatch.setattr(Figure, "savefig", record)
     return figures
 
 

@@ -5,7 +5,7 @@ import matplotlib.colors as mcolors
 import numpy as np
 import pytest
 
-from rollingtop import SphericalTop, simulate, simulate_models
+from rollingtop import ContactLostWarning, SphericalTop, simulate, simulate_models
 from rollingtop.absolute import period_map
 from rollingtop.contact import get_model
 from rollingtop.plot.paths import compare_figure, path_figure, timeseries_figure
@@ -119,7 +119,7 @@ def test_timeseries_figure_marks_the_loss_of_contact():
     body = SphericalTop(R=1, m=1, g=1, a3=0.5, I1=0.3, I3=0.5)
     sc = Scenario(body, "meridian", InitialConditions(gamma=(0.0, 0.6, 0.8), omega=(1.4, 0, 0.3)),
                   IntegrationOptions(t_end=4, samples=201))  # fmt: skip
-    with pytest.warns(UserWarning, match="normal reaction turns negative"):
+    with pytest.warns(ContactLostWarning, match="normal reaction turns negative"):
         traj = simulate(sc)
     ax3 = timeseries_figure(traj).axes[2]
     N = xy(line(ax3, "normal force N"))
