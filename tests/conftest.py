@@ -2,6 +2,7 @@
 
 from pathlib import Path
 
+import mpmath
 import numpy as np
 import pytest
 
@@ -17,6 +18,31 @@ PAPER_BODY = dict(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5)
 GAMMA0 = (0.0, 0.6, 0.8)
 OMEGA0 = (0.7, -0.3, 2.0)
 FREE = {"meridian": {"v_tau": 0.25}, "smooth": {"v_horizontal": (0.3, -0.2)}, "rough": {}}
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--slow", action="store_true", default=False, help="run the slow tests too")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Tests marked ``slow`` run only with ``--slow``; the default run stays short."""
+    if config.getoption("--slow"):
+        return
+    skip = pytest.mark.skip(reason="slow test: pass --slow to run it")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture(autouse=True)
+def _mpmath_precision_untouched():
+    """A test that needs more digits takes a local context (``mpmath.workdps``): the global
+    precision is shared by every later test, so a test that changes it fails here."""
+    prec = mpmath.mp.prec
+    yield
+    changed = mpmath.mp.prec
+    mpmath.mp.prec = prec
+    assert changed == prec, f"the test left mpmath.mp.prec = {changed} (was {prec})"
 
 
 @pytest.fixture

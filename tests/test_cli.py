@@ -241,3 +241,72 @@ def test_threads_above_the_cores_are_reduced_with_a_note(capsys):
         f"rollingtop: note: --threads {cores + 7} is more than the {cores} cores available; "
         f"used {cores}\n"
     )
+
+
+class RecordingBar:
+    """Stands in for the rich progress bar that compare shows on a terminal."""
+
+    def __init__(self, label):
+        self.label, self.tasks, self.updates = label, [], []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return None
+
+    def add_task(self, description, total):
+        self.tasks.append((description, total))
+        return len(self.tasks) - 1
+
+    def update(self, task, completed):
+        self.updates.append((task, completed))
+
+
+def test_compare_progress_bar_follows_each_model(tmp_path, capsys, monkeypatch):
+    """On a terminal, compare shows one bar per model, each rising from 0 to t_end (it used to
+    show one bar of t_end that never moved: the progress callback was dropped)."""
+    from rollingtop.cli import _output
+    from rollingtop.contact import MODELS
+
+    bars = []
+    monkeypatch.setattr(_output, "progress_bar", lambda label: bars.append(RecordingBar(label))
+                        or bars[-1])  # fmt: skip
+    code, out, err = run_cli(capsys, "compare", str(EXAMPLES / "paper.toml"), "-o",
+                             str(tmp_path / "c.png"), "--t-end", "0.5")  # fmt: skip
+    assert code == 0, err
+    (bar,) = bars
+    assert "{task.description}" in bar.label
+    assert bar.tasks == [(name, 0.5) for name in MODELS]
+    for task in range(len(MODELS)):
+        done = [t for k, t in bar.updates if k == task]
+        assert done and done == sorted(done) and done[-1] == 0.5
+
+
+def test_bare_command_prints_help(capsys):
+    code, out, err = run_cli(capsys)
+    assert code == 0 and err == "" and out.startswith("Usage: rollingtop [OPTIONS] COMMAND")
+    assert "warmup" in out and "simulate" in out
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--frobnicate"], "No such option '--frobnicate'"),
+        (["frob"], "No such command 'frob'"),
+        (["simulate"], "Missing argument 'SCENARIO'"),
+        (["verify", "--model", "ice"], "unknown contact model 'ice' (known: meridian, smooth"),
+    ],
+)
+def test_usage_errors_are_one_line(capsys, args, message):
+    code, out, err = run_cli(capsys, *args)
+    assert code == 2 and out == ""
+    assert err.splitlines() == [f"rollingtop: error: {err.split('error: ', 1)[1].rstrip()}"]
+    assert message in err
+
+
+def test_model_choices_come_from_the_registry(capsys):
+    from rollingtop.contact import MODELS
+
+    code, out, _ = run_cli(capsys, "simulate", "--help")
+    assert code == 0 and f"[{'|'.join(MODELS)}]" in out

@@ -359,6 +359,7 @@ def scenario_bytes(draw) -> bytes:
 # ---- scenarios through simulate, equilibria, orbits -------------------------------------------
 
 
+@pytest.mark.slow
 @fuzz(120)
 @given(data=scenario_bytes(), output=st.sampled_from([None, "out.nc", "out.csv"]))
 def test_fuzz_simulate_scenarios(data, output):
@@ -604,6 +605,7 @@ def csv_tables(draw) -> bytes:
     return data
 
 
+@pytest.mark.slow
 @fuzz(60)
 @given(example=st.sampled_from(["paper", "smooth", "rough", "pole"]), table=csv_tables())
 def test_fuzz_ensemble_tables(example, table):
@@ -621,6 +623,7 @@ def test_fuzz_ensemble_tables(example, table):
             check_ensemble_file(out_file, summary)
 
 
+@pytest.mark.slow
 @fuzz(12)
 @given(
     command=st.sampled_from(["plot", "path", "compare", "portrait", "animate"]),
@@ -657,11 +660,12 @@ def test_fuzz_figure_commands(command, value, data):
     ("content", "args", "message"),
     [
         (b"\xef\xbb\xbf[body]\n", [], "byte-order mark"),
-        (None, [], "not a regular file (it is a FIFO)"),
-        (
+        pytest.param(None, [], "not a regular file (it is a FIFO)", marks=pytest.mark.slow),
+        pytest.param(
             (EXAMPLES / "paper.toml").read_bytes(),
             ["--samples", "1000000000000"],
             "needs about 931.3 TiB of memory",
+            marks=pytest.mark.slow,
         ),  # fmt: skip
     ],
     ids=["bom", "fifo", "samples"],

@@ -22,7 +22,10 @@ from rollingtop.integrate.ensemble import compile_ensemble
 
 from .conftest import EXAMPLES
 
-pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+pytestmark = [
+    pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc"),
+    pytest.mark.slow,  # real processes run until signalled: 4 to 6 s each
+]
 
 #: Seconds from the signal to the exit of the process (the compiled loops return to Python
 #: every few tens of milliseconds; the rest is the interpreter's shutdown).

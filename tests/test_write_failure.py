@@ -129,6 +129,7 @@ SUBPROCESS_CASES = [
 
 @pytest.mark.parametrize(("args", "name", "limit"), SUBPROCESS_CASES,
                          ids=[f"{a[0]}-{n}" for a, n, _ in SUBPROCESS_CASES])  # fmt: skip
+@pytest.mark.slow
 def test_file_size_limit_in_a_real_process(tmp_path, args, name, limit):
     target = tmp_path / name
     (tmp_path / "keep.txt").write_text("unrelated")
@@ -145,6 +146,7 @@ def test_file_size_limit_in_a_real_process(tmp_path, args, name, limit):
     assert listing(tmp_path) == ["keep.txt"]
 
 
+@pytest.mark.slow
 def test_encoder_killed_by_the_file_size_limit(tmp_path):
     """ffmpeg runs with the default SIGXFSZ action (subprocess restores it) and dies of it."""
     target = tmp_path / "roll.mp4"

@@ -1,15 +1,23 @@
-"""Scenario files (TOML): parsing and validation.
+"""Scenario files (TOML): parsing and validation, nothing else.
 
 A scenario names a body, a contact model, initial conditions and integration options::
 
     [body]        R, m, g, a3, I1, I3, optional I2
-    [contact]     model = "meridian" | "smooth" | "rough"        (default "meridian")
+    [contact]     model = the name of a registered contact model (rollingtop.contact.MODELS;
+                  default DEFAULT_MODEL)
     [initial]     gamma, omega, optional alpha, position, and the model's free velocity
-                  components (meridian: v_tau; smooth: v_horizontal = [vx, vy]) or a full v
+                  components (ContactModel.free_velocity) or a full v
     [integration] t_end, rtol, atol, samples, max_steps            (defaults: DEFAULTS)
     [level]       M3, C1, C2 and optionally h, gamma3, branch, phi, psi: a level set of the
-                  meridian model's integrals (paper Sec. 3). With h and no [initial], the
-                  initial state is built on that level (``reduction.state_from_level``)
+                  integrals of a model with a reduction (ContactModel.has_reduction; paper
+                  Sec. 3). With h and no [initial], the initial state is built on that level
+                  (rollingtop.reduction.start.start_on_level)
+
+:func:`load_scenario` reads a file into a :class:`Scenario` of typed objects: the
+:class:`~rollingtop.SphericalTop`, the :class:`~rollingtop.contact.ContactModel`, the
+:class:`~rollingtop.dynamics.start.InitialConditions` and their state, the
+:class:`~rollingtop.integrate.options.IntegrationOptions`. The numerics live where their words
+do (:mod:`rollingtop.dynamics`, :mod:`rollingtop.reduction`); this module only calls them.
 
 Unknown tables and keys are errors, so that a typo never silently falls back to a default.
 Scenario files are read only when they are regular files of at most :data:`MAX_SCENARIO_BYTES`
@@ -20,34 +28,59 @@ cut to 80 characters in messages. ``samples`` is bounded so that a run's samples
 
 from __future__ import annotations
 
-import math
 import os
-import re
-import sys
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
+from rollingtop._checks import (
+    MEMORY_CAP_BYTES,
+    check_memory,
+    memory_limit,
+    number,
+    short_name,
+    short_repr,
+    vector,
+)
 from rollingtop._errors import ContactModelError, RollingTopError, ScenarioError
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
-from rollingtop.dynamics.state import initial_state
-from rollingtop.io import format_bytes, read_input_text
+from rollingtop.dynamics.start import InitialConditions
+from rollingtop.integrate.options import (
+    BYTES_PER_SAMPLE,
+    DEFAULTS,
+    MAX_STEPS_LIMIT,
+    IntegrationOptions,
+)
+from rollingtop.io import read_input_text
+from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.start import level_of_state, reduced_energy, start_on_level
 
 __all__ = [
+    "BYTES_PER_SAMPLE",
     "DEFAULTS",
+    "MAX_SCENARIO_BYTES",
+    "MAX_STEPS_LIMIT",
+    "MEMORY_CAP_BYTES",
+    "DEFAULT_MODEL",
     "InitialConditions",
     "IntegrationOptions",
     "LevelSpec",
     "Scenario",
+    "check_memory",
+    "check_model_name",
     "load_scenario",
+    "memory_limit",
+    "short_name",
+    "short_repr",
 ]
 
-#: Integration defaults. ``atol`` defaults to ``rtol / 100`` when not given.
-DEFAULTS = {"t_end": 10.0, "rtol": 1e-10, "atol": None, "samples": 1001, "max_steps": 10**8}
+#: The contact model of a scenario without a ``[contact]`` table (the paper's).
 DEFAULT_MODEL = "meridian"
 
 _BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3", "I2")
@@ -57,94 +90,11 @@ _LEVEL_KEYS = ("M3", "C1", "C2", "h", "gamma3", "branch", "phi", "psi")
 
 #: Largest scenario file read (bytes).
 MAX_SCENARIO_BYTES = 1 << 20
-#: Largest ``max_steps`` (the integrator's own "no limit").
-MAX_STEPS_LIMIT = 2**62
-#: Rough memory of one output sample of a single run (state, diagnostics, integrals, the
-#: dataset and its serialised file), used to refuse ``samples`` that cannot fit.
-BYTES_PER_SAMPLE = 1024
-#: Cap on the memory a run may plan for, before the physical-memory bound.
-MEMORY_CAP_BYTES = 8 << 30
-
-_QUOTE_CHARS = 80
 
 
-def short_repr(value: Any, limit: int = _QUOTE_CHARS) -> str:
-    """``repr(value)`` cut to ``limit`` characters (with an ellipsis), for error messages."""
-    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:
-        try:
-            return f"<integer of {len(str(abs(value)))} digits>"
-        except ValueError:  # longer than Python converts to text
-            return f"<integer of about {int(value.bit_length() * 0.30103)} digits>"
-    if isinstance(value, str) and len(value) > limit:
-        return repr(value[: limit - 3] + "…")
-    if isinstance(value, list | tuple | dict) and len(value) > limit:
-        return f"<{type(value).__name__} of {len(value)} items>"
-    try:
-        text = repr(value)
-    except (RecursionError, ValueError):
-        return f"<{type(value).__name__}>"
-    return text if len(text) <= limit else text[: limit - 1] + "…"
-
-
-def short_name(key: str, limit: int = _QUOTE_CHARS) -> str:
-    """A TOML key for a message: bare keys as they are, others quoted; cut to ``limit``."""
-    key = str(key)
-    if not re.fullmatch(r"[A-Za-z0-9_-]+", key):
-        return short_repr(key, limit)
-    return key if len(key) <= limit else key[: limit - 1] + "…"
-
-
-def memory_limit() -> int:
-    """Bytes a run may plan to allocate: :data:`MEMORY_CAP_BYTES` (8 GiB), or half the physical
-    memory when that is less."""
-    try:
-        physical = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return MEMORY_CAP_BYTES
-    return min(MEMORY_CAP_BYTES, physical // 2) if physical > 0 else MEMORY_CAP_BYTES
-
-
-def check_memory(what: str, needed: float) -> None:
-    """Refuse (``ScenarioError``) when ``needed`` bytes exceed :func:`memory_limit`."""
-    limit = memory_limit()
-    if needed > limit:
-        raise ScenarioError(
-            f"{what} needs about {format_bytes(needed)} of memory, more than the "
-            f"{format_bytes(limit)} a run may use (the lesser of 8 GiB and half the physical "
-            "memory)"
-        )
-
-
-def _number(where: str, key: str, value: Any, *, integer: bool = False) -> float | int:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        kind = "an integer" if integer else "a number"
-        raise ScenarioError(f"{where}.{key} = {short_repr(value)} must be {kind}")
-    if integer:
-        if isinstance(value, float):
-            if not value.is_integer():
-                raise ScenarioError(f"{where}.{key} = {short_repr(value)} must be an integer")
-            value = int(value)
-        return value
-    try:
-        x = float(value)
-    except OverflowError:
-        raise ScenarioError(f"{where}.{key} = {short_repr(value)} is too large") from None
-    if not math.isfinite(x):
-        raise ScenarioError(f"{where}.{key} = {short_repr(value)} must be finite")
-    return x
-
-
-def _vector(where: str, key: str, value: Any, length: int) -> tuple[float, ...]:
-    """A list of ``length`` finite real numbers (no strings, booleans or tables in it)."""
-    if not isinstance(value, list | tuple) or len(value) != length:
-        raise ScenarioError(
-            f"{where}.{key} = {short_repr(value)} must be a list of {length} numbers"
-        )
-    return tuple(_number(where, f"{key}[{i}]", x) for i, x in enumerate(value))
-
-
-def check_model_name(where: str, name: Any) -> str:
-    """``name`` if it names a contact model, else a ``ScenarioError`` quoting it (shortened)."""
+def check_model_name(where: str, name: object) -> str:
+    """``name`` if it names a contact model, else a ``ContactModelError`` quoting it
+    (shortened) and listing the registered models."""
     if not isinstance(name, str) or name not in MODELS:
         raise ContactModelError(
             f"{where}: unknown contact model {short_repr(name)} (known: {', '.join(MODELS)})"
@@ -153,117 +103,15 @@ def check_model_name(where: str, name: Any) -> str:
 
 
 @dataclass(frozen=True)
-class IntegrationOptions:
-    """Validated integration options.
-
-    Attributes
-    ----------
-    t_end : float
-        End time (> 0); the motion starts at t = 0.
-    rtol : float
-        Relative tolerance of the error control, ``1e-15 <= rtol <= 0.1``.
-    atol : float or None
-        Absolute tolerance, ``> 0``; ``None`` means ``rtol / 100`` (:attr:`resolved_atol`).
-    samples : int
-        Number of equally spaced samples in ``[0, t_end]``, >= 2.
-    max_steps : int
-        Bound on accepted steps.
-    """
-
-    t_end: float = DEFAULTS["t_end"]
-    rtol: float = DEFAULTS["rtol"]
-    atol: float | None = None
-    samples: int = DEFAULTS["samples"]
-    max_steps: int = DEFAULTS["max_steps"]
-
-    def __post_init__(self) -> None:
-        w = "integration"
-        t_end = _number(w, "t_end", self.t_end)
-        rtol = _number(w, "rtol", self.rtol)
-        atol = rtol / 100 if self.atol is None else _number(w, "atol", self.atol)
-        samples = _number(w, "samples", self.samples, integer=True)
-        max_steps = _number(w, "max_steps", self.max_steps, integer=True)
-        if t_end <= 0:
-            raise ScenarioError(f"integration.t_end = {t_end:g} must be > 0")
-        if not 1e-15 <= rtol <= 0.1:
-            raise ScenarioError(f"integration.rtol = {rtol:g} must lie in [1e-15, 0.1]")
-        if atol <= 0:
-            raise ScenarioError(f"integration.atol = {atol:g} must be > 0")
-        if samples < 2:
-            raise ScenarioError(f"integration.samples = {short_repr(samples)} must be >= 2")
-        check_memory(f"integration.samples = {short_repr(samples)}", samples * BYTES_PER_SAMPLE)
-        if not 1 <= max_steps <= MAX_STEPS_LIMIT:
-            raise ScenarioError(
-                f"integration.max_steps = {short_repr(max_steps)} must lie in [1, 2**62]"
-            )
-        step = t_end / (samples - 1)
-        if step < sys.float_info.min or step <= 4 * math.ulp(t_end):
-            raise ScenarioError(
-                f"integration.t_end = {t_end:g} is too small for {samples} samples (their "
-                "spacing is not representable)"
-            )
-        for k, val in (
-            ("t_end", t_end),
-            ("rtol", rtol),
-            ("samples", samples),
-            ("max_steps", max_steps),
-        ):
-            object.__setattr__(self, k, val)
-        if self.atol is not None:
-            object.__setattr__(self, "atol", atol)
-
-    @property
-    def resolved_atol(self) -> float:
-        """``atol`` as given, else ``rtol / 100``."""
-        return self.rtol / 100 if self.atol is None else self.atol
-
-    @property
-    def t_eval(self) -> np.ndarray:
-        """Sample times ``linspace(0, t_end, samples)``, shape (samples,)."""
-        return np.linspace(0.0, self.t_end, self.samples)
-
-
-@dataclass(frozen=True)
-class InitialConditions:
-    """Initial conditions as given by the user (see :func:`rollingtop.initial_state`)."""
-
-    gamma: tuple
-    omega: tuple
-    alpha: tuple | None = None
-    position: tuple = (0.0, 0.0)
-    v: tuple | None = None
-    free: dict = field(default_factory=dict)
-
-    @classmethod
-    def from_state(cls, y) -> InitialConditions:
-        """The initial conditions that rebuild the state ``y`` (full velocity given)."""
-        y = np.asarray(y, dtype=float)
-        return cls(gamma=tuple(y[12:15]), omega=tuple(y[3:6]), alpha=tuple(y[6:9]),
-                   position=tuple(y[15:17]), v=tuple(y[0:3]))  # fmt: skip
-
-    def state(self, body: SphericalTop, model: ContactModel) -> np.ndarray:
-        """The constraint-consistent state vector, shape (18,)."""
-        return initial_state(
-            body,
-            model,
-            gamma=self.gamma,
-            omega=self.omega,
-            alpha=self.alpha,
-            position=self.position,
-            v=self.v,
-            free=self.free,
-        )
-
-
-@dataclass(frozen=True)
 class LevelSpec:
-    """A level set of the meridian model's integrals, as given in a ``[level]`` table.
+    """A level set of a reduction's integrals, as given in a ``[level]`` table.
 
     ``M3, C1, C2`` (Lagrange, area, F6) fix the level set; ``h`` (reduced energy
     ``E - I3 w3^2/2 - m g R``) an orbit on it. ``gamma3`` (default: the first orbit's lowest
     turning point, or its other one when the lowest lies beyond a pole passage),
     ``branch`` (sign of ``w_tau``, default +1), ``phi`` and ``psi`` (Euler angles, default 0)
-    place the initial state when the scenario has no ``[initial]`` table.
+    place the initial state when the scenario has no ``[initial]`` table
+    (:func:`rollingtop.reduction.start.start_on_level`).
     """
 
     M3: float
@@ -279,12 +127,16 @@ class LevelSpec:
         for key in ("M3", "C1", "C2", "h", "gamma3", "phi", "psi"):
             value = getattr(self, key)
             if value is not None:
-                object.__setattr__(self, key, _number("level", key, value))
+                object.__setattr__(self, key, number("level", key, value))
         if isinstance(self.branch, bool) or not isinstance(self.branch, int | float):
             raise ScenarioError(f"level.branch = {short_repr(self.branch)} must be +1 or -1")
         if self.branch not in (1, -1):
             raise ScenarioError(f"level.branch = {short_repr(self.branch)} must be +1 or -1")
         object.__setattr__(self, "branch", int(self.branch))
+
+    def level_set(self, body: SphericalTop) -> LevelSet:
+        """The :class:`~rollingtop.reduction.LevelSet` ``(M3, C1, C2)`` of ``body``."""
+        return LevelSet(body, self.M3, self.C1, self.C2)
 
 
 @dataclass(frozen=True)
@@ -294,8 +146,9 @@ class Scenario:
 
     Construction checks the initial conditions against the model (so a scenario that loads can
     be simulated); :attr:`y0` is the constraint-consistent initial state, built from
-    ``initial``, else from ``level`` (with ``h``), else ``None`` (such a scenario serves the
-    reduction commands only).
+    ``initial`` (:meth:`InitialConditions.state`), else from ``level`` with ``h``
+    (:func:`~rollingtop.reduction.start.start_on_level`), else ``None`` (such a scenario serves
+    the reduction commands only). ``model`` may be given by name.
     """
 
     body: SphericalTop
@@ -304,39 +157,29 @@ class Scenario:
     integration: IntegrationOptions = field(default_factory=IntegrationOptions)
     source: str | None = None
     level: LevelSpec | None = None
+    y0: NDArray[np.float64] | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "model", get_model(self.model))
+        y0 = None
+        spec = self.level
         if self.initial is not None:
             y0 = self.initial.state(self.body, self.model)
-        elif self.level is not None and self.level.h is not None:
-            y0 = self._state_on_level()
-        else:
-            y0 = None
+        elif spec is not None and spec.h is not None:
+            self._require_reduction("an initial state built from [level]")
+            y0 = start_on_level(spec.level_set(self.body), spec.h, gamma3=spec.gamma3,
+                                branch=spec.branch, phi=spec.phi, psi=spec.psi)  # fmt: skip
         object.__setattr__(self, "y0", y0)
 
-    def _require_meridian(self, what: str) -> None:
-        if self.model.name != "meridian":
+    def _require_reduction(self, what: str) -> None:
+        if not self.model.has_reduction:
+            names = " or ".join(m.name for m in MODELS.values() if m.has_reduction)
             raise ScenarioError(
-                f"{what} needs the meridian model (the reduction is the paper's), "
+                f"{what} needs the {names} model (the reduction is the paper's), "
                 f"not {self.model.name!r}"
             )
 
-    def _state_on_level(self):
-        from rollingtop.reduction import orbits, state_from_level
-
-        self._require_meridian("an initial state built from [level]")
-        level = self.level_set()
-        spec = self.level
-        gamma3 = spec.gamma3
-        if gamma3 is None:  # a turning point of the first orbit, on the branch 0 < theta < pi
-            orbit = orbits(level, spec.h)[0]
-            theta = orbit.theta_max if 0 < orbit.theta_max < math.pi else orbit.theta_min
-            gamma3 = math.cos(theta)
-        return state_from_level(level, spec.h, gamma3, branch=spec.branch, phi=spec.phi,
-                                psi=spec.psi)  # fmt: skip
-
-    def require_state(self):
+    def require_state(self) -> NDArray[np.float64]:
         """The initial state, or a :class:`ScenarioError` saying how to give one."""
         if self.y0 is None:
             raise ScenarioError(
@@ -344,49 +187,44 @@ class Scenario:
             )
         return self.y0
 
-    def level_set(self):
-        """The :class:`~rollingtop.reduction.LevelSet` of ``[level]``, else of the initial state."""
-        from rollingtop.reduction import LevelSet, reduced_integrals
-
-        self._require_meridian("the reduction to one degree of freedom")
+    def level_set(self) -> LevelSet:
+        """The :class:`~rollingtop.reduction.LevelSet` of ``[level]``, else of the initial state
+        (:func:`~rollingtop.reduction.start.level_of_state`)."""
+        self._require_reduction("the reduction to one degree of freedom")
         if self.level is not None:
-            return LevelSet(self.body, self.level.M3, self.level.C1, self.level.C2)
-        y = self.require_state()
-        ints = reduced_integrals(self.body, y)
-        scale = float(np.linalg.norm(self.body.inertia * y[3:6]))  # round-off scale of M3, C1
-        return LevelSet(self.body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]),
-                        scale=scale)  # fmt: skip
+            return self.level.level_set(self.body)
+        return level_of_state(self.body, self.require_state())
 
     def level_h(self) -> float:
-        """The reduced energy ``h`` of ``[level]``, else of the initial state."""
-        from rollingtop.reduction import reduced_integrals
-
+        """The reduced energy ``h`` of ``[level]``, else of the initial state
+        (:func:`~rollingtop.reduction.start.reduced_energy`)."""
         if self.level is not None and self.level.h is not None:
             return self.level.h
         if self.level is not None and self.initial is None:
             raise ScenarioError("no h: give h in [level] (or --h)")
-        return float(reduced_integrals(self.body, self.require_state())["h"])
+        return reduced_energy(self.body, self.require_state())
 
-    def with_overrides(self, **overrides) -> Scenario:
+    def with_overrides(self, **overrides: Any) -> Scenario:
         """A copy with integration options (``t_end, rtol, atol, samples, max_steps``) or the
-        contact ``model`` replaced. ``None`` values are ignored."""
-        overrides = {k: v for k, v in overrides.items() if v is not None}
+        contact ``model`` (a name or a :class:`ContactModel`) replaced. ``None`` values are
+        ignored."""
+        given = {k: v for k, v in overrides.items() if v is not None}
         allowed = set(DEFAULTS) | {"model"}
-        unknown = sorted(set(overrides) - allowed)
+        unknown = sorted(set(given) - allowed)
         if unknown:
             raise ScenarioError(
                 f"unknown override {', '.join(unknown)} (allowed: {', '.join(sorted(allowed))})"
             )
-        model = overrides.pop("model", self.model)
+        model = given.pop("model", self.model)
         if not isinstance(model, ContactModel):
-            model = check_model_name("model", model)
-        integration = replace(self.integration, **overrides) if overrides else self.integration
-        return Scenario(self.body, get_model(model), self.initial, integration, self.source,
-                        self.level)  # fmt: skip
+            model = get_model(check_model_name("model", model))
+        integration = replace(self.integration, **given) if given else self.integration
+        return Scenario(self.body, model, self.initial, integration, self.source, self.level)
 
     @classmethod
-    def from_dict(cls, data: dict, source: str | None = None) -> Scenario:
-        """Build from the parsed TOML structure (see the module docstring)."""
+    def from_dict(cls, data: Mapping[str, Any], source: str | None = None) -> Scenario:
+        """Build from the parsed TOML structure (see the module docstring): check every
+        table and key, then build the typed objects."""
         allowed_tables = ("body", "contact", "initial", "integration", "level")
         for key, value in data.items():
             if key not in allowed_tables:
@@ -405,14 +243,14 @@ class Scenario:
         missing = [k for k in _BODY_KEYS[:-1] if k not in body_t]
         if missing:
             raise ScenarioError(f"[body] is missing {', '.join(missing)}")
-        body = SphericalTop(**{k: _number("body", k, body_t[k]) for k in _BODY_KEYS
+        body = SphericalTop(**{k: number("body", k, body_t[k]) for k in _BODY_KEYS
                                if k in body_t})  # fmt: skip
 
         contact_t = data.get("contact", {})
         _reject_unknown("contact", contact_t, ("model",))
         model = get_model(check_model_name("contact.model", contact_t.get("model", DEFAULT_MODEL)))
 
-        level = None
+        level: LevelSpec | None = None
         if "level" in data:
             level_t = data["level"]
             _reject_unknown("level", level_t, _LEVEL_KEYS)
@@ -426,7 +264,7 @@ class Scenario:
         if "initial" not in data:
             return cls(body, model, None, integration, source, level)
 
-        init_t = dict(data["initial"])
+        init_t: dict[str, Any] = dict(data["initial"])
         free_keys = tuple(model.free_velocity)
         for key in init_t:
             if key not in _INITIAL_KEYS + free_keys:
@@ -440,9 +278,10 @@ class Scenario:
         for key, value in init_t.items():
             length = _VECTOR_LENGTHS.get(key, model.free_velocity.get(key))
             if length == 1:
-                init_t[key] = _number("initial", key, value)
+                init_t[key] = number("initial", key, value)
             else:
-                init_t[key] = _vector("initial", key, value, length)
+                assert length is not None  # every allowed key has a length
+                init_t[key] = vector("initial", key, value, length)
         initial = InitialConditions(
             gamma=init_t["gamma"],
             omega=init_t["omega"],
@@ -454,7 +293,7 @@ class Scenario:
         return cls(body, model, initial, integration, source, level)
 
 
-def _reject_unknown(table: str, values: dict, allowed: tuple[str, ...]) -> None:
+def _reject_unknown(table: str, values: Mapping[str, object], allowed: tuple[str, ...]) -> None:
     for key in values:
         if key not in allowed:
             raise ScenarioError(
@@ -462,7 +301,7 @@ def _reject_unknown(table: str, values: dict, allowed: tuple[str, ...]) -> None:
             )
 
 
-def load_scenario(path: str | os.PathLike) -> Scenario:
+def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     """Read and validate a TOML scenario file.
 
     Raises

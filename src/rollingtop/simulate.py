@@ -1,62 +1,168 @@
-"""One entry point for simulations: :func:`simulate`."""
+"""One entry point for simulations: :func:`simulate`.
+
+It takes typed objects, ``simulate(body, model, state, options)``, or a scenario (a
+:class:`~rollingtop.scenario.Scenario` or the path of its TOML file) that holds them. Keyword
+options replace single integration options in either form.
+"""
 
 from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import replace
+from typing import Any, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from rollingtop._errors import ContactLostWarning
-from rollingtop.contact import ContactModel, get_model
+from rollingtop._errors import ContactLostWarning, InitialStateError
+from rollingtop.body import SphericalTop
+from rollingtop.contact import MODELS, ContactModel, get_model
+from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics.start import InitialConditions
+from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals, project_state
 from rollingtop.integrate import integrate
-from rollingtop.scenario import InitialConditions, Scenario, check_model_name, load_scenario
+from rollingtop.integrate.options import IntegrationOptions
+from rollingtop.scenario import Scenario, check_model_name, load_scenario
 from rollingtop.trajectory import Trajectory
 
 __all__ = ["simulate", "simulate_models", "switch_model"]
 
+ScenarioLike = Scenario | str | os.PathLike[str]
 
-def switch_model(scenario: Scenario, model) -> tuple[Scenario, np.ndarray]:
+
+def _model(model: ContactModel | str) -> ContactModel:
+    if isinstance(model, ContactModel):
+        return model
+    return get_model(check_model_name("model", model))
+
+
+def switch_model(
+    scenario: Scenario, model: ContactModel | str
+) -> tuple[Scenario, NDArray[np.float64]]:
     """The scenario's initial state under another contact model, as :func:`simulate_models`
     starts it: projected onto ``model``'s constraints
     (:func:`rollingtop.dynamics.state.project_state`: orientation and position kept,
     velocities moved to the nearest admissible ones in the kinetic-energy metric).
 
-    Returns the new scenario (its ``[level]`` dropped: the reduction is the meridian model's)
-    and the change of the velocities ``(v, omega)``, shape (6,); for the scenario's own model,
-    the scenario itself and zeros.
+    Returns the new scenario (its ``[level]`` dropped: a level belongs to the scenario's own
+    model) and the change of the velocities ``(v, omega)``, shape (6,); for the scenario's own
+    model, the scenario itself and zeros.
     """
-    if not isinstance(model, ContactModel):
-        model = get_model(check_model_name("model", model))
-    if model.name == scenario.model.name:
+    model = _model(model)
+    if model is scenario.model:
         return scenario, np.zeros(6)
     switched = _projected(scenario, model)
     return switched, switched.require_state()[:6] - scenario.require_state()[:6]
 
 
-def _projected(scenario: Scenario, model) -> Scenario:
-    from rollingtop.dynamics.state import project_state
-
+def _projected(scenario: Scenario, model: ContactModel) -> Scenario:
     y = project_state(scenario.body, model, scenario.require_state())
     return replace(scenario, model=model, initial=InitialConditions.from_state(y), level=None)
 
 
+def _given_state(
+    body: SphericalTop, model: ContactModel, state: ArrayLike | InitialConditions
+) -> NDArray[np.float64]:
+    """The initial state of ``simulate(body, model, state)``: built from initial conditions, or
+    a full state vector checked against the model's constraints."""
+    if isinstance(state, InitialConditions):
+        return state.state(body, model)
+    try:
+        y = np.array(state, dtype=float)
+    except (TypeError, ValueError):
+        raise InitialStateError(f"state must be {N_STATE} numbers") from None
+    if y.shape != (N_STATE,) or not np.all(np.isfinite(y)):
+        raise InitialStateError(f"state must be {N_STATE} finite numbers, got shape {y.shape}")
+    residuals = constraint_residuals(body, model, y)
+    for name, res in zip(model.constraints, residuals, strict=True):
+        if abs(res) > UNIT_TOLERANCE:
+            raise InitialStateError(
+                f"the state violates the constraint {name} of model {model.name!r} (residual "
+                f"{res:.3g}, tolerance {UNIT_TOLERANCE:g}): build it with initial_state or "
+                "project_state"
+            )
+    return y
+
+
+@overload
 def simulate(
-    scenario: Scenario | str | os.PathLike,
+    source: SphericalTop,
+    model: ContactModel | str,
+    state: ArrayLike | InitialConditions,
+    options: IntegrationOptions | None = None,
     *,
+    t_end: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    samples: int | None = None,
+    max_steps: int | None = None,
     progress: Callable[[float], None] | None = None,
     events: str | None = None,
     event_direction: int = 0,
-    **overrides,
+) -> Trajectory: ...
+
+
+@overload
+def simulate(
+    source: ScenarioLike,
+    model: ContactModel | str | None = None,
+    state: None = None,
+    options: IntegrationOptions | None = None,
+    *,
+    t_end: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    samples: int | None = None,
+    max_steps: int | None = None,
+    progress: Callable[[float], None] | None = None,
+    events: str | None = None,
+    event_direction: int = 0,
+) -> Trajectory: ...
+
+
+def simulate(
+    source: SphericalTop | ScenarioLike,
+    model: ContactModel | str | None = None,
+    state: ArrayLike | InitialConditions | None = None,
+    options: IntegrationOptions | None = None,
+    *,
+    t_end: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    samples: int | None = None,
+    max_steps: int | None = None,
+    progress: Callable[[float], None] | None = None,
+    events: str | None = None,
+    event_direction: int = 0,
 ) -> Trajectory:
-    """Integrate a scenario and return its :class:`~rollingtop.trajectory.Trajectory`.
+    """Integrate a motion and return its :class:`~rollingtop.trajectory.Trajectory`.
+
+    Two forms::
+
+        simulate(body, model, state, options=None, *, t_end=..., ...)   # no file needed
+        simulate(scenario, model=None, options=None, *, t_end=..., ...)
 
     Parameters
     ----------
-    scenario : Scenario or path
-        A :class:`~rollingtop.scenario.Scenario` or the path of a TOML scenario file.
+    source : SphericalTop, Scenario or path
+        The body, or a :class:`~rollingtop.scenario.Scenario` (or the path of a TOML scenario
+        file) that holds a body, a model, an initial state and integration options.
+    model : ContactModel or str
+        The contact model (an entry of :data:`rollingtop.contact.MODELS`, or its name). Needed
+        with a body. With a scenario, another model than its own projects the scenario's
+        initial state onto that model's constraints (:func:`switch_model`).
+    state : InitialConditions or array_like, shape (18,)
+        The initial state, with a body only: initial conditions (built by
+        :meth:`InitialConditions.state`) or a full state vector, which must satisfy the
+        model's constraints (build one with :func:`rollingtop.initial_state` or
+        :func:`rollingtop.dynamics.state.project_state`).
+    options : IntegrationOptions, optional
+        Integration options; default :class:`IntegrationOptions` ``()`` with a body, the
+        scenario's own with a scenario.
+    t_end, rtol, atol, samples, max_steps : optional
+        Replace single integration options (``None``: keep).
     progress : callable, optional
         Called with the current time now and then during the run (see
         :func:`rollingtop.integrate.integrate`).
@@ -65,10 +171,14 @@ def simulate(
         of ``gamma3``); they are in :attr:`Trajectory.event_t` and :attr:`Trajectory.event_y`.
     event_direction : int
         ``+1`` rising zeros only, ``-1`` falling only, ``0`` both.
-    **overrides
-        ``t_end, rtol, atol, samples, max_steps`` or ``model``, replacing the scenario's values;
-        under another ``model`` the initial state is projected onto its constraints
-        (:func:`switch_model`).
+
+    Raises
+    ------
+    RollingTopError
+        Inadmissible input (a :class:`ScenarioError` for options, an
+        :class:`InitialStateError` for a state, ...).
+    IntegrationError
+        The integrator could not reach ``t_end``.
 
     Warns
     -----
@@ -76,18 +186,42 @@ def simulate(
         When the normal reaction turns negative: the motion leaves the model's assumption that the
         contact is kept. The trajectory is still returned, with ``contact_lost_at`` recorded.
     """
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(scenario)
-    model = overrides.pop("model", None)
+    overrides = {"t_end": t_end, "rtol": rtol, "atol": atol, "samples": samples,
+                 "max_steps": max_steps}  # fmt: skip
+    given: dict[str, Any] = {k: v for k, v in overrides.items() if v is not None}
+    if isinstance(source, SphericalTop):
+        if model is None or state is None:
+            raise TypeError("simulate(body, model, state): a body needs a model and a state")
+        contact = _model(model)
+        y0 = _given_state(source, contact, state)
+        opts = options if options is not None else IntegrationOptions()
+        opts = replace(opts, **given) if given else opts
+        return _run(source, contact, y0, opts, progress, events, event_direction)
+    if state is not None:
+        raise TypeError("simulate(scenario): the scenario holds the state; give none")
+    scenario = source if isinstance(source, Scenario) else load_scenario(source)
     if model is not None:
         scenario, _ = switch_model(scenario, model)
-    scenario = scenario.with_overrides(**overrides)
-    opts = scenario.integration
-    y0 = scenario.require_state()
-    code = scenario.model.kernel_code(scenario.body, y0)  # meridian: pole cases carry nu
+    if options is not None:
+        scenario = replace(scenario, integration=options)
+    scenario = scenario.with_overrides(**given)
+    return _run(scenario.body, scenario.model, scenario.require_state(), scenario.integration,
+                progress, events, event_direction)  # fmt: skip
+
+
+def _run(
+    body: SphericalTop,
+    model: ContactModel,
+    y0: NDArray[np.float64],
+    opts: IntegrationOptions,
+    progress: Callable[[float], None] | None,
+    events: str | None,
+    event_direction: int,
+) -> Trajectory:
+    code = model.kernel_code(body, y0)  # the model's variant for this start (pole cases)
     result = integrate(
         code,
-        scenario.body.params,
+        body.params,
         y0,
         opts.t_eval,
         rtol=opts.rtol,
@@ -98,8 +232,8 @@ def simulate(
         event_direction=event_direction,
     )
     traj = Trajectory(
-        body=scenario.body,
-        model=scenario.model,
+        body=body,
+        model=model,
         t=result.t,
         y=result.y,
         rtol=opts.rtol,
@@ -121,29 +255,59 @@ def simulate(
         warnings.warn(
             ContactLostWarning(
                 f"the normal reaction turns negative at t = {lost:.6g}: the body would leave the "
-                f"plane, and the {scenario.model.name!r} model (contact kept) no longer applies"
+                f"plane, and the {model.name!r} model (contact kept) no longer applies"
             ),
-            stacklevel=2,
+            stacklevel=3,  # the caller of simulate
         )
     return traj
 
 
 def simulate_models(
-    scenario: Scenario | str | os.PathLike,
-    models=("meridian", "smooth", "rough"),
-    **overrides,
+    scenario: ScenarioLike,
+    models: Iterable[ContactModel | str] | None = None,
+    *,
+    t_end: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    samples: int | None = None,
+    max_steps: int | None = None,
+    progress: Callable[[str, float], None] | None = None,
 ) -> dict[str, Trajectory]:
     """Run the scenario's initial state under several contact models, side by side.
 
     The scenario's state is projected onto each model's constraints
     (:func:`rollingtop.dynamics.state.project_state`: orientation and position kept, velocities
     moved to the nearest admissible ones in the kinetic-energy metric), so each model starts as
-    close as it allows to the same state. Returns ``{model name: Trajectory}``.
+    close as it allows to the same state.
+
+    Parameters
+    ----------
+    scenario : Scenario or path
+    models : iterable of ContactModel or str, optional
+        Default: every registered model (:data:`rollingtop.contact.MODELS`), in its order.
+    t_end, rtol, atol, samples, max_steps : optional
+        Replace the scenario's integration options (as in :func:`simulate`).
+    progress : callable, optional
+        ``progress(name, t)``: the run of the model ``name`` has reached time ``t``; each run
+        goes from 0 to ``t_end`` in turn.
+
+    Returns
+    -------
+    dict
+        ``{model name: Trajectory}``, in the order of ``models``.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     scenario.require_state()
+    chosen = [get_model(m) for m in (MODELS.values() if models is None else models)]
     runs = {}
-    for name in models:
-        runs[name] = simulate(_projected(scenario, get_model(name)), **overrides)
+    for model in chosen:
+        report = None if progress is None else _tagged(progress, model.name)
+        runs[model.name] = simulate(_projected(scenario, model), t_end=t_end, rtol=rtol,
+                                    atol=atol, samples=samples, max_steps=max_steps,
+                                    progress=report)  # fmt: skip
     return runs
+
+
+def _tagged(progress: Callable[[str, float], None], name: str) -> Callable[[float], None]:
+    return lambda t: progress(name, t)

@@ -31,6 +31,16 @@ def directions(model, alpha, beta, gamma, w):
     return dirs
 
 
+def residuals(model, p, y):
+    """Constraint residuals ``(vp, d_k)``: the contact point's velocity ``vp = v + w x r`` along
+    each constraint direction (zero on the constraint manifold)."""
+    R, a3 = p[0], p[3]
+    v, w = y[0:3], y[3:6]
+    alpha, beta, gamma = y[6:9], y[9:12], y[12:15]
+    vp = v + np.cross(w, -R * gamma - np.array([0.0, 0.0, a3]))
+    return np.array([vp @ d for d, _ in directions(model, alpha, beta, gamma, w)])
+
+
 def rhs(model, p, y):
     """``y'`` and the contact force ``F`` (body frame) for state ``y`` of the package's layout.
 

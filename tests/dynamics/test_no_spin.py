@@ -44,9 +44,9 @@ def start(body, gamma, w_tau):
     return initial_state(body, "meridian", gamma=gamma, omega=w_tau * tau)
 
 
+@mp.workdps(30)  # a local context: the global precision is left alone
 def reference_period(b, h):
     """Period of gamma3 of the variable-mass pendulum at energy ``h`` (mpmath)."""
-    mp.mp.dps = 30
     mga = b.m * b.g * b.a3
 
     def f(t):

@@ -61,6 +61,7 @@ def critical_w3(b, gamma3):
     return 2 * b.I1 * math.sqrt(b.m * b.g * b.a3 * gamma3 / rho) / b.I3
 
 
+@pytest.mark.slow
 def test_threshold_derived_with_sympy():
     """U''(pole) from MODEL.md's U by sympy series, against the closed form (both poles)."""
     th, phi = sp.symbols("theta phi", real=True)

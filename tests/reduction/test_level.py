@@ -23,24 +23,24 @@ def fig5(paper_body):
 
 
 def test_potential_matches_model_md(fig5, paper_body):
-    mp.mp.dps = 30
-    for g3 in np.linspace(-0.98, 0.98, 41):
-        expected = plain.U(paper_body, 1, 0.5, -2, g3)
-        assert fig5.U_gamma3(g3) == pytest.approx(float(expected), rel=U_RTOL)
+    with mp.workdps(30):
+        for g3 in np.linspace(-0.98, 0.98, 41):
+            expected = plain.U(paper_body, 1, 0.5, -2, g3)
+            assert fig5.U_gamma3(g3) == pytest.approx(float(expected), rel=U_RTOL)
 
 
 def test_derivatives_match_mpmath(fig5, paper_body):
-    mp.mp.dps = 30
-    for g3 in (-0.9, -0.5, 0.1, 0.5, 0.93):
-        theta = math.acos(g3)
+    with mp.workdps(30):
+        for g3 in (-0.9, -0.5, 0.1, 0.5, 0.93):
+            theta = math.acos(g3)
 
-        def u_theta(t):
-            return plain.U(paper_body, 1, 0.5, -2, mp.cos(t))
+            def u_theta(t):
+                return plain.U(paper_body, 1, 0.5, -2, mp.cos(t))
 
-        d1 = mp.diff(u_theta, mp.acos(mp.mpf(g3)))
-        d2 = mp.diff(u_theta, mp.acos(mp.mpf(g3)), 2)
-        assert float(fig5.dU(theta)) == pytest.approx(float(d1), rel=DU_RTOL, abs=1e-12)
-        assert float(fig5.d2U(theta)) == pytest.approx(float(d2), rel=DU_RTOL)
+            d1 = mp.diff(u_theta, mp.acos(mp.mpf(g3)))
+            d2 = mp.diff(u_theta, mp.acos(mp.mpf(g3)), 2)
+            assert float(fig5.dU(theta)) == pytest.approx(float(d1), rel=DU_RTOL, abs=1e-12)
+            assert float(fig5.d2U(theta)) == pytest.approx(float(d2), rel=DU_RTOL)
 
 
 def test_reduced_quantities_match_eq_3_8(fig5, paper_body):
@@ -62,12 +62,12 @@ def test_pole_cases_are_regular(paper_body, C1, pole, theta0):
     with np.errstate(all="raise"):
         for t in (theta0 - 0.2, theta0, theta0 + 0.2):
             assert np.isfinite([level.U(t), level.dU(t), level.d2U(t), level.w_n(t)]).all()
-    mp.mp.dps = 30
-    for t in (0.3, 0.7) if pole == "south" else (math.pi - 0.3, math.pi - 0.7):
-        exact = plain.U(paper_body, 1, C1, -0.3, mp.cos(t))  # MODEL.md with C1 = +-M3 exactly
-        assert level.U(t) == pytest.approx(float(exact), rel=U_RTOL)
-        d1 = mp.diff(lambda x: plain.U(paper_body, 1, C1, -0.3, mp.cos(x)), t)
-        assert level.dU(t) == pytest.approx(float(d1), rel=DU_RTOL)
+    with mp.workdps(30):
+        for t in (0.3, 0.7) if pole == "south" else (math.pi - 0.3, math.pi - 0.7):
+            exact = plain.U(paper_body, 1, C1, -0.3, mp.cos(t))  # MODEL.md with C1 = +-M3 exactly
+            assert level.U(t) == pytest.approx(float(exact), rel=U_RTOL)
+            d1 = mp.diff(lambda x: plain.U(paper_body, 1, C1, -0.3, mp.cos(x)), t)
+            assert level.dU(t) == pytest.approx(float(d1), rel=DU_RTOL)
     # at the pole U is MODEL.md's limit: only the v_tau term and gravity remain
     I1v = -0.3 + (1.0 * paper_body.a3 * theta0)
     expected = paper_body.m * I1v**2 / (2 * paper_body.I1**2) + paper_body.m * paper_body.g * (

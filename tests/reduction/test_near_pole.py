@@ -42,6 +42,7 @@ DISTANCES = [
 ]
 
 
+@mp.workdps(40)  # a local context: the global precision is left alone
 def oracle(b: dict, M3: float, C1: float, C2: float, h: float, pole: str):
     """The orbit next to the pole's wall by mpmath (40 digits), in the distance q from the pole.
 
@@ -51,7 +52,6 @@ def oracle(b: dict, M3: float, C1: float, C2: float, h: float, pole: str):
     (I1 s^2), by tanh-sinh quadrature with break points that resolve the wall.
     Returns (q1, T, delta_psi); q1 is the pole distance of the turning point at the wall.
     """
-    mp.mp.dps = 40
     R, m, g, a3, I1 = (mp.mpf(b[k]) for k in ("R", "m", "g", "a3", "I1"))
     M3, C1, C2, h = mp.mpf(M3), mp.mpf(C1), mp.mpf(C2), mp.mpf(h)
     sign = 1 if pole == "south" else -1
@@ -92,7 +92,14 @@ def oracle(b: dict, M3: float, C1: float, C2: float, h: float, pole: str):
     return q1, T, dpsi
 
 
-CASES = [(body, d, pole, sign) for body in BODIES for (d, pole, sign) in DISTANCES]
+#: Run by default: every (pole, sign) pair, both bodies, distances 1e-2 to 1e-12; the rest with
+#: --slow (each case costs 1 to 2.5 s of mpmath).
+DEFAULT_CASES = {("paper", 1e-2), ("low", 1e-6), ("low", 1e-8), ("low", 1e-12)}
+CASES = [
+    pytest.param(body, d, pole, sign, marks=() if (body, d) in DEFAULT_CASES else pytest.mark.slow)
+    for body in BODIES
+    for (d, pole, sign) in DISTANCES
+]
 
 
 @pytest.mark.parametrize(("body_name", "d", "pole", "sign"), CASES)

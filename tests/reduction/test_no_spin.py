@@ -14,12 +14,12 @@ from rollingtop.reduction import LevelSet, orbits, steady_motions
 PERIOD_RTOL = 1e-11
 
 
+@mp.workdps(30)  # a local context: the global precision is left alone
 def plain_period(b: SphericalTop, C2: float, h: float, a: float, c: float, factor: int) -> float:
     """factor * int_a^c sqrt(rho / (2 (h - U))) dtheta with U = m C2^2/(2 I1^2) + m g a3 cos,
     by mpmath (tanh-sinh copes with the inverse square roots at turning points). ``a``, when a
     turning point, is refined to 30 digits first: the float one is off by round-off, which moves
     the integral by ~sqrt(round-off)."""
-    mp.mp.dps = 30
 
     def U(t):
         return b.m * mp.mpf(C2) ** 2 / (2 * b.I1**2) + b.m * b.g * b.a3 * mp.cos(t)

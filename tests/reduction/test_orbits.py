@@ -40,18 +40,18 @@ def simulate_from(level, h, gamma3, t_end, **kw):
 
 def test_steady_motions_of_fig5(fig5, paper_body):
     """Two centres and a saddle between them; U' = 0 there to mpmath precision."""
-    mp.mp.dps = 30
-    motions = steady_motions(fig5)
-    assert [m.type for m in motions] == ["center", "saddle", "center"]
-    assert [m.gamma3 for m in motions] == sorted(m.gamma3 for m in motions)
-    for m in motions:
-        root = mp.findroot(lambda g: mp.diff(lambda x: plain.U(paper_body, 1, 0.5, -2, x), g),
-                           (m.gamma3 - 1e-6, m.gamma3 + 1e-6), solver="anderson")  # fmt: skip
-        assert m.gamma3 == pytest.approx(float(root), abs=1e-12)
-        assert m.U == pytest.approx(float(plain.U(paper_body, 1, 0.5, -2, root)), rel=1e-13)
-        u2 = mp.diff(lambda x: plain.U(paper_body, 1, 0.5, -2, x), root, 2)
-        assert m.U2 == pytest.approx(float(u2), rel=1e-8)
-        assert (m.U2 > 0) == (m.type == "center")
+    with mp.workdps(30):
+        motions = steady_motions(fig5)
+        assert [m.type for m in motions] == ["center", "saddle", "center"]
+        assert [m.gamma3 for m in motions] == sorted(m.gamma3 for m in motions)
+        for m in motions:
+            root = mp.findroot(lambda g: mp.diff(lambda x: plain.U(paper_body, 1, 0.5, -2, x), g),
+                               (m.gamma3 - 1e-6, m.gamma3 + 1e-6), solver="anderson")  # fmt: skip
+            assert m.gamma3 == pytest.approx(float(root), abs=1e-12)
+            assert m.U == pytest.approx(float(plain.U(paper_body, 1, 0.5, -2, root)), rel=1e-13)
+            u2 = mp.diff(lambda x: plain.U(paper_body, 1, 0.5, -2, x), root, 2)
+            assert m.U2 == pytest.approx(float(u2), rel=1e-8)
+            assert (m.U2 > 0) == (m.type == "center")
 
 
 def test_a_state_started_at_a_centre_stays_there(fig5):
@@ -80,6 +80,7 @@ def test_a_state_started_at_a_centre_stays_there(fig5):
     np.testing.assert_allclose(np.hypot(X - cx / 2, Y - cy / 2), radius, rtol=1e-4)
 
 
+@pytest.mark.slow
 def test_small_oscillation_period_is_the_limit_of_orbit_periods(fig5):
     for m in steady_motions(fig5):
         if m.type != "center":
@@ -92,14 +93,14 @@ def test_small_oscillation_period_is_the_limit_of_orbit_periods(fig5):
 
 @pytest.mark.parametrize("h", [3.3, 4.0, 5.5, 6.5, 12.0])
 def test_period_matches_mpmath(fig5, paper_body, h):
-    mp.mp.dps = 30
-    for o in orbits(fig5, h):
-        lo, hi = plain.turning_points(paper_body, 1, 0.5, -2, h, [o.gamma3_min, o.gamma3_max])
-        assert o.gamma3_min == pytest.approx(float(lo), abs=1e-13)
-        assert o.gamma3_max == pytest.approx(float(hi), abs=1e-13)
-        expected = plain.period(paper_body, 1, 0.5, -2, h, lo, hi)
-        assert o.period == pytest.approx(float(expected), rel=PERIOD_RTOL)
-        assert o.kind == "periodic" and o.period_error < PERIOD_RTOL * o.period
+    with mp.workdps(30):
+        for o in orbits(fig5, h):
+            lo, hi = plain.turning_points(paper_body, 1, 0.5, -2, h, [o.gamma3_min, o.gamma3_max])
+            assert o.gamma3_min == pytest.approx(float(lo), abs=1e-13)
+            assert o.gamma3_max == pytest.approx(float(hi), abs=1e-13)
+            expected = plain.period(paper_body, 1, 0.5, -2, h, lo, hi)
+            assert o.period == pytest.approx(float(expected), rel=PERIOD_RTOL)
+            assert o.kind == "periodic" and o.period_error < PERIOD_RTOL * o.period
 
 
 @pytest.mark.parametrize("h", [4.0, 5.5])

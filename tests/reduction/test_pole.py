@@ -50,34 +50,34 @@ def test_reduced_orbit_through_the_pole(paper_body, C1, C2):
     assert (orbit.gamma3_max if C1 > 0 else orbit.gamma3_min) == (1.0 if C1 > 0 else -1.0)
     assert orbit.theta_min < level.pole_theta < orbit.theta_max
     # period against mpmath in the signed angle, MODEL.md's formula with C1 = +-M3 exactly
-    mp.mp.dps = 30
+    with mp.workdps(30):
 
-    def f(t):
-        return mp.sqrt(
-            (
-                paper_body.I1
-                + paper_body.m
-                * (
-                    paper_body.a3**2
-                    + paper_body.R**2
-                    + 2 * paper_body.a3 * paper_body.R * mp.cos(t)
+        def f(t):
+            return mp.sqrt(
+                (
+                    paper_body.I1
+                    + paper_body.m
+                    * (
+                        paper_body.a3**2
+                        + paper_body.R**2
+                        + 2 * paper_body.a3 * paper_body.R * mp.cos(t)
+                    )
                 )
+                / (2 * (h - U_theta_plain(paper_body, 1, C1, C2, t)))
             )
-            / (2 * (h - U_theta_plain(paper_body, 1, C1, C2, t)))
-        )
 
-    t1 = mp.findroot(
-        lambda t: U_theta_plain(paper_body, 1, C1, C2, t) - h,
-        (orbit.theta_min - 1e-9, orbit.theta_min + 1e-9),
-        solver="anderson",
-    )
-    t2 = mp.findroot(
-        lambda t: U_theta_plain(paper_body, 1, C1, C2, t) - h,
-        (orbit.theta_max - 1e-9, orbit.theta_max + 1e-9),
-        solver="anderson",
-    )
-    expected = 2 * mp.quad(f, [t1, level.pole_theta, t2])
-    assert orbit.period == pytest.approx(float(expected), rel=1e-10)
+        t1 = mp.findroot(
+            lambda t: U_theta_plain(paper_body, 1, C1, C2, t) - h,
+            (orbit.theta_min - 1e-9, orbit.theta_min + 1e-9),
+            solver="anderson",
+        )
+        t2 = mp.findroot(
+            lambda t: U_theta_plain(paper_body, 1, C1, C2, t) - h,
+            (orbit.theta_max - 1e-9, orbit.theta_max + 1e-9),
+            solver="anderson",
+        )
+        expected = 2 * mp.quad(f, [t1, level.pole_theta, t2])
+        assert orbit.period == pytest.approx(float(expected), rel=1e-10)
 
 
 @pytest.mark.parametrize(("C1", "C2"), CASES)

@@ -25,36 +25,36 @@ def random_points(rng, n=20):
 
 
 def test_field_matches_model_md(paper_body, rng):
-    mp.mp.dps = 30
-    for x in random_points(rng):
-        expected = [float(v) for v in plain.field(paper_body, 1.3, [mp.mpf(c) for c in x])]
-        np.testing.assert_allclose(
-            reduced_rhs(paper_body, 1.3, x), expected, rtol=1e-13, atol=1e-14
-        )
+    with mp.workdps(30):
+        for x in random_points(rng):
+            expected = [float(v) for v in plain.field(paper_body, 1.3, [mp.mpf(c) for c in x])]
+            np.testing.assert_allclose(
+                reduced_rhs(paper_body, 1.3, x), expected, rtol=1e-13, atol=1e-14
+            )
 
 
 def test_invariant_measure(paper_body, rng):
     """div(rho * field) = 0 at random points (mpmath derivatives at 30 digits)."""
-    mp.mp.dps = 30
-    for x in random_points(rng, 10):
-        x = [mp.mpf(c) for c in x]
-        div = 0
-        for i in range(4):
+    with mp.workdps(30):
+        for x in random_points(rng, 10):
+            x = [mp.mpf(c) for c in x]
+            div = 0
+            for i in range(4):
 
-            def component(t, i=i, x=x):
-                z = list(x)
-                z[i] = t
-                return plain.rho(paper_body, z[0]) * plain.field(paper_body, 1.3, z)[i]
+                def component(t, i=i, x=x):
+                    z = list(x)
+                    z[i] = t
+                    return plain.rho(paper_body, z[0]) * plain.field(paper_body, 1.3, z)[i]
 
-            div += mp.diff(component, x[i])
-        assert abs(div) < 1e-20
-    # and the density matters: without rho the divergence does not vanish
-    x = [mp.mpf(c) for c in (0.4, 0.3, -0.7, 0.9)]
-    div0 = sum(
-        mp.diff(lambda t, i=i: plain.field(paper_body, 1.3, x[:i] + [t] + x[i + 1 :])[i], x[i])
-        for i in range(4)
-    )
-    assert abs(div0) > 1e-3
+                div += mp.diff(component, x[i])
+            assert abs(div) < 1e-20
+        # and the density matters: without rho the divergence does not vanish
+        x = [mp.mpf(c) for c in (0.4, 0.3, -0.7, 0.9)]
+        div0 = sum(
+            mp.diff(lambda t, i=i: plain.field(paper_body, 1.3, x[:i] + [t] + x[i + 1 :])[i], x[i])
+            for i in range(4)
+        )
+        assert abs(div0) > 1e-3
 
 
 def test_full_simulation_follows_the_reduced_system():

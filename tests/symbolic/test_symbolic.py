@@ -42,6 +42,7 @@ def test_derived_equations_match_the_kernel(model, rng):
         np.testing.assert_allclose(got, dy[:15], rtol=0, atol=AGREE_RTOL * np.abs(dy).max())
 
 
+@pytest.mark.slow
 def test_every_claim_is_proved():
     results = verify()
     assert results and all(r.result == "proved" for r in results), [

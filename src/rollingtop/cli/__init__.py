@@ -1,0 +1,34 @@
+"""Command-line interface: thin commands that parse, call the library, print or write.
+
+Every input error is reported as one line on stderr with exit status 2 and no traceback
+(:mod:`rollingtop.cli._errors`). One module per command or family of commands:
+
+- :mod:`._simulate`: ``simulate``;
+- :mod:`._level`: ``equilibria``, ``orbits``, ``portrait`` (the reduction);
+- :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
+- :mod:`._ensemble`: ``ensemble``;
+- :mod:`._verify`: ``verify``;
+- :mod:`._warmup`: ``warmup``.
+"""
+
+from __future__ import annotations
+
+from rollingtop.cli._app import cli
+from rollingtop.cli._ensemble import ensemble
+from rollingtop.cli._figures import animate, compare, path, plot
+from rollingtop.cli._level import equilibria, orbits, portrait
+from rollingtop.cli._simulate import simulate
+from rollingtop.cli._verify import verify
+from rollingtop.cli._warmup import warmup
+
+__all__ = ["cli", "main"]
+
+for _command in (simulate, equilibria, orbits, portrait, path, plot, compare, animate, ensemble,
+                 verify, warmup):  # fmt: skip
+    cli.add_command(_command)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point: ``rollingtop [ARGS]`` (``argv``: the arguments, default
+    ``sys.argv[1:]``). Exits with the command's status."""
+    cli.main(args=argv, prog_name="rollingtop")

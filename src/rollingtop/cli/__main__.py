@@ -1,0 +1,5 @@
+"""``python -m rollingtop.cli``: the command-line interface."""
+
+from rollingtop.cli import main
+
+main()

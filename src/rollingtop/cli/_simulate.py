@@ -1,0 +1,127 @@
+"""``rollingtop simulate``: one run of a scenario, its integrals, constraints and reactions."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import TYPE_CHECKING, Any
+
+import click
+
+from rollingtop.cli import _output
+from rollingtop.cli._options import (
+    ModelChoice,
+    atol_option,
+    json_option,
+    rtol_option,
+    scenario_argument,
+    t_end_option,
+)
+from rollingtop.contact import ContactModel
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from rollingtop.scenario import Scenario
+    from rollingtop.trajectory import Trajectory
+
+__all__ = ["run_scenario", "simulate"]
+
+
+def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
+    """:func:`rollingtop.simulate` of ``sc`` with a progress bar on a terminal and its warnings
+    as lines (``options``: those of :func:`rollingtop.simulate`)."""
+    from rollingtop.simulate import simulate as run
+
+    with _output.timing(sc.integration.t_end) as progress:
+        return _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
+
+
+def _integrals_table(summary: dict[str, Any]) -> Table:
+    from rich.table import Table
+
+    table = Table(title=f"{summary['model']} model, t = 0 .. {summary['t_end']:g}")
+    for col in ("integral", "initial", "final", "max |drift|", "relative"):
+        table.add_column(col, justify="right" if col != "integral" else "left")
+    for name, row in summary["integrals"].items():
+        rel = row["max_rel_drift"]
+        table.add_row(
+            name,
+            f"{row['initial']:.15g}",
+            f"{row['final']:.15g}",
+            f"{row['max_abs_drift']:.2e}",
+            "-" if rel is None else f"{rel:.2e}",
+        )
+    return table
+
+
+def _print_report(summary: dict[str, Any]) -> None:
+    console = _output.console()
+    console.print(_integrals_table(summary))
+    c, r, s = summary["constraints"], summary["reactions"], summary["stats"]
+    lost = r["contact_lost_at"]
+    console.print(
+        f"constraints: max |residual| {c['max_abs_residual']:.2e}, "
+        f"orthonormality error {c['orthonormality_max_error']:.2e}\n"
+        f"reactions: min normal force {r['min_normal_force']:.6g}, friction coefficient needed "
+        f"{r['max_friction_ratio']:.6g}"
+        + ("" if lost is None else f", CONTACT LOST at t = {lost:.6g}")
+        + f"\nsteps {s['steps']} (+{s['rejected_steps']} rejected), {s['rhs_evals']} rhs "
+        f"evaluations, {s['wall_time_s']:.3f} s (+{s['compile_time_s']:.2f} s compile/load)",
+        highlight=False,
+    )
+
+
+@click.command()
+@scenario_argument
+@t_end_option
+@rtol_option
+@atol_option
+@click.option("--samples", type=int, default=None, help="Number of output samples.")
+@click.option(
+    "--model",
+    type=ModelChoice(),
+    default=None,
+    help="Contact model, overriding the scenario's (its state is projected onto the model's "
+    "constraints).",
+)
+@click.option(
+    "-o", "--output", type=click.Path(), default=None, help="Write samples to OUT.nc or OUT.csv."
+)
+@json_option
+def simulate(
+    scenario: str,
+    t_end: float | None,
+    rtol: float | None,
+    atol: float | None,
+    samples: int | None,
+    model: ContactModel | None,
+    output: str | None,
+    as_json: bool,
+) -> None:
+    """Simulate SCENARIO.toml and print its integrals, constraints and reactions."""
+    from rollingtop.io import check_output_path
+    from rollingtop.scenario import load_scenario
+    from rollingtop.simulate import switch_model
+    from rollingtop.trajectory import OUTPUT_SUFFIXES
+
+    if output is not None:
+        check_output_path(output, OUTPUT_SUFFIXES)
+    sc = load_scenario(scenario).with_overrides(t_end=t_end, rtol=rtol, atol=atol, samples=samples)
+    if model is not None and model is not sc.model:
+        sc, change = switch_model(sc, model)
+        dv, dw = math.hypot(*change[:3]), math.hypot(*change[3:])
+        _output.note(
+            f"initial state projected onto the {sc.model.name} model's constraints (velocities "
+            f"changed by |dv| = {dv:.3g}, |d omega| = {dw:.3g})"
+        )
+    traj = run_scenario(sc)
+    if output is not None:
+        traj.save(output)
+    summary = traj.summary()
+    if as_json:
+        click.echo(json.dumps(summary))
+    else:
+        _print_report(summary)
+        if output is not None:
+            click.echo(f"wrote {output}")

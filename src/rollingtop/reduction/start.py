@@ -1,0 +1,71 @@
+"""Between full states and the reduction: the level set and energy of a state, and a state
+started on a given level (paper Sec. 3; ``docs/model.md``, "One degree of freedom").
+
+- :func:`level_of_state`: the level set ``(M3, C1, C2)`` a state lies on.
+- :func:`reduced_energy`: its reduced energy ``h``.
+- :func:`start_on_level`: a full state on ``(M3, C1, C2, h)``, by default at a turning point of
+  the first orbit (how a scenario's ``[level]`` table with ``h`` starts a motion).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop.body import SphericalTop
+from rollingtop.dynamics._layout import W
+from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.orbits import orbits
+from rollingtop.reduction.variables import reduced_integrals, state_from_level
+
+__all__ = ["level_of_state", "reduced_energy", "start_on_level"]
+
+
+def level_of_state(body: SphericalTop, y: ArrayLike) -> LevelSet:
+    """The level set ``(M3, C1, C2)`` of the state ``y`` (shape (18,)).
+
+    The values come from :func:`~rollingtop.reduction.reduced_integrals`; ``|I w|`` of the state
+    is the round-off scale of ``M3`` and ``C1`` in the pole decision
+    (:class:`~rollingtop.reduction.LevelSet`, ``scale``).
+    """
+    y = np.asarray(y, dtype=float)
+    ints = reduced_integrals(body, y)
+    scale = float(np.linalg.norm(body.inertia * y[W]))
+    return LevelSet(body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]),
+                    scale=scale)  # fmt: skip
+
+
+def reduced_energy(body: SphericalTop, y: ArrayLike) -> float:
+    """The reduced energy ``h = E - I3 w3^2/2 - m g R`` of the state ``y`` (shape (18,))."""
+    return float(reduced_integrals(body, np.asarray(y, dtype=float))["h"])
+
+
+def start_on_level(
+    level: LevelSet,
+    h: float,
+    *,
+    gamma3: float | None = None,
+    branch: int = 1,
+    phi: float = 0.0,
+    psi: float = 0.0,
+) -> NDArray[np.float64]:
+    """A full state on the level ``(M3, C1, C2, h)``
+    (:func:`~rollingtop.reduction.state_from_level`).
+
+    ``gamma3`` defaults to a turning point of the first orbit on the level, its largest
+    ``theta`` when that lies inside ``(0, pi)`` (else its smallest, the other side of a pole
+    passage): there ``w_tau = 0``. ``branch`` is the sign of ``w_tau``; ``phi, psi`` the Euler
+    angles fixing the orientation.
+
+    Raises
+    ------
+    LevelSetError
+        No motion on the level with this ``h`` (or at this ``gamma3``).
+    """
+    if gamma3 is None:  # a turning point of the first orbit, on the branch 0 < theta < pi
+        orbit = orbits(level, h)[0]
+        theta = orbit.theta_max if 0 < orbit.theta_max < math.pi else orbit.theta_min
+        gamma3 = math.cos(theta)
+    return state_from_level(level, h, gamma3, branch=branch, phi=phi, psi=psi)
