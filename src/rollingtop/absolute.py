@@ -177,8 +177,9 @@ class PeriodMap:
 
 
 def start_theta(orbit: Orbit) -> float:
-    """The canonical starting turning point of an orbit (see :class:`PeriodMap`)."""
-    return orbit.theta_max if 0 < orbit.theta_max < math.pi else orbit.theta_min
+    """The canonical starting turning point of an orbit (see :class:`PeriodMap`):
+    :attr:`rollingtop.reduction.Orbit.start_theta`."""
+    return orbit.start_theta
 
 
 def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodMap:

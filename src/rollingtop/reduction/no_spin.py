@@ -89,7 +89,6 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
     if level.pole != "both":
         raise LevelSetError(f"not a no-spin level: {level.describe()}")
     poles = _poles(level)
-    rho_min = float(np.min(level.rho(np.array([0.0, math.pi]))))
     if poles is None:  # U constant: uniform rolling over (or rest)
         U0 = float(level.U(0.0))
         if h < U0:
@@ -101,7 +100,7 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
                           "at rest: U is constant on this level (a3 g = 0), every gamma3 is a "
                           "neutral equilibrium")]  # fmt: skip
         T, err = rolling_over_period(level, h)
-        w_max = math.sqrt(2 * (h - U0) / rho_min)
+        w_max = float(np.max(level.w_tau(np.array([0.0, math.pi]), h)))  # at the lighter pole
         return [Orbit(-1.0, 1.0, -math.pi, math.pi, T, err, "periodic", True, w_max,
                       "rolls over: passes through both poles each period")]  # fmt: skip
     centre, saddle = poles

@@ -84,6 +84,13 @@ class Orbit:
         return json_ready(asdict(self))
 
     @property
+    def start_theta(self) -> float:
+        """The canonical turning point to start the orbit from: ``theta_max`` (the lowest
+        ``gamma3``) when it lies on the branch ``0 < theta < pi``, else ``theta_min`` (the other
+        side of a pole passage); ``w_tau = 0`` there."""
+        return self.theta_max if 0 < self.theta_max < math.pi else self.theta_min
+
+    @property
     def rolls_over(self) -> bool:
         """``theta`` runs round the whole circle (no spin, above the upright pole's energy):
         the orbit has no turning points and ``theta_min``, ``theta_max`` are a full turn apart."""

@@ -65,7 +65,5 @@ def start_on_level(
         No motion on the level with this ``h`` (or at this ``gamma3``).
     """
     if gamma3 is None:  # a turning point of the first orbit, on the branch 0 < theta < pi
-        orbit = orbits(level, h)[0]
-        theta = orbit.theta_max if 0 < orbit.theta_max < math.pi else orbit.theta_min
-        gamma3 = math.cos(theta)
+        gamma3 = math.cos(orbits(level, h)[0].start_theta)
     return state_from_level(level, h, gamma3, branch=branch, phi=phi, psi=psi)
