@@ -49,7 +49,7 @@ from rollingtop._checks import (
 )
 from rollingtop._errors import ContactModelError, RollingTopError, ScenarioError
 from rollingtop.body import SphericalTop
-from rollingtop.contact import MODELS, ContactModel, get_model
+from rollingtop.contact import DEFAULT_MODEL, MODELS, ContactModel, get_model
 from rollingtop.dynamics.start import InitialConditions
 from rollingtop.integrate.options import (
     BYTES_PER_SAMPLE,
@@ -81,7 +81,6 @@ __all__ = [
 ]
 
 #: The contact model of a scenario without a ``[contact]`` table (the paper's).
-DEFAULT_MODEL = "meridian"
 
 _BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3", "I2")
 _INITIAL_KEYS = ("gamma", "omega", "alpha", "position", "v")

@@ -36,6 +36,8 @@ MODULES: tuple[ModuleType, ...] = (
 )
 
 MODELS: dict[str, ContactModel] = {m.MODEL.name: m.MODEL for m in MODULES}
+#: The model of a scenario that names none: the paper's, first in the registry.
+DEFAULT_MODEL: str = MODULES[0].MODEL.name
 
 
 def _kernels() -> tuple[Kernel, ...]:
@@ -47,7 +49,16 @@ def _kernels() -> tuple[Kernel, ...]:
 #: Every compiled kernel, indexed by its code.
 KERNELS: tuple[Kernel, ...] = _kernels()
 
-__all__ = ["KERNELS", "MODELS", "MODULES", "ContactModel", "Kernel", "get_model", "kernel_by_code"]
+__all__ = [
+    "DEFAULT_MODEL",
+    "KERNELS",
+    "MODELS",
+    "MODULES",
+    "ContactModel",
+    "Kernel",
+    "get_model",
+    "kernel_by_code",
+]
 
 
 def get_model(name: str | ContactModel) -> ContactModel:
