@@ -19,11 +19,14 @@ functions allocate nothing and are compiled without reference counting (``_nrt=F
 (:mod:`._dop853_stages`).
 """
 
+from __future__ import annotations
+
 import math
 
 import numpy as np
 
 from rollingtop._jit import compiled, kernel
+from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.dynamics._events import event_value
 from rollingtop.dynamics._kernel import project, reaction, rhs
 from rollingtop.integrate._dop853_stages import scaled_errors, stage
@@ -77,14 +80,14 @@ MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 
 
 
 @compiled()
-def new_track():
+def new_track() -> FloatArray:
     """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
     the normal force at the last accepted step."""
     return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
 
 
 @kernel
-def update_track(track, t, N, T_force):
+def update_track(track: FloatArray, t: float, N: float, T_force: float) -> None:
     """Fold one evaluation of the contact force into ``track``."""
     if N < track[MIN_NORMAL]:
         track[MIN_NORMAL] = N
@@ -99,7 +102,19 @@ def update_track(track, t, N, T_force):
 
 
 @compiled()
-def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
+def initial_step(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    f: FloatArray,
+    t_end: float,
+    t0: float,
+    rtol: float,
+    atol: float,
+    ytmp: FloatArray,
+    ftmp: FloatArray,
+    ws: Workspace,
+) -> float:
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy.
 
     NaN (and no evaluation of the right-hand side) when the scaled norm of ``y`` or ``f`` is not
@@ -136,7 +151,20 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
 
 
 @compiled()
-def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
+def start(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    f: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    ev_code: int,
+    out: FloatArray,
+    ytmp: FloatArray,
+    ynew: FloatArray,
+    ws: Workspace,
+) -> tuple[FloatArray, IntArray, FloatArray]:
     """Prepare a run from ``y`` at ``t_eval[0]``: derivative ``f``, reaction tracking, initial
     step, the first sample ``out[0]``. Returns ``(ctrl, counts, track)`` for :func:`run`."""
     nc = rhs(code, p, y, f, ws)
@@ -156,7 +184,17 @@ def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
 
 
 @kernel
-def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
+def _prepare_dense(
+    code: int,
+    p: FloatArray,
+    K: FloatArray,
+    y: FloatArray,
+    ynew: FloatArray,
+    h: float,
+    ytmp: FloatArray,
+    Fd: FloatArray,
+    ws: Workspace,
+) -> None:
     """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
     n = y.shape[0]
     for s in range(13, 16):
@@ -175,7 +213,7 @@ def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
 
 
 @kernel
-def _dense_eval(Fd, y, x, out):
+def _dense_eval(Fd: FloatArray, y: FloatArray, x: float, out: FloatArray) -> None:
     """State at the fraction ``x`` of the step: ``y + sum`` of the interpolant's terms."""
     for i in range(y.shape[0]):
         acc = 0.0
@@ -186,7 +224,17 @@ def _dense_eval(Fd, y, x, out):
 
 
 @kernel
-def _normal_root(code, p, Fd, y, t, h, ytmp, dy, ws):
+def _normal_root(
+    code: int,
+    p: FloatArray,
+    Fd: FloatArray,
+    y: FloatArray,
+    t: float,
+    h: float,
+    ytmp: FloatArray,
+    dy: FloatArray,
+    ws: Workspace,
+) -> float:
     """Time in ``[t, t + h]`` where the normal force crosses zero, by bisection on the dense
     output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings.
     ``ytmp`` and ``dy`` are scratch."""
@@ -205,7 +253,15 @@ def _normal_root(code, p, Fd, y, t, h, ytmp, dy, ws):
 
 
 @kernel
-def _event_root(ev_code, code, Fd, y, t, h, ytmp):
+def _event_root(
+    ev_code: int,
+    code: int,
+    Fd: FloatArray,
+    y: FloatArray,
+    t: float,
+    h: float,
+    ytmp: FloatArray,
+) -> float:
     """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
     output (60 halvings: to the resolution of the interpolant)."""
     _dense_eval(Fd, y, 0.0, ytmp)
@@ -224,26 +280,26 @@ def _event_root(ev_code, code, Fd, y, t, h, ytmp):
 
 @kernel
 def run(
-    code,
-    p,
-    y,
-    f,
-    ctrl,
-    counts,
-    track,
-    t_eval,
-    out,
-    ev_spec,
-    ev_t,
-    ev_y,
-    budget,
-    K,
-    ynew,
-    ytmp,
-    y_old,
-    Fd,
-    ws,
-):
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    f: FloatArray,
+    ctrl: FloatArray,
+    counts: IntArray,
+    track: FloatArray,
+    t_eval: FloatArray,
+    out: FloatArray,
+    ev_spec: IntArray,
+    ev_t: FloatArray,
+    ev_y: FloatArray,
+    budget: int,
+    K: FloatArray,
+    ynew: FloatArray,
+    ytmp: FloatArray,
+    y_old: FloatArray,
+    Fd: FloatArray,
+    ws: Workspace,
+) -> int:
     """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
 
     Parameters
