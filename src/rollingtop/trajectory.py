@@ -111,37 +111,37 @@ class Trajectory(NetCDFOutput):
 
     # ---- state components -------------------------------------------------------------------
     @property
-    def v(self) -> np.ndarray:
+    def v(self) -> FloatArray:
         """CoM velocity, body frame, shape (n, 3)."""
         return self.y[:, V]
 
     @property
-    def omega(self) -> np.ndarray:
+    def omega(self) -> FloatArray:
         """Angular velocity, body frame, shape (n, 3)."""
         return self.y[:, W]
 
     @property
-    def alpha(self) -> np.ndarray:
+    def alpha(self) -> FloatArray:
         """Fixed ``x`` axis in the body frame, shape (n, 3)."""
         return self.y[:, ALPHA]
 
     @property
-    def beta(self) -> np.ndarray:
+    def beta(self) -> FloatArray:
         """Fixed ``y`` axis in the body frame, shape (n, 3)."""
         return self.y[:, BETA]
 
     @property
-    def gamma(self) -> np.ndarray:
+    def gamma(self) -> FloatArray:
         """Upward vertical in the body frame, shape (n, 3)."""
         return self.y[:, GAMMA]
 
     @property
-    def position(self) -> np.ndarray:
+    def position(self) -> FloatArray:
         """Horizontal CoM position ``(X, Y)`` in the fixed frame, shape (n, 2)."""
         return self.y[:, POSITION]
 
     @property
-    def contact_point(self) -> np.ndarray:
+    def contact_point(self) -> FloatArray:
         """Contact point on the plane, fixed frame, shape (n, 2).
 
         ``(X, Y) + ((r, alpha), (r, beta))`` with ``r = -R gamma - a``, i.e.
@@ -151,29 +151,29 @@ class Trajectory(NetCDFOutput):
 
     # ---- measured quantities ----------------------------------------------------------------
     @functools.cached_property
-    def integrals(self) -> dict[str, np.ndarray]:
+    def integrals(self) -> dict[str, FloatArray]:
         """First integrals of the model and body along the samples, each shape (n,)."""
         names = self.model.integrals(self.body.symmetric)
         return evaluate(self.body, self.y, names, pole=self.pole_case)
 
     @functools.cached_property
-    def _diagnostics(self) -> np.ndarray:
+    def _diagnostics(self) -> FloatArray:
         out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
         _kernel.diagnostics(self._code, self.body.params, np.ascontiguousarray(self.y), out)
         return out
 
     @property
-    def normal_force(self) -> np.ndarray:
+    def normal_force(self) -> FloatArray:
         """Normal reaction ``N = (F, gamma)`` at the samples, shape (n,); must stay positive."""
         return self._diagnostics[:, 0]
 
     @property
-    def tangential_force(self) -> np.ndarray:
+    def tangential_force(self) -> FloatArray:
         """Magnitude of the constraint's horizontal force at the samples, shape (n,)."""
         return self._diagnostics[:, 1]
 
     @property
-    def friction_ratio(self) -> np.ndarray:
+    def friction_ratio(self) -> FloatArray:
         """Tangential over normal force, shape (n,): the friction coefficient the motion needs."""
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(
@@ -181,12 +181,12 @@ class Trajectory(NetCDFOutput):
             )
 
     @property
-    def constraint_residuals(self) -> np.ndarray:
+    def constraint_residuals(self) -> FloatArray:
         """Residual ``J_k u`` of each constraint row at the samples, shape (n, rows)."""
         return self._diagnostics[:, 4 : 4 + len(self.model.constraints)]
 
     @property
-    def orthonormality_error(self) -> np.ndarray:
+    def orthonormality_error(self) -> FloatArray:
         """``max |Q Q^T - 1|`` of the frame ``Q = [alpha; beta; gamma]``, shape (n,)."""
         return self._diagnostics[:, 3]
 
@@ -319,7 +319,7 @@ class Trajectory(NetCDFOutput):
         ds["t"].attrs["long_name"] = "time"
         return ds
 
-    def _csv_table(self) -> tuple[list[str], np.ndarray]:
+    def _csv_table(self) -> tuple[list[str], FloatArray]:
         cols = ["t"]
         blocks = [self.t[:, None]]
         for name, arr, parts in (
