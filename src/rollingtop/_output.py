@@ -4,15 +4,18 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 
 class NetCDFOutput:
     """Mixin: :meth:`to_netcdf` from the class's ``to_xarray()``."""
 
-    def to_xarray(self) -> Any:  # pragma: no cover - every subclass defines it
+    def to_xarray(self) -> xr.Dataset:  # pragma: no cover - every subclass defines it
         raise NotImplementedError
 
     def to_netcdf(self, path: str | os.PathLike[str]) -> Path:

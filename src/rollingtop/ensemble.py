@@ -6,17 +6,21 @@ import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rollingtop._errors import ScenarioError
 from rollingtop._output import NetCDFOutput
+from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, kernel_by_code
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.ensemble_tables import (
     MAX_TABLE_BYTES,
+    Columns,
     check_ensemble_memory,
     grid_table,
     read_table,
@@ -29,6 +33,9 @@ from rollingtop.scenario import (
     Scenario,
     short_repr,
 )
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = [
     "MAX_TABLE_BYTES",
@@ -71,36 +78,38 @@ class EnsembleResult(NetCDFOutput):
     """
 
     model: ContactModel
-    bodies: list
-    initial: np.ndarray
-    final: np.ndarray
+    bodies: list[SphericalTop]
+    initial: FloatArray
+    final: FloatArray
     t_end: float
-    status: np.ndarray
-    steps: np.ndarray
-    rejected_steps: np.ndarray
-    rhs_evals: np.ndarray
-    min_normal_force: np.ndarray
-    max_friction_ratio: np.ndarray
-    integrals: dict
+    status: IntArray
+    steps: IntArray
+    rejected_steps: IntArray
+    rhs_evals: IntArray
+    min_normal_force: FloatArray
+    max_friction_ratio: FloatArray
+    integrals: dict[str, dict[str, FloatArray]]
     wall_time_s: float
     compile_time_s: float
     threads: int
-    t: np.ndarray | None = None
-    samples: np.ndarray | None = None
-    columns: dict = field(default_factory=dict)
+    t: FloatArray | None = None
+    samples: FloatArray | None = None
+    columns: Columns = field(default_factory=dict)
 
     @property
     def n(self) -> int:
-        return self.initial.shape[0]
+        n: int = self.initial.shape[0]
+        return n
 
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
         """JSON-ready summary (the output of ``rollingtop ensemble --json``).
 
         ``max_abs_drift`` is the largest ``|final - initial|`` of each integral over the
         trajectories that finished; ``max_rel_drift`` the same divided by the largest
         ``|initial|`` over the ensemble.
         """
-        worst, worst_abs = {}, {}
+        worst: dict[str, float | None] = {}
+        worst_abs: dict[str, float | None] = {}
         ok = self.status == 0
         for name, d in self.integrals.items():
             if not ok.any():
@@ -133,13 +142,13 @@ class EnsembleResult(NetCDFOutput):
             "contact_lost": int(np.sum(self.min_normal_force < 0)),
         }
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """Per-trajectory results as an :class:`xarray.Dataset` (samples included if kept)."""
         import xarray as xr
 
         comp = [f"{k}{i}" for k in ("v", "omega", "alpha", "beta", "gamma") for i in (1, 2, 3)]
         comp += ["X", "Y", "psi_nu"]
-        data = {
+        data: dict[str, tuple[str | tuple[str, ...], NDArray[Any]]] = {
             "initial_state": (("trajectory", "state"), self.initial),
             "final_state": (("trajectory", "state"), self.final),
             "status": ("trajectory", self.status.astype(np.int32)),
@@ -152,14 +161,17 @@ class EnsembleResult(NetCDFOutput):
         for name, d in self.integrals.items():
             for key, values in d.items():
                 data[f"{name}_{key}"] = ("trajectory", values)
-        for name, values in self.columns.items():
-            data[f"input_{name}"] = ("trajectory", np.asarray(values, dtype=float))
-        coords = {"trajectory": np.arange(self.n), "state": comp}
-        if self.samples is not None:
+        for name, column in self.columns.items():
+            data[f"input_{name}"] = ("trajectory", np.asarray(column, dtype=float))
+        coords: dict[str, NDArray[Any] | list[str]] = {
+            "trajectory": np.arange(self.n),
+            "state": comp,
+        }
+        if self.samples is not None and self.t is not None:  # kept together
             data["samples"] = (("trajectory", "t", "state"), self.samples)
             coords["t"] = self.t
         b = self.bodies[0]
-        attrs = {f"body_{k}": v for k, v in b.to_dict().items()}
+        attrs: dict[str, str | float] = {f"body_{k}": v for k, v in b.to_dict().items()}
         attrs.update(model=self.model.name, t_end=self.t_end,
                      summary_json=json.dumps(self.summary()), source="rollingtop ensemble",
                      single_body=int(all(x == b for x in self.bodies)))  # fmt: skip
@@ -169,7 +181,7 @@ class EnsembleResult(NetCDFOutput):
 def simulate_ensemble(
     body: SphericalTop | Sequence[SphericalTop],
     model: str | ContactModel,
-    states,
+    states: FloatArray | Sequence[Sequence[float]],
     *,
     t_end: float,
     rtol: float = 1e-10,
@@ -240,7 +252,9 @@ def simulate_ensemble(
     if threads is not None:
         if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
             raise ScenarioError(f"threads = {short_repr(threads)} must be an integer >= 1")
-        threads = min(int(threads), numba.config.NUMBA_NUM_THREADS)  # what is really used
+        # what is really used (numba.config sets its options at run time: no stubs)
+        max_threads: int = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
+        threads = min(int(threads), max_threads)
     # the model picks its kernel variant per state (meridian: the pole cases)
     codes = np.array([model.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)],
                      dtype=np.int64)  # fmt: skip
@@ -262,18 +276,26 @@ def simulate_ensemble(
     )  # fmt: skip
 
 
-def _ensemble_integrals(model, bodies, codes, initial, final) -> dict:
-    names = None
-    for b in {id(b): b for b in bodies}.values():
+def _ensemble_integrals(
+    model: ContactModel,
+    bodies: list[SphericalTop],
+    codes: IntArray,
+    initial: FloatArray,
+    final: FloatArray,
+) -> dict[str, dict[str, FloatArray]]:
+    shared: set[str] = set()  # the integrals every body has
+    for k, b in enumerate({id(b): b for b in bodies}.values()):
         own = set(model.integrals(b.symmetric))
-        names = own if names is None else names & own
-    names = [n for n in model.integrals(True) if n in names]
-    result = {n: {"initial": np.empty(len(bodies)), "final": np.empty(len(bodies))} for n in names}
-    groups: dict = {}
+        shared = own if k == 0 else shared & own
+    names = [n for n in model.integrals(True) if n in shared]
+    result: dict[str, dict[str, FloatArray]] = {
+        n: {"initial": np.empty(len(bodies)), "final": np.empty(len(bodies))} for n in names
+    }
+    groups: dict[tuple[int, int], tuple[SphericalTop, int, list[int]]] = {}
     for k, (b, c) in enumerate(zip(bodies, codes, strict=True)):
         groups.setdefault((id(b), int(c)), (b, int(c), []))[2].append(k)
-    for b, c, idx in groups.values():
-        idx = np.array(idx)
+    for b, c, members in groups.values():
+        idx = np.array(members)
         for key, Y in (("initial", initial[idx]), ("final", final[idx])):
             for name, values in evaluate(b, Y, names, pole=kernel_by_code(c).variant).items():
                 result[name][key][idx] = values
@@ -282,8 +304,9 @@ def _ensemble_integrals(model, bodies, codes, initial, final) -> dict:
     return result
 
 
-def ensemble_from_scenario(scenario: Scenario, columns: dict, **kwargs) -> EnsembleResult:
-    """Run the scenario's body and model over the initial states of ``columns``."""
+def ensemble_from_scenario(scenario: Scenario, columns: Columns, **kwargs: Any) -> EnsembleResult:
+    """Run the scenario's body and model over the initial states of ``columns``; ``kwargs`` go to
+    :func:`simulate_ensemble` (the scenario's ``t_end``, ``rtol`` and ``atol`` by default)."""
     opts = scenario.integration
     check_ensemble_memory(len(next(iter(columns.values()), ())), kwargs.get("samples"))
     kwargs.setdefault("t_end", opts.t_end)

@@ -5,13 +5,16 @@ ensemble too large to hold before anything is allocated."""
 from __future__ import annotations
 
 import math
+import os
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TypeAlias
 
 import numpy as np
 
 from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._types import FloatArray
 from rollingtop.contact import ContactModel
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.io import read_input_text
@@ -23,7 +26,10 @@ from rollingtop.scenario import (
     short_repr,
 )
 
-__all__ = ["check_ensemble_memory", "grid_table", "read_table", "states_from_table"]
+__all__ = ["Columns", "check_ensemble_memory", "grid_table", "read_table", "states_from_table"]
+
+#: Columns of initial values, each of one value per trajectory (:func:`states_from_table`).
+Columns: TypeAlias = Mapping[str, Sequence[float] | FloatArray]
 
 #: Largest CSV table of initial states read (bytes).
 MAX_TABLE_BYTES = 64 << 20
@@ -48,7 +54,7 @@ _VECTOR_KEYS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3, "v_ho
 
 def _column_map(model: ContactModel) -> dict[str, tuple[str, int | None]]:
     """Column name -> (initial-condition key, component index or None)."""
-    cols = {}
+    cols: dict[str, tuple[str, int | None]] = {}
     for key, n in _VECTOR_KEYS.items():
         if key == "v_horizontal" and "v_horizontal" not in model.free_velocity:
             continue
@@ -61,7 +67,7 @@ def _column_map(model: ContactModel) -> dict[str, tuple[str, int | None]]:
     return cols
 
 
-def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -> np.ndarray:
+def states_from_table(scenario: Scenario, columns: Columns) -> FloatArray:
     """Initial states from the scenario's initial conditions with some values replaced per row.
 
     ``columns`` maps names to equal-length sequences: ``gamma1..3, omega1..3, alpha1..3,
@@ -90,11 +96,13 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
 
     states = np.empty((n, N_STATE))
     for row in range(n):
-        fields = {
-            "gamma": list(base.gamma), "omega": list(base.omega),
-            "alpha": None if base.alpha is None else list(base.alpha),
-            "position": list(base.position), "v": None if base.v is None else list(base.v),
-        }  # fmt: skip
+        # the vectors of initial_state, each where given
+        fields: dict[str, list[float]] = {"gamma": list(base.gamma), "omega": list(base.omega),
+                                          "position": list(base.position)}  # fmt: skip
+        if base.alpha is not None:
+            fields["alpha"] = list(base.alpha)
+        if base.v is not None:
+            fields["v"] = list(base.v)
         free = {k: (list(v) if np.ndim(v) else v) for k, v in base.free.items()}
         for name, values in columns.items():
             key, i = allowed[name]
@@ -102,7 +110,7 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
             if key == "theta":
                 fields["gamma"] = [0.0, math.sin(x), math.cos(x)]
                 if "alpha" not in {allowed[c][0] for c in columns}:
-                    fields["alpha"] = None
+                    fields.pop("alpha", None)
             elif key in model.free_velocity:
                 if i is None:
                     free[key] = x
@@ -111,15 +119,19 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
                     vec[i] = x
                     free[key] = vec
             else:
-                if fields[key] is None:
+                if key not in fields:
                     raise ScenarioError(f"row {row + 1}: column {name} needs a base value of {key}")
+                assert i is not None  # a vector's column names its component (_column_map)
                 fields[key][i] = x
         if any(allowed[c][0] == "v" for c in columns):
             free = {}
         elif any(allowed[c][0] in model.free_velocity for c in columns):
-            fields["v"] = None
+            fields.pop("v", None)
         try:
-            states[row] = initial_state(scenario.body, model, free=free, **fields)
+            states[row] = initial_state(
+                scenario.body, model, free=free, gamma=fields["gamma"], omega=fields["omega"],
+                alpha=fields.get("alpha"), position=fields["position"], v=fields.get("v"),
+            )  # fmt: skip
         except RollingTopError as exc:  # name the row
             raise type(exc)(f"ensemble row {row + 1}: {exc}") from None
     return states
@@ -128,7 +140,7 @@ def states_from_table(scenario: Scenario, columns: dict[str, Sequence[float]]) -
 _GRID = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*([^:]+):([^:]+):(\d+)\s*$")
 
 
-def grid_table(spec: str, samples: int | None = None) -> dict[str, np.ndarray]:
+def grid_table(spec: str, samples: int | None = None) -> dict[str, FloatArray]:
     """Columns of a Cartesian grid from ``"name=start:stop:count,name=..."``.
 
     The grid's size is checked against the memory limit (with ``samples`` kept per
@@ -161,7 +173,7 @@ def grid_table(spec: str, samples: int | None = None) -> dict[str, np.ndarray]:
     return {name: m.ravel() for name, m in zip(names, mesh, strict=True)}
 
 
-def read_table(path) -> dict[str, np.ndarray]:
+def read_table(path: str | os.PathLike[str]) -> dict[str, FloatArray]:
     """Columns of a CSV file with a header row (``#`` comment lines allowed)."""
     path = Path(path)
     text = read_input_text(path, "table", MAX_TABLE_BYTES, ScenarioError)

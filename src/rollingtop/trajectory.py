@@ -5,19 +5,26 @@ from __future__ import annotations
 import functools
 import io
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rollingtop._json import finite_or_none
 from rollingtop._output import NetCDFOutput
+from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, kernel_by_code
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop.dynamics.integrals import evaluate
+from rollingtop.integrate.driver import StepReactions
 from rollingtop.io import check_output_path, write_bytes_atomic
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["Trajectory", "OUTPUT_SUFFIXES"]
 
@@ -61,9 +68,9 @@ class Trajectory(NetCDFOutput):
         :mod:`rollingtop.dynamics._layout`).
     rtol, atol : float
         Tolerances the motion was integrated with.
-    stats : dict
+    stats : dict of str to float
         ``steps, rejected_steps, rhs_evals, wall_time_s, compile_time_s``.
-    step_reactions : dict
+    step_reactions : StepReactions
         Contact reactions monitored at every accepted step (not only at samples):
         ``min_normal_force, t_min_normal_force, contact_lost_at, max_friction_ratio, ...``.
     event_t : ndarray, shape (k,)
@@ -77,14 +84,14 @@ class Trajectory(NetCDFOutput):
 
     body: SphericalTop
     model: ContactModel
-    t: np.ndarray
-    y: np.ndarray
+    t: FloatArray
+    y: FloatArray
     rtol: float
     atol: float
-    stats: dict = field(default_factory=dict)
-    step_reactions: dict = field(default_factory=dict)
-    event_t: np.ndarray = field(default_factory=lambda: np.empty(0))
-    event_y: np.ndarray = field(default_factory=lambda: np.empty((0, N_STATE)))
+    stats: dict[str, float] = field(default_factory=dict)
+    step_reactions: StepReactions = field(default_factory=StepReactions)
+    event_t: FloatArray = field(default_factory=lambda: np.empty(0))
+    event_y: FloatArray = field(default_factory=lambda: np.empty((0, N_STATE)))
     kernel_code: int | None = None
 
     def __post_init__(self) -> None:
@@ -92,44 +99,49 @@ class Trajectory(NetCDFOutput):
             self.kernel_code = self.model.code
 
     @property
+    def _code(self) -> int:
+        """:attr:`kernel_code` (which ``__post_init__`` sets: ``model.code`` where not given)."""
+        return self.model.code if self.kernel_code is None else self.kernel_code
+
+    @property
     def pole_case(self) -> str | None:
         """``"south"``/``"north"`` when integrated as a meridian pole case (the kernel's variant),
         else ``None``."""
-        return kernel_by_code(self.kernel_code).variant
+        return kernel_by_code(self._code).variant
 
     # ---- state components -------------------------------------------------------------------
     @property
-    def v(self) -> np.ndarray:
+    def v(self) -> FloatArray:
         """CoM velocity, body frame, shape (n, 3)."""
         return self.y[:, V]
 
     @property
-    def omega(self) -> np.ndarray:
+    def omega(self) -> FloatArray:
         """Angular velocity, body frame, shape (n, 3)."""
         return self.y[:, W]
 
     @property
-    def alpha(self) -> np.ndarray:
+    def alpha(self) -> FloatArray:
         """Fixed ``x`` axis in the body frame, shape (n, 3)."""
         return self.y[:, ALPHA]
 
     @property
-    def beta(self) -> np.ndarray:
+    def beta(self) -> FloatArray:
         """Fixed ``y`` axis in the body frame, shape (n, 3)."""
         return self.y[:, BETA]
 
     @property
-    def gamma(self) -> np.ndarray:
+    def gamma(self) -> FloatArray:
         """Upward vertical in the body frame, shape (n, 3)."""
         return self.y[:, GAMMA]
 
     @property
-    def position(self) -> np.ndarray:
+    def position(self) -> FloatArray:
         """Horizontal CoM position ``(X, Y)`` in the fixed frame, shape (n, 2)."""
         return self.y[:, POSITION]
 
     @property
-    def contact_point(self) -> np.ndarray:
+    def contact_point(self) -> FloatArray:
         """Contact point on the plane, fixed frame, shape (n, 2).
 
         ``(X, Y) + ((r, alpha), (r, beta))`` with ``r = -R gamma - a``, i.e.
@@ -139,29 +151,29 @@ class Trajectory(NetCDFOutput):
 
     # ---- measured quantities ----------------------------------------------------------------
     @functools.cached_property
-    def integrals(self) -> dict[str, np.ndarray]:
+    def integrals(self) -> dict[str, FloatArray]:
         """First integrals of the model and body along the samples, each shape (n,)."""
         names = self.model.integrals(self.body.symmetric)
         return evaluate(self.body, self.y, names, pole=self.pole_case)
 
     @functools.cached_property
-    def _diagnostics(self) -> np.ndarray:
+    def _diagnostics(self) -> FloatArray:
         out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
-        _kernel.diagnostics(self.kernel_code, self.body.params, np.ascontiguousarray(self.y), out)
+        _kernel.diagnostics(self._code, self.body.params, np.ascontiguousarray(self.y), out)
         return out
 
     @property
-    def normal_force(self) -> np.ndarray:
+    def normal_force(self) -> FloatArray:
         """Normal reaction ``N = (F, gamma)`` at the samples, shape (n,); must stay positive."""
         return self._diagnostics[:, 0]
 
     @property
-    def tangential_force(self) -> np.ndarray:
+    def tangential_force(self) -> FloatArray:
         """Magnitude of the constraint's horizontal force at the samples, shape (n,)."""
         return self._diagnostics[:, 1]
 
     @property
-    def friction_ratio(self) -> np.ndarray:
+    def friction_ratio(self) -> FloatArray:
         """Tangential over normal force, shape (n,): the friction coefficient the motion needs."""
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(
@@ -169,12 +181,12 @@ class Trajectory(NetCDFOutput):
             )
 
     @property
-    def constraint_residuals(self) -> np.ndarray:
+    def constraint_residuals(self) -> FloatArray:
         """Residual ``J_k u`` of each constraint row at the samples, shape (n, rows)."""
         return self._diagnostics[:, 4 : 4 + len(self.model.constraints)]
 
     @property
-    def orthonormality_error(self) -> np.ndarray:
+    def orthonormality_error(self) -> FloatArray:
         """``max |Q Q^T - 1|`` of the frame ``Q = [alpha; beta; gamma]``, shape (n,)."""
         return self._diagnostics[:, 3]
 
@@ -182,15 +194,16 @@ class Trajectory(NetCDFOutput):
     def contact_lost_at(self) -> float | None:
         """First time the normal force was negative (steps or samples), else ``None``."""
         times = []
-        if self.step_reactions.get("contact_lost_at") is not None:
-            times.append(self.step_reactions["contact_lost_at"])
+        step_lost = self.step_reactions.get("contact_lost_at")
+        if step_lost is not None:
+            times.append(step_lost)
         negative = np.flatnonzero(self.normal_force < 0)
         if negative.size:
             times.append(float(self.t[negative[0]]))
         return min(times) if times else None
 
     # ---- reports ----------------------------------------------------------------------------
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
         """Summary as a JSON-ready dict (the output of ``rollingtop simulate --json``).
 
         Keys: ``model, t_end, final, integrals, constraints, reactions, stats`` (see README).
@@ -248,8 +261,8 @@ class Trajectory(NetCDFOutput):
         }
 
     # ---- export -----------------------------------------------------------------------------
-    def _attrs(self) -> dict:
-        attrs = {f"body_{k}": v for k, v in self.body.to_dict().items()}
+    def _attrs(self) -> dict[str, str | float]:
+        attrs: dict[str, str | float] = {f"body_{k}": v for k, v in self.body.to_dict().items()}
         attrs.update(
             model=self.model.name,
             model_description=self.model.description,
@@ -270,12 +283,12 @@ class Trajectory(NetCDFOutput):
         )
         return attrs
 
-    def to_xarray(self):
+    def to_xarray(self) -> xr.Dataset:
         """The samples as an :class:`xarray.Dataset` with units and parameters as attributes."""
         import xarray as xr
 
         comp = ("1", "2", "3")
-        data = {
+        data: dict[str, tuple[str | tuple[str, str], FloatArray]] = {
             "v": (("t", "component"), self.v),
             "omega": (("t", "component"), self.omega),
             "alpha": (("t", "component"), self.alpha),
@@ -300,13 +313,13 @@ class Trajectory(NetCDFOutput):
             },
             attrs=self._attrs(),
         )
-        for name in ds.variables:
-            if name in _UNITS:
-                ds[name].attrs["units"] = _UNITS[name]
+        for name, units in _UNITS.items():
+            if name in ds.variables:
+                ds[name].attrs["units"] = units
         ds["t"].attrs["long_name"] = "time"
         return ds
 
-    def _csv_table(self) -> tuple[list[str], np.ndarray]:
+    def _csv_table(self) -> tuple[list[str], FloatArray]:
         cols = ["t"]
         blocks = [self.t[:, None]]
         for name, arr, parts in (
@@ -336,7 +349,7 @@ class Trajectory(NetCDFOutput):
             blocks.append(values[:, None])
         return cols, np.hstack(blocks)
 
-    def to_csv(self, path) -> Path:
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
         """Write the samples as CSV (one header row; ``#`` comment lines carry the parameters)."""
         path = check_output_path(path, (".csv",))
         cols, table = self._csv_table()
@@ -349,7 +362,7 @@ class Trajectory(NetCDFOutput):
         np.savetxt(text, table, delimiter=",", fmt="%.17g")
         return write_bytes_atomic(path, text.getvalue().encode("utf-8"))
 
-    def save(self, path) -> Path:
+    def save(self, path: str | os.PathLike[str]) -> Path:
         """Write to ``.nc`` (NetCDF) or ``.csv``, chosen by the suffix."""
         path = check_output_path(path, OUTPUT_SUFFIXES)
         return self.to_netcdf(path) if path.suffix.lower() == ".nc" else self.to_csv(path)

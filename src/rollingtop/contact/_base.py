@@ -3,17 +3,34 @@ compiled kernels (model x variant) that integrate it."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 import numpy as np
-from numpy.typing import NDArray
+
+from rollingtop._types import FloatArray
 
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
 
-FloatArray = NDArray[np.float64]
+#: The free velocity components given to :attr:`ContactModel.velocity`: a number for a scalar
+#: component, an array for a vector one.
+FreeVelocity: TypeAlias = Mapping[str, float | FloatArray]
+#: ``velocity(body, gamma, omega, alpha, beta, free) -> v`` (:attr:`ContactModel.velocity`).
+VelocityFunction: TypeAlias = Callable[
+    ["SphericalTop", FloatArray, FloatArray, FloatArray, FloatArray, FreeVelocity], FloatArray
+]
+
+
+class VerticalDirection(Protocol):
+    """``vertical_direction(omega, alpha, beta, psi_nu=0.0) -> psi_nu``
+    (:attr:`ContactModel.vertical_direction`)."""
+
+    def __call__(
+        self, omega: FloatArray, alpha: FloatArray, beta: FloatArray, psi_nu: float = 0.0, /
+    ) -> float: ...
 
 
 @dataclass(frozen=True)
@@ -114,12 +131,12 @@ class ContactModel:
     free_velocity: dict[str, int]
     integrals_symmetric: tuple[str, ...]
     integrals_general: tuple[str, ...]
-    velocity: Callable[..., FloatArray]
-    symbolic_directions: Callable[[Any, Any], list[Any]]
+    velocity: VelocityFunction
+    symbolic_directions: Callable[[ModuleType, Any], list[Any]]
     symbolic_velocity: Callable[[Any, Any, Any, Any], Any]
     singular: Callable[[SphericalTop, FloatArray], str | None] | None = None
     vertical_tolerance: float = 0.0
-    vertical_direction: Callable[..., float] | None = None
+    vertical_direction: VerticalDirection | None = None
     variants: tuple[str, ...] = ()
     select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
     has_reduction: bool = False

@@ -3,12 +3,27 @@ present, one more contact row ``(vp, n) = 0`` (the smooth and meridian models): 
 equations as the general path (:func:`rollingtop.dynamics._kernel.rhs_rows`), written out in
 scalars (a 1x1 or 2x2 solve), several times faster. The tests hold them to the general path."""
 
+from __future__ import annotations
+
 from rollingtop._jit import inline
+from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact._rows import contact_arm_rate, free_forces, row_bias
 
 
 @inline
-def rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
+def rhs_contact(
+    p: FloatArray,
+    y: FloatArray,
+    dy: FloatArray,
+    ws: Workspace,
+    two: bool,
+    n1: float,
+    n2: float,
+    n3: float,
+    nd1: float,
+    nd2: float,
+    nd3: float,
+) -> int:
     """The accelerations for the normal row ``(vp, gamma) = 0`` plus, if ``two``, the row
     ``(vp, n) = 0`` with ``n' = nd``; fills ``dy[0:6]`` and, for the reaction, the force
     directions ``ws[2]`` and multipliers ``ws[4]``. Returns the number of rows."""
@@ -55,7 +70,9 @@ def rhs_contact(p, y, dy, ws, two, n1, n2, n3, nd1, nd2, nd3):
 
 
 @inline
-def project_contact(p, y, two, n1, n2, n3):
+def project_contact(
+    p: FloatArray, y: FloatArray, two: bool, n1: float, n2: float, n3: float
+) -> None:
     """The velocity projection (:func:`rollingtop.dynamics._kernel.project`) for the normal row
     and, if ``two``, the row along ``n`` (the rows of :func:`rhs_contact`; a 1x1 or 2x2
     solve)."""

@@ -26,7 +26,10 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 {table}
 """
 
+from __future__ import annotations
+
 from rollingtop._jit import inline, kernel
+from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact import {imports}
 '''
 
@@ -37,7 +40,7 @@ def _module(name: str) -> ModuleType:
 
 def _branches() -> list[tuple[int, str, int, ModuleType]]:
     """``(code, module name, variant index, module)`` of every kernel."""
-    out = []
+    out: list[tuple[int, str, int, ModuleType]] = []
     for k in KERNELS:
         mod = _module(k.model)
         variant = 0 if k.variant is None else 1 + mod.MODEL.variants.index(k.variant)
@@ -46,6 +49,8 @@ def _branches() -> list[tuple[int, str, int, ModuleType]]:
 
 
 def _function(decorator: str, signature: str, doc: str, body: list[str], tail: list[str]) -> str:
+    """A function of the generated module; ``signature`` is laid out as ``ruff format`` would
+    lay it out (the generated file is checked by ``ruff format --check`` too)."""
     lines = ["", "", decorator, f"def {signature}:", f'    """{doc}"""', *body, *tail]
     return "\n".join(lines) + "\n"
 
@@ -73,14 +78,15 @@ def source() -> str:
 
     text += _function(
         "@kernel",
-        "rows(code, p, y, J, bias, dirs)",
+        "rows(\n    code: int, p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, "
+        "dirs: FloatArray\n) -> int",
         "The constraint rows of kernel ``code``; returns their number (-1: unknown code).",
         calls("rows", "p, y, J, bias, dirs, {v}"),
         ["    return -1"],
     )
     text += _function(
         "@inline",
-        "accel(code, p, y, dy, ws)",
+        "accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) -> int",
         "Closed-form accelerations of kernel ``code``; returns the number of rows, or -1 where "
         "the\n    model has no closed form (then the general path applies).",
         calls("accel", "p, y, dy, ws, {v}"),
@@ -88,21 +94,21 @@ def source() -> str:
     )
     text += _function(
         "@inline",
-        "project_velocity(code, p, y)",
+        "project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool",
         "Closed-form velocity projection of kernel ``code``; ``False`` where the model has none.",
         calls("project_velocity", "p, y, {v}", "        return True"),
         ["    return False"],
     )
     text += _function(
         "@inline",
-        "direction_rate(code, p, y)",
+        "direction_rate(code: int, p: FloatArray, y: FloatArray) -> float",
         "``psi_nu'`` under kernel ``code`` (0 unless it carries a constraint direction).",
         calls("direction_rate", "p, y, {v}"),
         ["    return _rows.direction_rate(p, y, 0)"],
     )
     text += _function(
         "@inline",
-        "sync_direction(code, y)",
+        "sync_direction(code: int, y: FloatArray) -> None",
         "Re-synchronise ``psi_nu`` with the axis azimuth after a step, as kernel ``code`` does.",
         calls("sync_direction", "y, {v}", "        return"),
         ["    _rows.sync_direction(y, 0)"],
@@ -110,7 +116,7 @@ def source() -> str:
     carried = " or ".join(f"code == {k.code}" for k in KERNELS if k.carries_direction)
     text += _function(
         "@inline",
-        "carries_direction(code)",
+        "carries_direction(code: int) -> bool",
         "Whether kernel ``code`` carries its constraint direction in ``psi_nu``.",
         [],
         [f"    return {carried or 'False'}"],

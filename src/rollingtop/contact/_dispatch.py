@@ -10,12 +10,17 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 - 4: ``meridian``, variant ``north``
 """
 
+from __future__ import annotations
+
 from rollingtop._jit import inline, kernel
+from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact import _rows, meridian, rough, smooth
 
 
 @kernel
-def rows(code, p, y, J, bias, dirs):
+def rows(
+    code: int, p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray
+) -> int:
     """The constraint rows of kernel ``code``; returns their number (-1: unknown code)."""
     if code == 0:
         return meridian.rows(p, y, J, bias, dirs, 0)
@@ -31,7 +36,7 @@ def rows(code, p, y, J, bias, dirs):
 
 
 @inline
-def accel(code, p, y, dy, ws):
+def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) -> int:
     """Closed-form accelerations of kernel ``code``; returns the number of rows, or -1 where the
     model has no closed form (then the general path applies)."""
     if code == 0:
@@ -48,7 +53,7 @@ def accel(code, p, y, dy, ws):
 
 
 @inline
-def project_velocity(code, p, y):
+def project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool:
     """Closed-form velocity projection of kernel ``code``; ``False`` where the model has none."""
     if code == 0:
         meridian.project_velocity(p, y, 0)
@@ -69,7 +74,7 @@ def project_velocity(code, p, y):
 
 
 @inline
-def direction_rate(code, p, y):
+def direction_rate(code: int, p: FloatArray, y: FloatArray) -> float:
     """``psi_nu'`` under kernel ``code`` (0 unless it carries a constraint direction)."""
     if code == 0:
         return meridian.direction_rate(p, y, 0)
@@ -81,7 +86,7 @@ def direction_rate(code, p, y):
 
 
 @inline
-def sync_direction(code, y):
+def sync_direction(code: int, y: FloatArray) -> None:
     """Re-synchronise ``psi_nu`` with the axis azimuth after a step, as kernel ``code`` does."""
     if code == 0:
         meridian.sync_direction(y, 0)
@@ -96,6 +101,6 @@ def sync_direction(code, y):
 
 
 @inline
-def carries_direction(code):
+def carries_direction(code: int) -> bool:
     """Whether kernel ``code`` carries its constraint direction in ``psi_nu``."""
     return code == 3 or code == 4

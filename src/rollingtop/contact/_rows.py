@@ -6,22 +6,40 @@ time derivative of the condition along the motion adds the *bias* ``dJ/dt . u`` 
 acceleration equation (``docs/model.md``, "Dynamics").
 """
 
+from __future__ import annotations
+
 import math
 
 from rollingtop._jit import inline
+from rollingtop._types import Float6, FloatArray
 
 
 @inline
-def row_bias(y, r1, r2, r3, rd1, rd2, rd3, d1, d2, d3, dd1, dd2, dd3):
+def row_bias(
+    y: FloatArray,
+    r1: float,
+    r2: float,
+    r3: float,
+    rd1: float,
+    rd2: float,
+    rd3: float,
+    d1: float,
+    d2: float,
+    d3: float,
+    dd1: float,
+    dd2: float,
+    dd3: float,
+) -> float:
     """``J' u = (d', v) + (r' x d + r x d', w)`` of the contact row along ``d``."""
     q1 = rd2 * d3 - rd3 * d2 + r2 * dd3 - r3 * dd2
     q2 = rd3 * d1 - rd1 * d3 + r3 * dd1 - r1 * dd3
     q3 = rd1 * d2 - rd2 * d1 + r1 * dd2 - r2 * dd1
-    return dd1 * y[0] + dd2 * y[1] + dd3 * y[2] + q1 * y[3] + q2 * y[4] + q3 * y[5]
+    bias: float = dd1 * y[0] + dd2 * y[1] + dd3 * y[2] + q1 * y[3] + q2 * y[4] + q3 * y[5]
+    return bias
 
 
 @inline
-def contact_arm_rate(p, y):
+def contact_arm_rate(p: FloatArray, y: FloatArray) -> Float6:
     """Contact arm ``r = -R gamma - a`` and its rate ``r' = -R gamma'``, ``gamma' = gamma x w``
     (paper eq. 2.1), as six scalars."""
     R, a3 = p[0], p[3]
@@ -38,7 +56,20 @@ def contact_arm_rate(p, y):
 
 
 @inline
-def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
+def contact_row(
+    p: FloatArray,
+    y: FloatArray,
+    k: int,
+    d1: float,
+    d2: float,
+    d3: float,
+    dd1: float,
+    dd2: float,
+    dd3: float,
+    J: FloatArray,
+    bias: FloatArray,
+    dirs: FloatArray,
+) -> None:
     """Write row ``k`` for the no-slip condition ``(vp, d) = 0`` of the contact point.
 
     ``vp = v + w x r`` with ``r = -R gamma - a``, so ``J = (d, r x d)``; the reaction is the
@@ -59,7 +90,9 @@ def contact_row(p, y, k, d1, d2, d3, dd1, dd2, dd3, J, bias, dirs):
 
 
 @inline
-def normal_row(p, y, k, J, bias, dirs):
+def normal_row(
+    p: FloatArray, y: FloatArray, k: int, J: FloatArray, bias: FloatArray, dirs: FloatArray
+) -> None:
     """Row ``k`` for the contact condition ``f1 = (vp, gamma) = 0`` (paper eq. 2.4)."""
     w1, w2, w3 = y[3], y[4], y[5]
     g1, g2, g3 = y[12], y[13], y[14]
@@ -80,7 +113,7 @@ def normal_row(p, y, k, J, bias, dirs):
 
 
 @inline
-def free_forces(p, y):
+def free_forces(p: FloatArray, y: FloatArray) -> Float6:
     """The free forces ``f = (m v x w - m g gamma, (I w) x w)`` as six scalars."""
     m, g, I1, I2, I3 = p[1], p[2], p[4], p[5], p[6]
     v1, v2, v3 = y[0], y[1], y[2]
@@ -96,7 +129,7 @@ def free_forces(p, y):
 
 
 @inline
-def sync_azimuth(y, period):
+def sync_azimuth(y: FloatArray, period: float) -> None:
     """Set ``psi_nu = y[17]`` to the axis azimuth ``psi = atan2(beta3, alpha3)``, the value
     nearest to the present one modulo ``period`` (``2 pi``: continuous; ``pi``: keeping the side
     of a pole, see :mod:`rollingtop.contact.meridian`)."""
@@ -105,7 +138,7 @@ def sync_azimuth(y, period):
 
 
 @inline
-def sync_direction(y, variant):
+def sync_direction(y: FloatArray, variant: int) -> None:
     """``psi_nu`` follows the axis azimuth (:func:`sync_azimuth`, modulo ``2 pi``) wherever it is
     defined (``s > 1e-12``): the default of a model that carries no direction."""
     if math.sqrt(y[8] * y[8] + y[11] * y[11]) > 1e-12:
@@ -113,7 +146,7 @@ def sync_direction(y, variant):
 
 
 @inline
-def direction_rate(p, y, variant):
+def direction_rate(p: FloatArray, y: FloatArray, variant: int) -> float:
     """``psi_nu'`` of a model that carries no direction: 0 (``psi_nu`` is re-synchronised with
     the axis azimuth after every step)."""
     return 0.0

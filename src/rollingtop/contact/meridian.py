@@ -49,15 +49,23 @@ along the fixed ``x`` axis, ``nu = alpha`` (``psi_nu = 0``). An axis within
 through all horizontal directions there) is never used to start a motion.
 """
 
+from __future__ import annotations
+
 import math
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rollingtop._jit import inline, kernel
-from rollingtop.contact._base import ContactModel, contact_arm
+from rollingtop._types import Float6, FloatArray, Workspace
+from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import contact_row, normal_row, sync_azimuth
 from rollingtop.contact._rows import sync_direction as sync_geometric
+
+if TYPE_CHECKING:
+    from rollingtop.body import SphericalTop
 
 #: The variants (kernels of their own, :class:`~rollingtop.contact._base.Kernel`): the pole
 #: cases, with the constraint direction carried in ``psi_nu``; chosen by :func:`select_variant`.
@@ -92,7 +100,7 @@ NO_SPIN_TOLERANCE = 1e-10
 
 
 @inline
-def nu_geometric(y):
+def nu_geometric(y: FloatArray) -> Float6:
     """``nu = (e3 - gamma3 gamma)/s`` and its time derivative along the motion.
 
     ``s = sqrt(gamma1^2 + gamma2^2)`` (free of cancellation near the poles) and
@@ -113,20 +121,23 @@ def nu_geometric(y):
 
 
 @inline
-def psi_nu_rate(p, y, north):
+def psi_nu_rate(p: FloatArray, y: FloatArray, north: bool) -> float:
     """``psi_nu' = M3 / (I1 (1 + gamma3))`` (south) or ``-M3 / (I1 (1 - gamma3))`` (north);
     exactly 0 with no spin, ``|M3| <= NO_SPIN_TOLERANCE |I w|`` (see the module docstring)."""
     M3 = p[6] * y[5]
     Iw1, Iw2 = p[4] * y[3], p[5] * y[4]
     if M3 * M3 <= NO_SPIN_TOLERANCE * NO_SPIN_TOLERANCE * (Iw1 * Iw1 + Iw2 * Iw2 + M3 * M3):
         return 0.0
+    rate: float
     if north:
-        return -M3 / (p[4] * (1.0 - y[14]))
-    return M3 / (p[4] * (1.0 + y[14]))
+        rate = -M3 / (p[4] * (1.0 - y[14]))
+        return rate
+    rate = M3 / (p[4] * (1.0 + y[14]))
+    return rate
 
 
 @inline
-def nu_carried(p, y, north):
+def nu_carried(p: FloatArray, y: FloatArray, north: bool) -> Float6:
     """Carried ``nu = cos(psi_nu) alpha + sin(psi_nu) beta`` (pole cases) and
     ``nu' = psi_nu' (gamma x nu) + nu x w``."""
     c, s = math.cos(y[17]), math.sin(y[17])
@@ -143,7 +154,7 @@ def nu_carried(p, y, north):
 
 
 @inline
-def nu_of(p, y, variant):
+def nu_of(p: FloatArray, y: FloatArray, variant: int) -> Float6:
     """The constraint direction and its derivative for ``variant`` (geometric or carried)."""
     if variant == GEOMETRIC:
         return nu_geometric(y)
@@ -151,7 +162,9 @@ def nu_of(p, y, variant):
 
 
 @kernel
-def rows(p, y, J, bias, dirs, variant):
+def rows(
+    p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
+) -> int:
     """Constraint rows ``f1`` (normal) and ``f2`` (along ``nu``, geometric or carried by
     ``variant``); returns their number, 2."""
     normal_row(p, y, 0, J, bias, dirs)
@@ -161,14 +174,14 @@ def rows(p, y, J, bias, dirs, variant):
 
 
 @inline
-def accel(p, y, dy, ws, variant):
+def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """Closed form of the accelerations (:func:`.rhs_contact` with the row along ``nu``)."""
     n1, n2, n3, nd1, nd2, nd3 = nu_of(p, y, variant)
     return rhs_contact(p, y, dy, ws, True, n1, n2, n3, nd1, nd2, nd3)
 
 
 @inline
-def project_velocity(p, y, variant):
+def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     """Closed form of the velocity projection (:func:`.project_contact` with the row along
     ``nu``)."""
     n1, n2, n3, _, _, _ = nu_of(p, y, variant)
@@ -176,7 +189,7 @@ def project_velocity(p, y, variant):
 
 
 @inline
-def direction_rate(p, y, variant):
+def direction_rate(p: FloatArray, y: FloatArray, variant: int) -> float:
     """``psi_nu'``: :func:`psi_nu_rate` in a pole case, 0 otherwise (``psi_nu`` then follows the
     axis azimuth, :func:`sync_direction`)."""
     if variant == GEOMETRIC:
@@ -185,7 +198,7 @@ def direction_rate(p, y, variant):
 
 
 @inline
-def sync_direction(y, variant):
+def sync_direction(y: FloatArray, variant: int) -> None:
     """Re-synchronise ``psi_nu`` with the axis azimuth after a step: modulo ``2 pi`` with the
     geometric ``nu`` (where the azimuth is defined); in a pole case modulo ``pi`` (keeping the
     side of the pole), only away from the pole (``s > RESYNC_S``) or where the axis moves across
@@ -231,7 +244,7 @@ def pole_case(M3: float, C1: float, scale: float = 0.0) -> str | None:
     return None
 
 
-def select_variant(body, y: np.ndarray) -> str | None:
+def select_variant(body: SphericalTop, y: FloatArray) -> str | None:
     """The variant for a motion from state ``y``: ``"south"`` / ``"north"`` on the pole level
     sets ``C1 = +-M3`` of a symmetric body (within :data:`POLE_CASE_TOLERANCE`), else ``None``
     (the geometric ``nu``). A vertical axis is always on a pole level (``C1 = +-M3`` there, see
@@ -250,14 +263,16 @@ def select_variant(body, y: np.ndarray) -> str | None:
     return None
 
 
-def tau_nu(gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def tau_nu(gamma: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Horizontal unit vectors ``tau = e3 x gamma / s`` and ``nu = (e3 - gamma3 gamma) / s``."""
     g1, g2, g3 = gamma
     s = math.hypot(g1, g2)
     return np.array([-g2, g1, 0.0]) / s, np.array([-g3 * g1 / s, -g3 * g2 / s, s])
 
 
-def vertical_direction(omega, alpha, beta, psi_nu: float = 0.0) -> float:
+def vertical_direction(
+    omega: FloatArray, alpha: FloatArray, beta: FloatArray, psi_nu: float = 0.0
+) -> float:
     """Azimuth ``psi_nu`` of the carried constraint direction at a vertical axis.
 
     ``nu = cos(psi_nu) alpha + sin(psi_nu) beta`` (the convention of :func:`nu_carried`): the
@@ -274,7 +289,7 @@ def vertical_direction(omega, alpha, beta, psi_nu: float = 0.0) -> float:
     return math.atan2(float(nu @ np.asarray(beta)), float(nu @ np.asarray(alpha)))
 
 
-def _singular(body, gamma: np.ndarray) -> str | None:
+def _singular(body: SphericalTop, gamma: FloatArray) -> str | None:
     if gamma[0] == 0.0 and gamma[1] == 0.0 and not body.symmetric:
         return (
             f"the symmetry axis is vertical (gamma3 = {gamma[2]:+.12g}), where the meridian "
@@ -285,7 +300,14 @@ def _singular(body, gamma: np.ndarray) -> str | None:
     return None
 
 
-def _velocity(body, gamma, omega, alpha, beta, free):
+def _velocity(
+    body: SphericalTop,
+    gamma: FloatArray,
+    omega: FloatArray,
+    alpha: FloatArray,
+    beta: FloatArray,
+    free: FreeVelocity,
+) -> FloatArray:
     if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction (module docstring)
         psi_nu = vertical_direction(omega, alpha, beta)
         nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
@@ -297,11 +319,11 @@ def _velocity(body, gamma, omega, alpha, beta, free):
     return -wxr + slip * tau
 
 
-def _symbolic_directions(sp, gamma):
+def _symbolic_directions(sp: ModuleType, gamma: Any) -> list[Any]:
     return [gamma, sp.Matrix([0, 0, 1]) - gamma[2] * gamma]
 
 
-def _symbolic_velocity(gamma, tau, wxr, free):
+def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
     return -wxr + free[0] * tau  # contact velocity along tau only
 
 

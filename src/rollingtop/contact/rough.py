@@ -4,17 +4,27 @@ The three rows are ``(vp, e_i) = 0`` along the body axes: they span the same con
 ``(vp, alpha) = (vp, beta) = (vp, gamma) = 0`` and their directions do not move in the body.
 """
 
+from __future__ import annotations
+
 import math
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rollingtop._jit import inline, kernel
-from rollingtop.contact._base import ContactModel, contact_arm
+from rollingtop._types import Float3, Float6, FloatArray, Workspace
+from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._rows import contact_arm_rate, contact_row, free_forces
+
+if TYPE_CHECKING:
+    from rollingtop.body import SphericalTop
 
 
 @kernel
-def rows(p, y, J, bias, dirs, variant):
+def rows(
+    p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
+) -> int:
     """Constraint rows ``(vp, e1) = (vp, e2) = (vp, e3) = 0``; returns 3."""
     contact_row(p, y, 0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, J, bias, dirs)
     contact_row(p, y, 1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, J, bias, dirs)
@@ -23,7 +33,7 @@ def rows(p, y, J, bias, dirs, variant):
 
 
 @inline
-def _rough_matrix(p, r1, r2, r3):
+def _rough_matrix(p: FloatArray, r1: float, r2: float, r3: float) -> Float6:
     """``A = J M^-1 J^T`` of the rough model's rows ``J_k = (e_k, r x e_k)`` (lower triangle):
     ``A = 1/m + sum_j (r x e_k)_j (r x e_l)_j / I_j`` with ``r x e1 = (0, r3, -r2)``,
     ``r x e2 = (-r3, 0, r1)``, ``r x e3 = (r2, -r1, 0)``."""
@@ -38,7 +48,17 @@ def _rough_matrix(p, r1, r2, r3):
 
 
 @inline
-def _solve3(A11, A21, A22, A31, A32, A33, b1, b2, b3):
+def _solve3(
+    A11: float,
+    A21: float,
+    A22: float,
+    A31: float,
+    A32: float,
+    A33: float,
+    b1: float,
+    b2: float,
+    b3: float,
+) -> Float3:
     """``A^-1 b`` for a 3x3 SPD ``A`` (lower triangle) by Cholesky, in scalars."""
     L11 = math.sqrt(A11)
     L21 = A21 / L11
@@ -56,7 +76,7 @@ def _solve3(A11, A21, A22, A31, A32, A33, b1, b2, b3):
 
 
 @inline
-def accel(p, y, dy, ws, variant):
+def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """Closed form of the accelerations for the rows ``(vp, e_k) = 0``: with
     ``J u = vp = v + w x r`` the multipliers are the contact force ``lambda`` itself,
     ``A lambda = -w x r' - f_v / m - (I^-1 f_w) x r`` (the bias of row ``k`` is
@@ -88,7 +108,7 @@ def accel(p, y, dy, ws, variant):
 
 
 @inline
-def project_velocity(p, y, variant):
+def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     """Closed form of the velocity projection (:func:`rollingtop.dynamics._kernel.project`):
     ``lambda = A^-1 vp``, ``v <- v - lambda / m``, ``w <- w - I^-1 (r x lambda)``."""
     R, m, a3 = p[0], p[1], p[3]
@@ -108,15 +128,22 @@ def project_velocity(p, y, variant):
     y[5] -= (r1 * l2 - r2 * l1) / p[6]
 
 
-def _velocity(body, gamma, omega, alpha, beta, free):
+def _velocity(
+    body: SphericalTop,
+    gamma: FloatArray,
+    omega: FloatArray,
+    alpha: FloatArray,
+    beta: FloatArray,
+    free: FreeVelocity,
+) -> FloatArray:
     return -np.cross(omega, contact_arm(body, gamma))
 
 
-def _symbolic_directions(sp, gamma):
+def _symbolic_directions(sp: ModuleType, gamma: Any) -> list[Any]:
     return [sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0]), sp.Matrix([0, 0, 1])]
 
 
-def _symbolic_velocity(gamma, tau, wxr, free):
+def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
     return -wxr
 
 

@@ -1,43 +1,64 @@
 """Smooth (frictionless) plane: only the contact is kept, ``f1 = (vp, gamma) = 0``."""
 
+from __future__ import annotations
+
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from rollingtop._jit import inline, kernel
-from rollingtop.contact._base import ContactModel, contact_arm
+from rollingtop._types import FloatArray, Workspace
+from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import normal_row
 
+if TYPE_CHECKING:
+    from rollingtop.body import SphericalTop
+
 
 @kernel
-def rows(p, y, J, bias, dirs, variant):
+def rows(
+    p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
+) -> int:
     """Constraint row ``f1``; returns 1."""
     normal_row(p, y, 0, J, bias, dirs)
     return 1
 
 
 @inline
-def accel(p, y, dy, ws, variant):
+def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """Closed form of the accelerations (:func:`.rhs_contact`)."""
     return rhs_contact(p, y, dy, ws, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @inline
-def project_velocity(p, y, variant):
+def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     """Closed form of the velocity projection (:func:`.project_contact`)."""
     project_contact(p, y, False, 0.0, 0.0, 0.0)
 
 
-def _velocity(body, gamma, omega, alpha, beta, free):
-    vx, vy = free["v_horizontal"]
+def _velocity(
+    body: SphericalTop,
+    gamma: FloatArray,
+    omega: FloatArray,
+    alpha: FloatArray,
+    beta: FloatArray,
+    free: FreeVelocity,
+) -> FloatArray:
+    vx, vy = np.asarray(free["v_horizontal"], dtype=float)
     wxr = np.cross(omega, contact_arm(body, gamma))
-    return vx * np.asarray(alpha) + vy * np.asarray(beta) - (wxr @ gamma) * np.asarray(gamma)
+    v: FloatArray = (
+        vx * np.asarray(alpha) + vy * np.asarray(beta) - (wxr @ gamma) * np.asarray(gamma)
+    )
+    return v
 
 
-def _symbolic_directions(sp, gamma):
+def _symbolic_directions(sp: ModuleType, gamma: Any) -> list[Any]:
     return [gamma]
 
 
-def _symbolic_velocity(gamma, tau, wxr, free):
+def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
     return -wxr + free[0] * tau + free[1] * gamma.cross(tau)  # contact velocity horizontal
 
 

@@ -7,9 +7,12 @@ while ``w_tau`` does not, so under a kernel that carries its direction the event
 ``w_tau = (w, nu x gamma)`` with the carried direction ``nu`` (continuous through the pole).
 """
 
+from __future__ import annotations
+
 import math
 
 from rollingtop._jit import kernel
+from rollingtop._types import FloatArray
 from rollingtop.contact import _dispatch
 
 NONE = 0
@@ -20,7 +23,7 @@ EVENTS = {"w_tau": W_TAU}
 
 
 @kernel
-def event_value(code, model_code, y):
+def event_value(code: int, model_code: int, y: FloatArray) -> float:
     """Value of event function ``code`` at state ``y`` under kernel ``model_code``."""
     if code == W_TAU:
         if _dispatch.carries_direction(model_code):
@@ -29,8 +32,10 @@ def event_value(code, model_code, y):
             n2 = c * y[7] + s * y[10]
             n3 = c * y[8] + s * y[11]
             g1, g2, g3 = y[12], y[13], y[14]
-            return (
+            w_tau: float = (
                 y[3] * (n2 * g3 - n3 * g2) + y[4] * (n3 * g1 - n1 * g3) + y[5] * (n1 * g2 - n2 * g1)
             )
-        return y[12] * y[4] - y[13] * y[3]
+            return w_tau
+        s_w_tau: float = y[12] * y[4] - y[13] * y[3]
+        return s_w_tau
     return 1.0

@@ -27,19 +27,33 @@ The kernels called at every stage allocate nothing and are compiled without refe
 (:func:`rollingtop._jit.kernel`); the test suite compiles each of them.
 """
 
+from __future__ import annotations
+
 import math
 
 import numpy as np
 
 from rollingtop._jit import compiled, inline, kernel
+from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact import _dispatch
 from rollingtop.contact._dispatch import rows as constraint_rows
 from rollingtop.contact._rows import free_forces
 from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
 
+__all__ = [
+    "constraint_rows",
+    "diagnostics",
+    "new_workspace",
+    "project",
+    "project_velocity_rows",
+    "reaction",
+    "rhs",
+    "rhs_rows",
+]
+
 
 @compiled()
-def new_workspace():
+def new_workspace() -> Workspace:
     """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels (callable from
     Python and from compiled code)."""
     return (
@@ -52,7 +66,7 @@ def new_workspace():
 
 
 @inline
-def _solve_spd(n, A, x):
+def _solve_spd(n: int, A: FloatArray, x: FloatArray) -> None:
     """Solve ``A z = x`` in place (``x <- z``) for SPD ``A`` given by its lower triangle."""
     for j in range(n):
         d = A[j, j]
@@ -78,7 +92,7 @@ def _solve_spd(n, A, x):
 
 
 @inline
-def _kinematics(code, p, y, dy):
+def _kinematics(code: int, p: FloatArray, y: FloatArray, dy: FloatArray) -> None:
     w1, w2, w3 = y[3], y[4], y[5]
     for base in (6, 9, 12):
         e1, e2, e3 = y[base], y[base + 1], y[base + 2]
@@ -91,7 +105,7 @@ def _kinematics(code, p, y, dy):
 
 
 @kernel
-def rhs(code, p, y, dy, ws):
+def rhs(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) -> int:
     """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
 
     After the call ``ws[4][:nrows]`` holds the multipliers ``lambda`` and ``ws[2]`` the force
@@ -107,7 +121,7 @@ def rhs(code, p, y, dy, ws):
 
 
 @kernel
-def rhs_rows(code, p, y, dy, ws):
+def rhs_rows(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) -> int:
     """:func:`rhs` by the general path: the model's rows from :func:`constraint_rows` and the
     small SPD system solved by Cholesky. Every model has it; the tests hold the closed forms of
     :func:`rhs` to it."""
@@ -137,7 +151,7 @@ def rhs_rows(code, p, y, dy, ws):
 
 
 @kernel
-def reaction(nc, y, ws):
+def reaction(nc: int, y: FloatArray, ws: Workspace) -> tuple[float, float]:
     """Normal force ``N = (F, gamma)`` and tangential force ``|F - N gamma|`` (last :func:`rhs`).
 
     ``F = sum_k lambda_k d_k`` is the constraint force at the contact point (body frame).
@@ -155,7 +169,7 @@ def reaction(nc, y, ws):
 
 
 @kernel
-def project(code, p, y, ws):
+def project(code: int, p: FloatArray, y: FloatArray, ws: Workspace) -> None:
     """Project ``y`` in place onto the constraint manifold.
 
     The frame ``Q = [alpha; beta; gamma]`` goes to its nearest orthogonal matrix by one
@@ -182,7 +196,7 @@ def project(code, p, y, ws):
 
 
 @kernel
-def project_velocity_rows(code, p, y, ws):
+def project_velocity_rows(code: int, p: FloatArray, y: FloatArray, ws: Workspace) -> None:
     """The velocity part of :func:`project` by the general path (rows and a Cholesky solve);
     the tests hold the closed forms to it."""
     J, bias, dirs, A, lam = ws
@@ -208,7 +222,7 @@ def project_velocity_rows(code, p, y, ws):
 
 
 @compiled()
-def diagnostics(code, p, Y, out):
+def diagnostics(code: int, p: FloatArray, Y: FloatArray, out: FloatArray) -> None:
     """Per-sample reactions and constraint errors.
 
     Parameters

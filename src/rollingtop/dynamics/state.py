@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rollingtop._errors import InitialStateError
+from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics import _kernel
@@ -20,7 +22,7 @@ __all__ = ["initial_state", "constraint_residuals", "project_state", "UNIT_TOLER
 UNIT_TOLERANCE = 1e-9
 
 
-def _vector(name: str, value, length: int) -> np.ndarray:
+def _vector(name: str, value: object, length: int) -> FloatArray:
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -32,7 +34,7 @@ def _vector(name: str, value, length: int) -> np.ndarray:
     return arr
 
 
-def _unit(name: str, value) -> np.ndarray:
+def _unit(name: str, value: object) -> FloatArray:
     x = _vector(name, value, 3)
     norm = float(np.linalg.norm(x))
     if abs(norm - 1.0) > UNIT_TOLERANCE:
@@ -43,7 +45,7 @@ def _unit(name: str, value) -> np.ndarray:
     return x / norm
 
 
-def default_alpha(gamma: np.ndarray) -> np.ndarray:
+def default_alpha(gamma: FloatArray) -> FloatArray:
     """Default fixed ``x`` axis: the horizontal projection of the symmetry axis ``e3``.
 
     In the body frame this is ``nu = (e3 - gamma3 gamma)/s``, so the azimuth of the axis starts at
@@ -54,11 +56,12 @@ def default_alpha(gamma: np.ndarray) -> np.ndarray:
         h = e - (e @ gamma) * gamma
         norm = np.linalg.norm(h)
         if norm > 1e-6:
-            return h / norm
+            unit: FloatArray = h / norm
+            return unit
     raise AssertionError("unreachable: some body axis is not vertical")
 
 
-def _vertical(model: ContactModel, gamma: np.ndarray) -> np.ndarray:
+def _vertical(model: ContactModel, gamma: FloatArray) -> FloatArray:
     """``gamma`` set exactly vertical, ``(0, 0, +-1)``, where the model counts it as vertical
     (``sqrt(gamma1^2 + gamma2^2)`` below :attr:`ContactModel.vertical_tolerance`)."""
     if math.hypot(gamma[0], gamma[1]) < model.vertical_tolerance:
@@ -66,14 +69,15 @@ def _vertical(model: ContactModel, gamma: np.ndarray) -> np.ndarray:
     return gamma
 
 
-def _horizontal(alpha: np.ndarray, gamma: np.ndarray) -> np.ndarray:
+def _horizontal(alpha: FloatArray, gamma: FloatArray) -> FloatArray:
     """``alpha`` made exactly orthogonal to ``gamma`` and unit (at a vertical ``gamma`` its third
     component becomes exactly 0, which keeps the frame's zeros exact in the projection)."""
     alpha = alpha - float(alpha @ gamma) * gamma
-    return alpha / np.linalg.norm(alpha)
+    unit: FloatArray = alpha / np.linalg.norm(alpha)
+    return unit
 
 
-def _start_code(body: SphericalTop, model: ContactModel, y: np.ndarray) -> int:
+def _start_code(body: SphericalTop, model: ContactModel, y: FloatArray) -> int:
     """Kernel code used to project a new state: the model's own, except at a vertical axis, where
     a model's variant (:meth:`ContactModel.kernel`: the meridian model's pole variant, which
     carries ``nu``) is the only one defined. Away from the vertical the model's own code keeps the
@@ -83,25 +87,27 @@ def _start_code(body: SphericalTop, model: ContactModel, y: np.ndarray) -> int:
     return model.code
 
 
-def constraint_residuals(body: SphericalTop, model, y: np.ndarray) -> np.ndarray:
+def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -> FloatArray:
     """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
     model = get_model(model)
+    state = np.asarray(y, dtype=float)
     J, bias, dirs, _, _ = _kernel.new_workspace()
-    nc = _kernel.constraint_rows(model.code, body.params, np.asarray(y, dtype=float), J, bias, dirs)
-    return J[:nc] @ np.asarray(y[:6], dtype=float)
+    nc = _kernel.constraint_rows(model.code, body.params, state, J, bias, dirs)
+    residuals: FloatArray = J[:nc] @ state[:6]
+    return residuals
 
 
 def initial_state(
     body: SphericalTop,
     model: str | ContactModel,
     *,
-    gamma: Sequence[float],
-    omega: Sequence[float],
-    alpha: Sequence[float] | None = None,
-    position: Sequence[float] = (0.0, 0.0),
-    v: Sequence[float] | None = None,
+    gamma: ArrayLike,
+    omega: ArrayLike,
+    alpha: ArrayLike | None = None,
+    position: ArrayLike = (0.0, 0.0),
+    v: ArrayLike | None = None,
     free: Mapping[str, object] | None = None,
-) -> np.ndarray:
+) -> FloatArray:
     """Build a constraint-consistent state vector.
 
     Parameters
@@ -193,7 +199,7 @@ def initial_state(
                     f"{model.name!r} (residual {res:.3g}, tolerance {UNIT_TOLERANCE:g})"
                 )
     else:
-        values = {}
+        values: dict[str, float | FloatArray] = {}
         for name, length in model.free_velocity.items():
             raw = free.get(name, 0.0 if length == 1 else [0.0] * length)
             if length == 1:
@@ -209,7 +215,7 @@ def initial_state(
     return y
 
 
-def project_state(body: SphericalTop, model: str | ContactModel, y: np.ndarray) -> np.ndarray:
+def project_state(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -> FloatArray:
     """The state nearest to ``y`` that satisfies ``model``'s constraints.
 
     Orientation, position and ``psi_nu`` are kept; the velocities ``u = (v, w)`` move to the

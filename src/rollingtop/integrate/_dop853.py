@@ -16,18 +16,21 @@ Everything here takes bare arrays and runs in numba's nopython mode; see
 :func:`rollingtop.integrate.driver.integrate` for the validated entry point. The stepping
 functions allocate nothing and are compiled without reference counting (``_nrt=False``; see
 :mod:`rollingtop.dynamics._kernel` for why); the stages come from generated code
-(:mod:`._dop853_stages`).
+(:mod:`._dop853_stages`), the dense output and the roots located on it from :mod:`._dop853_dense`.
 """
+
+from __future__ import annotations
 
 import math
 
 import numpy as np
 
 from rollingtop._jit import compiled, kernel
+from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.dynamics._events import event_value
 from rollingtop.dynamics._kernel import project, reaction, rhs
+from rollingtop.integrate._dop853_dense import dense_eval, event_root, normal_root, prepare_dense
 from rollingtop.integrate._dop853_stages import scaled_errors, stage
-from rollingtop.integrate._dop853_tableau import D
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -77,14 +80,14 @@ MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 
 
 
 @compiled()
-def new_track():
+def new_track() -> FloatArray:
     """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
     the normal force at the last accepted step."""
     return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
 
 
 @kernel
-def update_track(track, t, N, T_force):
+def update_track(track: FloatArray, t: float, N: float, T_force: float) -> None:
     """Fold one evaluation of the contact force into ``track``."""
     if N < track[MIN_NORMAL]:
         track[MIN_NORMAL] = N
@@ -99,7 +102,19 @@ def update_track(track, t, N, T_force):
 
 
 @compiled()
-def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
+def initial_step(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    f: FloatArray,
+    t_end: float,
+    t0: float,
+    rtol: float,
+    atol: float,
+    ytmp: FloatArray,
+    ftmp: FloatArray,
+    ws: Workspace,
+) -> float:
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy.
 
     NaN (and no evaluation of the right-hand side) when the scaled norm of ``y`` or ``f`` is not
@@ -136,7 +151,20 @@ def initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ftmp, ws):
 
 
 @compiled()
-def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
+def start(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    f: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    ev_code: int,
+    out: FloatArray,
+    ytmp: FloatArray,
+    ynew: FloatArray,
+    ws: Workspace,
+) -> tuple[FloatArray, IntArray, FloatArray]:
     """Prepare a run from ``y`` at ``t_eval[0]``: derivative ``f``, reaction tracking, initial
     step, the first sample ``out[0]``. Returns ``(ctrl, counts, track)`` for :func:`run`."""
     nc = rhs(code, p, y, f, ws)
@@ -156,94 +184,27 @@ def start(code, p, y, f, t_eval, rtol, atol, ev_code, out, ytmp, ynew, ws):
 
 
 @kernel
-def _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws):
-    """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
-    n = y.shape[0]
-    for s in range(13, 16):
-        stage(K, s, y, h, ytmp)
-        rhs(code, p, ytmp, K[s], ws)
-    for i in range(n):
-        dlt = ynew[i] - y[i]
-        Fd[0, i] = dlt
-        Fd[1, i] = h * K[0, i] - dlt
-        Fd[2, i] = 2.0 * dlt - h * (K[12, i] + K[0, i])
-        for r in range(4):
-            acc = 0.0
-            for j in range(16):
-                acc += D[r, j] * K[j, i]
-            Fd[3 + r, i] = h * acc
-
-
-@kernel
-def _dense_eval(Fd, y, x, out):
-    """State at the fraction ``x`` of the step: ``y + sum`` of the interpolant's terms."""
-    for i in range(y.shape[0]):
-        acc = 0.0
-        for r in range(6, -1, -1):
-            acc += Fd[r, i]
-            acc *= x if (6 - r) % 2 == 0 else 1.0 - x
-        out[i] = y[i] + acc
-
-
-@kernel
-def _normal_root(code, p, Fd, y, t, h, ytmp, dy, ws):
-    """Time in ``[t, t + h]`` where the normal force crosses zero, by bisection on the dense
-    output (the force is positive at ``x = 0`` and negative at ``x = 1``); 60 halvings.
-    ``ytmp`` and ``dy`` are scratch."""
-    lo, hi = 0.0, 1.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        _dense_eval(Fd, y, mid, ytmp)
-        project(code, p, ytmp, ws)
-        nc = rhs(code, p, ytmp, dy, ws)
-        N, _ = reaction(nc, ytmp, ws)
-        if N >= 0.0:
-            lo = mid
-        else:
-            hi = mid
-    return t + 0.5 * (lo + hi) * h
-
-
-@kernel
-def _event_root(ev_code, code, Fd, y, t, h, ytmp):
-    """Time in ``[t, t + h]`` where the event function changes sign, by bisection on the dense
-    output (60 halvings: to the resolution of the interpolant)."""
-    _dense_eval(Fd, y, 0.0, ytmp)
-    g_lo = event_value(ev_code, code, ytmp)
-    lo, hi = 0.0, 1.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        _dense_eval(Fd, y, mid, ytmp)
-        g = event_value(ev_code, code, ytmp)
-        if (g > 0.0) == (g_lo > 0.0) and g != 0.0:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-@kernel
 def run(
-    code,
-    p,
-    y,
-    f,
-    ctrl,
-    counts,
-    track,
-    t_eval,
-    out,
-    ev_spec,
-    ev_t,
-    ev_y,
-    budget,
-    K,
-    ynew,
-    ytmp,
-    y_old,
-    Fd,
-    ws,
-):
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    f: FloatArray,
+    ctrl: FloatArray,
+    counts: IntArray,
+    track: FloatArray,
+    t_eval: FloatArray,
+    out: FloatArray,
+    ev_spec: IntArray,
+    ev_t: FloatArray,
+    ev_y: FloatArray,
+    budget: int,
+    K: FloatArray,
+    ynew: FloatArray,
+    ytmp: FloatArray,
+    y_old: FloatArray,
+    Fd: FloatArray,
+    ws: Workspace,
+) -> int:
     """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
 
     Parameters
@@ -361,11 +322,11 @@ def run(
         dense_ready = False
         k = counts[NEXT_SAMPLE]
         if k < n_samples and t_eval[k] <= t_new:
-            _prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
+            prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
             counts[NFEV] += 3
             dense_ready = True
             while k < n_samples and t_eval[k] <= t_new:
-                _dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
+                dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
                 project(code, p, out[k], ws)
                 k += 1
             counts[NEXT_SAMPLE] = k
@@ -384,10 +345,10 @@ def run(
         if N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and track[LAST_NORMAL] >= 0.0:
             # first loss of contact: locate N = 0 inside the step on the dense output
             if not dense_ready:
-                _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
+                prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
                 counts[NFEV] += 3
                 dense_ready = True
-            track[T_CONTACT_LOST] = _normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
+            track[T_CONTACT_LOST] = normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
             counts[NFEV] += 60
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
@@ -398,14 +359,14 @@ def run(
             rising = g_new > g_old
             if crossed and (ev_spec[EV_DIRECTION] == 0 or (ev_spec[EV_DIRECTION] > 0) == rising):
                 if not dense_ready:
-                    _prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
+                    prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
                     counts[NFEV] += 3
                     dense_ready = True
-                x = _event_root(ev_spec[EV_CODE], code, Fd, y_old, t, h, ytmp)
+                x = event_root(ev_spec[EV_CODE], code, Fd, y_old, t, h, ytmp)
                 m = counts[N_EVENTS]
                 if m < ev_t.shape[0]:
                     ev_t[m] = t + x * h
-                    _dense_eval(Fd, y_old, x, ev_y[m])
+                    dense_eval(Fd, y_old, x, ev_y[m])
                     project(code, p, ev_y[m], ws)
                 counts[N_EVENTS] += 1
             ctrl[G_OLD] = g_new

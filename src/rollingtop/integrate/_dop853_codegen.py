@@ -10,6 +10,9 @@ this generator and the tableau.
     python -m rollingtop.integrate._dop853_codegen
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterable
 from pathlib import Path
 
 from rollingtop.integrate._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A
@@ -23,11 +26,14 @@ Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 :mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
 """
 
+from __future__ import annotations
+
 from rollingtop._jit import kernel
+from rollingtop._types import FloatArray
 
 
 @kernel
-def stage(K, s, y, h, ytmp):
+def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
     """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
 
     Parameters
@@ -50,7 +56,15 @@ def stage(K, s, y, h, ytmp):
 ERROR_FUNCTION = '''
 
 @kernel
-def scaled_errors(K, y, ynew, rtol, atol, err5, err3):
+def scaled_errors(
+    K: FloatArray,
+    y: FloatArray,
+    ynew: FloatArray,
+    rtol: float,
+    atol: float,
+    err5: FloatArray,
+    err3: FloatArray,
+) -> None:
     """``sum_j E[j] K[j]`` (the 5th- and 3rd-order error estimates over the step size) divided
     by the scale ``atol + max(|y|, |ynew|) rtol``, component by component.
 
@@ -70,10 +84,10 @@ def scaled_errors(K, y, ynew, rtol, atol, err5, err3):
 '''
 
 
-def _combination(coefficients, lhs: str, head: str, tail: str) -> list[str]:
+def _combination(coefficients: Iterable[float], lhs: str, head: str, tail: str) -> list[str]:
     """``lhs = head(c0 * K[0, i] + ...)tail`` with zero terms left out, laid out as
     ``ruff format`` would lay it out."""
-    parts = []
+    parts: list[str] = []
     for j, c in enumerate(coefficients):
         c = float(c)
         if c == 0.0:

@@ -4,11 +4,14 @@ Written by ``python -m rollingtop.integrate._dop853_codegen`` from
 :mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
 """
 
+from __future__ import annotations
+
 from rollingtop._jit import kernel
+from rollingtop._types import FloatArray
 
 
 @kernel
-def stage(K, s, y, h, ytmp):
+def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
     """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
 
     Parameters
@@ -162,7 +165,15 @@ def stage(K, s, y, h, ytmp):
 
 
 @kernel
-def scaled_errors(K, y, ynew, rtol, atol, err5, err3):
+def scaled_errors(
+    K: FloatArray,
+    y: FloatArray,
+    ynew: FloatArray,
+    rtol: float,
+    atol: float,
+    err5: FloatArray,
+    err3: FloatArray,
+) -> None:
     """``sum_j E[j] K[j]`` (the 5th- and 3rd-order error estimates over the step size) divided
     by the scale ``atol + max(|y|, |ynew|) rtol``, component by component.
 

@@ -5,17 +5,20 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypedDict
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rollingtop._errors import IntegrationError
+from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import KERNELS
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._events import EVENTS
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
 
-__all__ = ["IntegrationResult", "integrate", "compile_kernels"]
+__all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
 
 #: Accepted steps per call of the compiled loop (tens of milliseconds). Between calls the driver
 #: is back in Python: the progress callback runs and so do signal handlers (Ctrl-C, SIGTERM;
@@ -23,6 +26,17 @@ __all__ = ["IntegrationResult", "integrate", "compile_kernels"]
 PROGRESS_CHUNK = 20_000
 
 _compile_time: float | None = None
+
+
+class StepReactions(TypedDict, total=False):
+    """Contact reactions monitored at every accepted step (:attr:`IntegrationResult.reactions`,
+    :attr:`rollingtop.Trajectory.step_reactions`)."""
+
+    min_normal_force: float
+    t_min_normal_force: float
+    contact_lost_at: float | None
+    max_friction_ratio: float
+    t_max_friction_ratio: float
 
 
 @dataclass
@@ -39,7 +53,7 @@ class IntegrationResult:
         Time spent in the compiled loop (compilation excluded).
     compile_time_s : float
         Time this call spent compiling or loading the cached kernels (0 once they are loaded).
-    reactions : dict
+    reactions : StepReactions
         ``min_normal_force`` and ``t_min_normal_force``, ``contact_lost_at`` (first accepted step
         with negative normal force, or ``None``), ``max_friction_ratio`` and its time, monitored at
         every accepted step.
@@ -51,21 +65,33 @@ class IntegrationResult:
         Events found beyond ``max_events`` (not stored).
     """
 
-    t: np.ndarray
-    y: np.ndarray
+    t: FloatArray
+    y: FloatArray
     steps: int
     rejected_steps: int
     rhs_evals: int
     wall_time_s: float
     compile_time_s: float
-    reactions: dict = field(default_factory=dict)
-    event_t: np.ndarray = field(default_factory=lambda: np.empty(0))
-    event_y: np.ndarray = field(default_factory=lambda: np.empty((0, N_STATE)))
+    reactions: StepReactions = field(default_factory=StepReactions)
+    event_t: FloatArray = field(default_factory=lambda: np.empty(0))
+    event_y: FloatArray = field(default_factory=lambda: np.empty((0, N_STATE)))
     events_dropped: int = 0
 
 
-def _workspace(n_samples: int):
-    return dict(
+class _Work(TypedDict):
+    """Work arrays of one run of the compiled loop (:func:`._dop853.run`) and its samples."""
+
+    K: FloatArray
+    ynew: FloatArray
+    ytmp: FloatArray
+    y_old: FloatArray
+    Fd: FloatArray
+    ws: Workspace
+    out: FloatArray
+
+
+def _workspace(n_samples: int) -> _Work:
+    return _Work(
         K=np.zeros((16, N_STATE)),
         ynew=np.zeros(N_STATE),
         ytmp=np.zeros(N_STATE),
@@ -98,7 +124,17 @@ def compile_kernels() -> float:
     return _compile_time
 
 
-def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
+def _run_compiled(
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int | None,
+    progress: Callable[[float], None] | None,
+    event: tuple[int, int, int],
+) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
     n = t_eval.shape[0]
     w = _workspace(n)
     ev_code, ev_direction, capacity = event
@@ -153,7 +189,7 @@ def _run_compiled(code, p, y0, t_eval, rtol, atol, max_steps, progress, event):
     return w["out"], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
 
 
-def _raise_for_status(status: int, ctrl: np.ndarray, counts: np.ndarray) -> None:
+def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
     """:class:`IntegrationError` (one line) for a status of ``dop.run`` that ends a run early."""
     t, h = float(ctrl[dop.T]), float(ctrl[dop.H_ABS])
     if status == dop.STEP_TOO_SMALL and np.isnan(h):
@@ -185,9 +221,9 @@ def _raise_for_status(status: int, ctrl: np.ndarray, counts: np.ndarray) -> None
 
 def integrate(
     code: int,
-    params: np.ndarray,
-    y0: np.ndarray,
-    t_eval: np.ndarray,
+    params: ArrayLike,
+    y0: ArrayLike,
+    t_eval: ArrayLike,
     *,
     rtol: float,
     atol: float,

@@ -18,13 +18,16 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from typing import Any, cast
 
 import numba
 import numpy as np
 from numba import prange, types
 from numba.extending import intrinsic
+from numpy.typing import ArrayLike
 
 from rollingtop._jit import compiled
+from rollingtop._types import FloatArray, IntArray
 from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate import _dop853 as dop
@@ -44,21 +47,41 @@ WAIT_SLICE = 0.05
 
 
 @intrinsic
-def _read_flag(typingctx, flag):
+def _read_flag_intrinsic(typingctx: Any, flag: types.Type) -> Any:
     """``flag[0]`` of an int64 array, by an atomic (relaxed) load: another thread sets it while
-    a compiled loop runs, and a plain load could be hoisted out of that loop by the compiler."""
+    a compiled loop runs, and a plain load could be hoisted out of that loop by the compiler.
+
+    The arguments are numba's typing context and the argument's numba type; the result is the
+    signature and the code generator (``None``: not an int64 array)."""
     if not (isinstance(flag, types.Array) and flag.dtype == types.int64):
         return None
 
-    def codegen(context, builder, signature, args):
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
         array = context.make_array(signature.args[0])(context, builder, args[0])
         return builder.load_atomic(array.data, "monotonic", 8)
 
     return types.int64(flag), codegen
 
 
+#: What :func:`_read_flag_intrinsic` is in compiled code. numba's stubs type an intrinsic's call
+#: with its typing function's parameters (the typing context included) and as never returning.
+_read_flag = cast(Callable[[IntArray], int], _read_flag_intrinsic)
+
+
 @compiled()
-def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats, stop):
+def _integrate_one(
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    out: FloatArray,
+    final: FloatArray,
+    stats: FloatArray,
+    stop: IntArray,
+) -> None:
     """Integrate one trajectory; ``out`` (len(t_eval), 18) samples, ``final`` (18,) state,
     ``stats`` (6,): status (``dop.FINISHED``, a failure code, ``dop.BUDGET_EXHAUSTED`` for
     ``max_steps`` accepted steps, ``dop.INTERRUPTED`` when ``stop[0]`` was set), steps,
@@ -96,7 +119,19 @@ def _integrate_one(code, p, y0, t_eval, rtol, atol, max_steps, out, final, stats
 
 
 @compiled(parallel=True, nogil=True)
-def _batch(codes, P, Y0, t_eval, rtol, atol, max_steps, out, final, stats, stop):
+def _batch(
+    codes: IntArray,
+    P: FloatArray,
+    Y0: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    out: FloatArray,
+    final: FloatArray,
+    stats: FloatArray,
+    stop: IntArray,
+) -> None:
     for k in prange(Y0.shape[0]):
         if _read_flag(stop) != 0:
             stats[k, 0] = dop.INTERRUPTED
@@ -125,17 +160,17 @@ def compile_ensemble() -> float:
 
 
 def integrate_batch(
-    codes: np.ndarray,
-    params: np.ndarray,
-    states: np.ndarray,
-    t_eval: np.ndarray,
+    codes: ArrayLike,
+    params: ArrayLike,
+    states: ArrayLike,
+    t_eval: ArrayLike,
     *,
     rtol: float,
     atol: float,
     max_steps: int = 10**7,
     threads: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-):
+) -> tuple[FloatArray, FloatArray, FloatArray, float]:
     """Integrate ``N`` trajectories in parallel.
 
     Parameters
@@ -184,13 +219,15 @@ def integrate_batch(
     # numba's thread count is per thread: the worker takes the caller's (or ``threads``)
     n_threads = numba.get_num_threads()
     if threads is not None:
-        n_threads = max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
+        # numba.config sets its options at run time (no stubs)
+        max_threads: int = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
+        n_threads = max(1, min(int(threads), max_threads))
     step = N if progress is None else BATCH
     stop = np.zeros(1, dtype=np.int64)
     done = [0]  # trajectories finished, written by the worker
     failure: list[BaseException] = []
 
-    def work():
+    def work() -> None:
         try:
             numba.set_num_threads(n_threads)
             for lo in range(0, N, step):

@@ -23,6 +23,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from fractions import Fraction
+from typing import Any
 
 import sympy as sp
 
@@ -66,11 +67,11 @@ class ClaimResult:
     method: str
     seconds: float
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, str | float]:
         return asdict(self)
 
 
-def _time_derivative(expr, field):
+def _time_derivative(expr: Any, field: dict[Any, Any]) -> Any:
     """``d expr/dt`` along ``field`` (a dict symbol -> derivative), with ``s`` and ``theta``."""
     g1, g2, g3 = S.gamma
     extended = dict(field)
@@ -79,7 +80,7 @@ def _time_derivative(expr, field):
     return sum(sp.diff(expr, x) * dx for x, dx in extended.items() if expr.has(x))
 
 
-def _manifold(model: str) -> dict:
+def _manifold(model: str) -> dict[Any, Any]:
     """Rational parametrisation of the constraint manifold: substitutions for gamma, s, v,
     alpha, beta in terms of ``q, k`` (gamma), the free components and ``w``."""
     sq = 2 * q / (1 + q**2)
@@ -102,11 +103,11 @@ def _manifold(model: str) -> dict:
     return subs
 
 
-def _random_rational(rng, lo=-3, hi=3):
+def _random_rational(rng: random.Random, lo: int = -3, hi: int = 3) -> Any:
     return sp.Rational(Fraction(rng.randint(lo * 97, hi * 97), rng.randint(1, 97)))
 
 
-def decide(expr, model: str, symmetric: bool = True, seed: int = 1) -> tuple[bool, str]:
+def decide(expr: Any, model: str, symmetric: bool = True, seed: int = 1) -> tuple[bool, str]:
     """Does ``expr`` (a function of the state, ``s``, ``theta`` and the parameters) vanish on
     the manifold of ``model``? Returns ``(holds, method)``."""
     subs = _manifold(model)
@@ -119,7 +120,7 @@ def decide(expr, model: str, symmetric: bool = True, seed: int = 1) -> tuple[boo
     rng = random.Random(seed)
     symbols = sorted(on.free_symbols, key=lambda x: x.name)
     for _ in range(N_POINTS):
-        values = {}
+        values: dict[Any, Any] = {}
         for x in symbols:
             if x in (q, k):
                 values[x] = sp.Rational(rng.randint(1, 50), rng.randint(51, 120))  # in (0, 1)
@@ -136,7 +137,7 @@ def decide(expr, model: str, symmetric: bool = True, seed: int = 1) -> tuple[boo
     return True, f"exact evaluation at {N_POINTS} random rational points"
 
 
-def _integrals():
+def _integrals() -> dict[str, Any]:
     I = sp.diag(S.I1, S.I2, S.I3)
     Iw = I * S.w
     r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
@@ -158,7 +159,7 @@ def _integrals():
     }
 
 
-def _reduced_claims():
+def _reduced_claims() -> dict[str, tuple[Any, Any]]:
     """The reduced system (3.3) follows from the full one: d/dt of (gamma3, v_tau, w_n, w_tau)
     along the full field minus the right-hand sides of (3.3)."""
     g1, g2, g3 = S.gamma

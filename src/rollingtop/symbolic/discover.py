@@ -11,6 +11,7 @@ paper's ``F6`` comes out, together with the area and Lagrange integrals.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import sympy as sp
 
@@ -26,12 +27,12 @@ class LinearIntegrals:
     """General solution of the ansatz: coefficient functions with free constants."""
 
     q: sp.Symbol  # q = tan(theta/2), gamma3 = (1 - q^2)/(1 + q^2)
-    coefficients: dict  # "A", "B", "C", "D" -> expression in q and the constants
-    constants: tuple  # the free constants
-    conditions: list  # the coefficient equations that were solved
+    coefficients: dict[str, Any]  # "A", "B", "C", "D" -> expression in q and the constants
+    constants: tuple[Any, ...]  # the free constants
+    conditions: list[Any]  # the coefficient equations that were solved
     integral: sp.Expr  # F in the reduced variables
 
-    def basis(self) -> dict:
+    def basis(self) -> dict[Any, Any]:
         """One integral per free constant (that constant 1, the others 0)."""
         out = {}
         for c in self.constants:
@@ -40,7 +41,7 @@ class LinearIntegrals:
         return out
 
 
-def _solve_linear_first_order(eq, f, x, constant):
+def _solve_linear_first_order(eq: Any, f: Any, x: Any, constant: Any) -> Any:
     """Solve ``eq = 0``, linear in ``f(x)`` and ``f'(x)``, by the integrating factor."""
     d = sp.Derivative(f, x)
     e = sp.expand(eq.doit())
@@ -89,8 +90,8 @@ def discover_linear_integrals() -> LinearIntegrals:
     poly = sp.Poly(sp.expand(numerator), vt, wn, wt, w3)
     conditions = [sp.factor(co) for co in poly.coeffs()]
     unknowns = [A, B, C, D]
-    known: dict = {}
-    constants = []
+    known: dict[Any, Any] = {}
+    constants: list[Any] = []
     pending = list(conditions)
     while pending:
         progress = False
@@ -105,7 +106,7 @@ def discover_linear_integrals() -> LinearIntegrals:
                 progress = True
             elif len(left) == 1:
                 f = left[0]
-                constant = 0
+                constant: Any = 0
                 if e.has(sp.Derivative(f, x)):
                     constant = sp.Symbol(f"C{len(constants) + 1}")
                     constants.append(constant)

@@ -24,11 +24,14 @@ contact point, which the normal multiplier absorbs -- the accelerations agree (t
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
+from typing import Any
 
 import sympy as sp
 
+from rollingtop._types import FloatArray
 from rollingtop.contact import get_model
 
 __all__ = ["Symbols", "SYMBOLS", "derive", "Derivation"]
@@ -52,11 +55,12 @@ class Symbols:
     beta: sp.Matrix
 
     @property
-    def params(self):
+    def params(self) -> tuple[Any, ...]:
+        """``(R, m, g, a3, I1, I2, I3)``, the order of :attr:`rollingtop.SphericalTop.params`."""
         return (self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3)
 
     @property
-    def state(self):
+    def state(self) -> tuple[Any, ...]:
         """``(v, w, alpha, beta, gamma)`` as a flat tuple of 15 symbols."""
         return (*self.v, *self.w, *self.alpha, *self.beta, *self.gamma)
 
@@ -65,7 +69,10 @@ def _make_symbols() -> Symbols:
     R, m, a3_ = sp.symbols("R m a3", real=True)
     g = sp.Symbol("g", nonnegative=True)
     I1, I2, I3 = sp.symbols("I1 I2 I3", positive=True)
-    vec = lambda name: sp.Matrix(sp.symbols(f"{name}1:4", real=True))  # noqa: E731
+
+    def vec(name: str) -> Any:
+        return sp.Matrix(sp.symbols(f"{name}1:4", real=True))
+
     return Symbols(R, m, g, a3_, I1, I2, I3, vec("v"), vec("w"), vec("gamma"), vec("alpha"),
                    vec("beta"))  # fmt: skip
 
@@ -73,11 +80,11 @@ def _make_symbols() -> Symbols:
 SYMBOLS = _make_symbols()
 
 
-def _cross(a, b):
+def _cross(a: Any, b: Any) -> Any:
     return sp.Matrix(a).cross(sp.Matrix(b))
 
 
-def constraints(model: str, S: Symbols = SYMBOLS) -> list:
+def constraints(model: str, S: Symbols = SYMBOLS) -> list[Any]:
     """The model's constraints ``c_k(u, gamma) = (vp, d_k)``, linear in ``u``."""
     r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
     vp = S.v + _cross(S.w, r)
@@ -92,8 +99,8 @@ class Derivation:
     model: str
     symmetric: bool
     udot: sp.Matrix  # (6,) accelerations (v', w')
-    field: dict  # symbol -> time derivative, for v, w, alpha, beta, gamma
-    constraints: list
+    field: dict[Any, Any]  # symbol -> time derivative, for v, w, alpha, beta, gamma
+    constraints: list[Any]
     lagrangian: sp.Expr
 
 
@@ -136,7 +143,9 @@ def derive(model: str, symmetric: bool = True) -> Derivation:
     return Derivation(model, symmetric, udot, field, cons, L)
 
 
-def rhs_function(model: str, symmetric: bool = True):
+def rhs_function(
+    model: str, symmetric: bool = True
+) -> Callable[[FloatArray, FloatArray], list[float]]:
     """A NumPy function ``f(params, y) -> y'[:15]`` of the derived field (``y`` in the kernel's
     layout ``(v, w, alpha, beta, gamma, ...)``), for comparison with the compiled kernel."""
     S = SYMBOLS
@@ -144,7 +153,8 @@ def rhs_function(model: str, symmetric: bool = True):
     exprs = [d.field[x] for x in S.state]
     f = sp.lambdify([S.params, S.state], exprs, "numpy")
 
-    def rhs(params, y):
-        return f(tuple(params), tuple(y[:15]))
+    def rhs(params: FloatArray, y: FloatArray) -> list[float]:
+        values: list[float] = f(tuple(params), tuple(y[:15]))
+        return values
 
     return rhs
