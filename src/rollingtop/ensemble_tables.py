@@ -103,7 +103,9 @@ def states_from_table(scenario: Scenario, columns: Columns) -> FloatArray:
             fields["alpha"] = list(base.alpha)
         if base.v is not None:
             fields["v"] = list(base.v)
-        free = {k: (list(v) if np.ndim(v) else v) for k, v in base.free.items()}
+        free: dict[str, float | list[float]] = {
+            k: (float(v) if isinstance(v, int | float) else list(v)) for k, v in base.free.items()
+        }
         for name, values in columns.items():
             key, i = allowed[name]
             x = float(values[row])
@@ -115,7 +117,8 @@ def states_from_table(scenario: Scenario, columns: Columns) -> FloatArray:
                 if i is None:
                     free[key] = x
                 else:
-                    vec = list(free.get(key, [0.0] * model.free_velocity[key]))
+                    old = free.get(key, [0.0] * model.free_velocity[key])
+                    vec = [old] if isinstance(old, float) else list(old)
                     vec[i] = x
                     free[key] = vec
             else:
