@@ -114,7 +114,7 @@ def initial_state(
     ----------
     body : SphericalTop
     model : str or ContactModel
-        Contact model (``"meridian"``, ``"smooth"``, ``"rough"``).
+        Contact model, or its name (a key of :data:`rollingtop.contact.MODELS`).
     gamma : array_like, shape (3,)
         Upward vertical in the body frame; unit within 1e-9 (then normalised exactly).
     omega : array_like, shape (3,)
