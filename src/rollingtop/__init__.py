@@ -27,7 +27,10 @@ from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario,
 from rollingtop.simulate import simulate, simulate_models
 from rollingtop.trajectory import Trajectory
 
-__version__ = _metadata.version("rollingtop")  # the one version string: pyproject.toml
+try:  # the one version string: pyproject.toml, read from the installed metadata
+    __version__ = _metadata.version("rollingtop")
+except _metadata.PackageNotFoundError:  # a source tree on sys.path, not installed
+    __version__ = "0+unknown"
 
 __all__ = [
     "BodyError",

@@ -20,7 +20,9 @@ Python signature of each kernel.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, TypeVar, cast
 
 from numba import njit as _numba_njit
@@ -51,3 +53,58 @@ def compiled(**options: Any) -> Callable[[F], F]:
         return cast(F, njit(**{**BASE_OPTIONS, **options})(func))
 
     return decorate
+
+
+class CacheNotSaved(UserWarning):
+    """numba could not save a compiled kernel to its on-disk cache (full disk, file-size limit,
+    permissions): the run goes on with the kernel compiled in memory."""
+
+
+#: Most failed cache saves tolerated in one :func:`call` (each repetition compiles at least one
+#: more function, which numba keeps in memory; the package has fewer compiled functions).
+MAX_SAVE_FAILURES = 200
+_warned = False
+
+R = TypeVar("R")
+
+
+def _from_numba_cache(exc: OSError) -> bool:
+    """Whether ``exc`` was raised while numba saved its cache (``numba/core/caching.py``)."""
+    tb = exc.__traceback__
+    while tb is not None:
+        path = Path(tb.tb_frame.f_code.co_filename)
+        if path.name == "caching.py" and "numba" in path.parts:
+            return True
+        tb = tb.tb_next
+    return False
+
+
+def call(func: Callable[..., R], *args: Any) -> R:
+    """Call the compiled ``func`` from Python, tolerating a failed save of numba's cache.
+
+    numba compiles a function on first use, registers the machine code in memory, and only then
+    saves it to its cache. An ``OSError`` from that save (``ENOSPC``, ``EFBIG`` under
+    ``ulimit -f``, ``EACCES``) escapes from the call that triggered the compilation, although the
+    code is ready: every command would fail on a full disk. numba has no option for this, so the
+    call is repeated here (numba then finds the code in memory, or compiles the next function of
+    the chain), and the failure is reported once, as a :class:`CacheNotSaved` warning. Only
+    supported behaviour is relied on: the exception, and the function kept in memory.
+    """
+    global _warned
+    for _ in range(MAX_SAVE_FAILURES):
+        try:
+            return func(*args)
+        except OSError as exc:
+            if not _from_numba_cache(exc):
+                raise
+            if not _warned:
+                _warned = True
+                where = exc.filename or "numba's cache folder"
+                warnings.warn(
+                    CacheNotSaved(
+                        f"compiled kernels not saved to {where} ({exc.strerror or exc}): they "
+                        "are compiled again in every run until it can be written"
+                    ),
+                    stacklevel=2,
+                )
+    return func(*args)

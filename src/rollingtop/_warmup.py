@@ -8,8 +8,8 @@ first run after an installation pays for the compilation (about half a minute on
 numba invalidates a cached function when its own source file changes, not when a function it
 calls from another file does; installing rollingtop rewrites every file, so an installation never
 runs stale code. An editable (development) checkout should keep its cache in a folder named by the
-sources (the test suite does: ``tests/conftest.py``) or clear ``__pycache__`` after editing a
-kernel. Nothing here deletes files.
+sources (the test suite does: the repository's root ``conftest.py``) or clear ``__pycache__``
+after editing a kernel. Nothing here deletes files.
 """
 
 from __future__ import annotations

@@ -49,15 +49,14 @@ def check_ensemble_memory(n: int, samples: int | None, what: str = "the ensemble
     check_memory(label, needed)
 
 
-_VECTOR_KEYS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3, "v_horizontal": 2}
+_VECTOR_KEYS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3}
 
 
 def _column_map(model: ContactModel) -> dict[str, tuple[str, int | None]]:
     """Column name -> (initial-condition key, component index or None)."""
     cols: dict[str, tuple[str, int | None]] = {}
-    for key, n in _VECTOR_KEYS.items():
-        if key == "v_horizontal" and "v_horizontal" not in model.free_velocity:
-            continue
+    vectors = _VECTOR_KEYS | {k: n for k, n in model.free_velocity.items() if n > 1}
+    for key, n in vectors.items():
         for i in range(n):
             cols[f"{key}{i + 1}"] = (key, i)
     for key, n in model.free_velocity.items():

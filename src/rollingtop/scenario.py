@@ -33,7 +33,7 @@ import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -58,8 +58,9 @@ from rollingtop.integrate.options import (
     IntegrationOptions,
 )
 from rollingtop.io import read_input_text
-from rollingtop.reduction.level import LevelSet
-from rollingtop.reduction.start import level_of_state, reduced_energy, start_on_level
+
+if TYPE_CHECKING:  # the reduction (and scipy.optimize) is imported where a level is needed
+    from rollingtop.reduction.level import LevelSet
 
 __all__ = [
     "BYTES_PER_SAMPLE",
@@ -135,6 +136,8 @@ class LevelSpec:
 
     def level_set(self, body: SphericalTop) -> LevelSet:
         """The :class:`~rollingtop.reduction.LevelSet` ``(M3, C1, C2)`` of ``body``."""
+        from rollingtop.reduction.level import LevelSet
+
         return LevelSet(body, self.M3, self.C1, self.C2)
 
 
@@ -166,6 +169,8 @@ class Scenario:
             y0 = self.initial.state(self.body, self.model)
         elif spec is not None and spec.h is not None:
             self._require_reduction("an initial state built from [level]")
+            from rollingtop.reduction.start import start_on_level
+
             y0 = start_on_level(spec.level_set(self.body), spec.h, gamma3=spec.gamma3,
                                 branch=spec.branch, phi=spec.phi, psi=spec.psi)  # fmt: skip
         object.__setattr__(self, "y0", y0)
@@ -192,6 +197,8 @@ class Scenario:
         self._require_reduction("the reduction to one degree of freedom")
         if self.level is not None:
             return self.level.level_set(self.body)
+        from rollingtop.reduction.start import level_of_state
+
         return level_of_state(self.body, self.require_state())
 
     def level_h(self) -> float:
@@ -201,6 +208,8 @@ class Scenario:
             return self.level.h
         if self.level is not None and self.initial is None:
             raise ScenarioError("no h: give h in [level] (or --h)")
+        from rollingtop.reduction.start import reduced_energy
+
         return reduced_energy(self.body, self.require_state())
 
     def with_overrides(self, **overrides: Any) -> Scenario:

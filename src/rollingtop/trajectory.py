@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rollingtop._jit import call
 from rollingtop._json import finite_or_none
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
@@ -159,7 +160,7 @@ class Trajectory(NetCDFOutput):
     @functools.cached_property
     def _diagnostics(self) -> FloatArray:
         out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
-        _kernel.diagnostics(self._code, self.body.params, np.ascontiguousarray(self.y), out)
+        call(_kernel.diagnostics, self._code, self.body.params, np.ascontiguousarray(self.y), out)
         return out
 
     @property

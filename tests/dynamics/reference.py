@@ -1,6 +1,7 @@
-"""A plain NumPy implementation of the equations of motion, written from MODEL.md for the tests.
+"""A plain NumPy implementation of the equations of motion, written from docs/model.md for the
+tests.
 
-It does not import the package. It solves the full linear system of MODEL.md, "Dynamics", for
+It does not import the package. It solves the full linear system of docs/model.md, "Dynamics", for
 the unknowns ``(v', w', lambda_1..k)`` with ``numpy.linalg.solve`` (the package eliminates the
 accelerations and factorises the multiplier block instead), and differentiates the constraints
 in the vector form ``d/dt (vp, d) = (v' + w' x r + w x r', d) + (vp, d') = 0`` with
@@ -24,7 +25,7 @@ def directions(model, alpha, beta, gamma, w):
         pdot = -g3dot * gamma - g3 * gdot
         dirs.append((p / s, pdot / s - p * sdot / s**2))
     elif model == "rough":
-        # vp = 0 as f1 plus (vp, alpha) = (vp, beta) = 0 (MODEL.md; the package uses body axes)
+        # vp = 0 as f1 plus (vp, alpha) = (vp, beta) = 0 (docs/model.md; the package uses body axes)
         dirs += [(alpha, np.cross(alpha, w)), (beta, np.cross(beta, w))]
     elif model != "smooth":
         raise ValueError(model)

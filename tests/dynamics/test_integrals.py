@@ -1,4 +1,4 @@
-"""First integrals: conserved where MODEL.md says, and the models differ where physics says."""
+"""First integrals: conserved where docs/model.md says, and the models differ where physics says."""
 
 import numpy as np
 import pytest
@@ -69,7 +69,7 @@ def test_models_differ_where_physics_says(long_run):
 
 
 def test_jellett_area_lagrange_identity(long_run):
-    """MODEL.md: F4 + a3 F3 + R F5 = 0 holds identically (it is a kinematic identity)."""
+    """docs/model.md: F4 + a3 F3 + R F5 = 0 holds identically (it is a kinematic identity)."""
     body = long_run.body
     F = evaluate(body, long_run.y, ["jellett", "lagrange", "area"])
     np.testing.assert_allclose(

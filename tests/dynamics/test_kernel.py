@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rollingtop import SphericalTop, initial_state, simulate
-from rollingtop.contact import get_model
+from rollingtop.contact import KERNELS, get_model
 from rollingtop.dynamics import _kernel
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
 
@@ -61,7 +61,7 @@ def random_body(rng):
 def test_rhs_matches_reference_at_random_states(model, rng):
     dy = np.empty(18)
     ws = _kernel.new_workspace()
-    code = {"meridian": 0, "smooth": 1, "rough": 2}[model]
+    code = get_model(model).code
     for _ in range(50):
         body = random_body(rng)
         y = random_state(rng, body, model)
@@ -144,11 +144,13 @@ def _off_manifold_state(rng, code):
     return y
 
 
-@pytest.mark.parametrize("code", [0, 1, 2, 3, 4])
+@pytest.mark.parametrize(
+    "code", [k.code for k in KERNELS], ids=[f"{k.model}-{k.variant}" for k in KERNELS]
+)
 def test_closed_forms_equal_the_general_row_path(code, rng):
-    """Every model's closed-form right-hand side, reaction and velocity projection against the
+    """Every kernel's closed-form right-hand side, reaction and velocity projection against the
     general path (the model's rows and a Cholesky solve), also off the constraint manifold and in
-    the pole variants (codes 3, 4) with a carried psi_nu."""
+    the pole variants with a carried psi_nu."""
     dy, dy_rows = np.empty(18), np.empty(18)
     ws = _kernel.new_workspace()
     for _ in range(30):

@@ -4,8 +4,8 @@ Both poles are pole levels at once; the simulator takes the south variant, whose
 direction must then not turn (``psi_nu' = 0``), also at the north pole where its formula
 ``M3 / (I1 (1 + gamma3))`` is 0/0, and also when round-off leaves ``w3`` a few ulps off 0.
 
-Independent reference: with ``M3 = C1 = 0`` and ``v_tau = 0`` (so ``C2 = 0``) MODEL.md's reduced
-system is a pendulum of variable mass, ``h = rho(theta) theta'^2 / 2 + m g a3 cos(theta)``,
+Independent reference: with ``M3 = C1 = 0`` and ``v_tau = 0`` (so ``C2 = 0``) docs/model.md's
+reduced system is a pendulum of variable mass, ``h = rho(theta) theta'^2 / 2 + m g a3 cos(theta)``,
 ``rho = I1 + m (a3^2 + R^2 + 2 a3 R cos(theta))``; its period, ``T = 2 int sqrt(rho / (2 (h - U)))
 dtheta`` between the turning points (rocking about ``gamma3 = -1``, where the CoM is lowest for
 ``a3 > 0``: height ``R + a3 gamma3``), or over a full turn (rolling over), is computed with mpmath.

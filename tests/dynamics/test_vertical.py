@@ -2,7 +2,7 @@
 in the pole variant that carries ``nu``; a spin above the threshold stays vertical, one below
 falls.
 
-The threshold is derived here independently of the package, from MODEL.md's effective potential
+The threshold is derived here independently of the package, from docs/model.md's effective potential
 (section "One degree of freedom") written in the signed nutation angle: on the pole level of a
 vertical start (``C1 = +-M3``; ``v_tau = 0`` gives ``C2 = I1 v_tau - M3 a3 theta_pole``)
 ``U'(pole) = 0`` and the sleeping top is stable iff ``U''(pole) > 0``, which sympy reduces to
@@ -63,7 +63,7 @@ def critical_w3(b, gamma3):
 
 @pytest.mark.slow
 def test_threshold_derived_with_sympy():
-    """U''(pole) from MODEL.md's U by sympy series, against the closed form (both poles)."""
+    """U''(pole) from docs/model.md's U by sympy series, against the closed form (both poles)."""
     th, phi = sp.symbols("theta phi", real=True)
     M3, I1, m, g, R = sp.symbols("M3 I1 m g R", positive=True)
     a3 = sp.symbols("a3", real=True)

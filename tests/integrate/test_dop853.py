@@ -8,6 +8,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from rollingtop import ContactLostWarning, IntegrationError, SphericalTop, simulate
+from rollingtop.contact import get_model
 from rollingtop.dynamics import _kernel
 from rollingtop.integrate import integrate
 from rollingtop.integrate._dop853_stages import stage
@@ -16,6 +17,9 @@ from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
 
 from ..conftest import GAMMA0, OMEGA0, PAPER_BODY
 from ..dynamics import reference
+
+#: Kernel code of the paper's model (no pole variant).
+MERIDIAN = get_model("meridian").code
 
 
 def scenario(t_end=20.0, rtol=1e-10, atol=None, samples=101, model="meridian", **initial):
@@ -34,9 +38,11 @@ def test_dense_output_matches_integration_to_each_sample():
     """A sample from the 7th-order interpolant equals integrating to that time as the end point."""
     sc = scenario(t_end=3.0, rtol=1e-12, samples=7)
     t_eval = np.array([0.0, 0.37, 1.1, 1.234567, 2.9])
-    dense = integrate(0, sc.body.params, sc.y0, t_eval, rtol=1e-12, atol=1e-14).y
+    dense = integrate(MERIDIAN, sc.body.params, sc.y0, t_eval, rtol=1e-12, atol=1e-14).y
     for k in range(1, len(t_eval)):
-        direct = integrate(0, sc.body.params, sc.y0, t_eval[[0, k]], rtol=1e-12, atol=1e-14).y[-1]
+        direct = integrate(
+            MERIDIAN, sc.body.params, sc.y0, t_eval[[0, k]], rtol=1e-12, atol=1e-14
+        ).y[-1]
         np.testing.assert_allclose(dense[k], direct, rtol=0, atol=1e-10)
 
 
@@ -89,10 +95,10 @@ def test_fixed_step_convergence_order_is_eight(order_reference):
         h = ORDER_T_END / n
         y, ynew = sc.y0.copy(), np.empty(18)
         for _ in range(n):
-            _kernel.rhs(0, p, y, K[0], ws)
+            _kernel.rhs(MERIDIAN, p, y, K[0], ws)
             for s in range(1, 12):
                 stage(K, s, y, h, ynew)
-                _kernel.rhs(0, p, ynew, K[s], ws)
+                _kernel.rhs(MERIDIAN, p, ynew, K[s], ws)
             stage(K, 12, y, h, ynew)  # the solution (first same as last)
             y[:] = ynew
         errors.append(np.linalg.norm(y[:17] - ref))
@@ -106,7 +112,7 @@ def test_adaptive_steps_grow_like_rtol_to_the_minus_one_eighth(order_reference):
     rtols = np.array([1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11])
     errors, steps = [], []
     for rtol in rtols:
-        r = integrate(0, sc.body.params, sc.y0, np.array([0.0, ORDER_T_END]), rtol=rtol,
+        r = integrate(MERIDIAN, sc.body.params, sc.y0, np.array([0.0, ORDER_T_END]), rtol=rtol,
                       atol=rtol / 100)  # fmt: skip
         errors.append(np.linalg.norm(r.y[-1, :17] - ref))
         steps.append(r.steps)
@@ -127,11 +133,11 @@ def test_step_count_close_to_scipy_dop853():
 
     def f(t, y):
         dy = np.empty(18)
-        _kernel.rhs(0, sc.body.params, np.ascontiguousarray(y), dy, ws)
+        _kernel.rhs(MERIDIAN, sc.body.params, np.ascontiguousarray(y), dy, ws)
         return dy
 
     sol = solve_ivp(f, (0, 20.0), sc.y0, method="DOP853", rtol=1e-10, atol=1e-12)
-    ours = integrate(0, sc.body.params, sc.y0, np.array([0.0, 20.0]), rtol=1e-10, atol=1e-12)
+    ours = integrate(MERIDIAN, sc.body.params, sc.y0, np.array([0.0, 20.0]), rtol=1e-10, atol=1e-12)
     scipy_steps = len(sol.t) - 1
     assert abs(ours.steps - scipy_steps) <= 0.1 * scipy_steps
     assert ours.rhs_evals >= 12 * ours.steps
@@ -206,7 +212,7 @@ def test_friction_ratio_tracked_at_steps_covers_samples():
 def test_rejects_bad_t_eval():
     sc = scenario()
     with pytest.raises(ValueError, match="strictly increasing"):
-        integrate(0, sc.body.params, sc.y0, np.array([0.0, 1.0, 1.0]), rtol=1e-8, atol=1e-10)
+        integrate(MERIDIAN, sc.body.params, sc.y0, np.array([0.0, 1.0, 1.0]), rtol=1e-8, atol=1e-10)
 
 
 def test_events_on_w_tau_are_turning_points_of_gamma3():
@@ -235,14 +241,16 @@ def test_event_capacity_keeps_the_first_events_and_counts_the_rest():
     sc = scenario(t_end=30.0, rtol=1e-10)
     p = sc.body.params
     t_eval = np.array([0.0, 30.0])
-    full = integrate(0, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau", event_direction=1)
+    full = integrate(
+        MERIDIAN, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau", event_direction=1
+    )
     assert len(full.event_t) == 10 and full.events_dropped == 0
-    capped = integrate(0, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau",
+    capped = integrate(MERIDIAN, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau",
                        event_direction=1, max_events=3)  # fmt: skip
     assert capped.events_dropped == 7
     np.testing.assert_array_equal(capped.event_t, full.event_t[:3])
     np.testing.assert_array_equal(capped.event_y, full.event_y[:3])
-    none = integrate(0, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12)
+    none = integrate(MERIDIAN, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12)
     assert none.event_t.shape == (0,) and none.event_y.shape == (0, 18)
     assert none.events_dropped == 0
 

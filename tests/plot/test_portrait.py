@@ -1,6 +1,6 @@
-"""The phase portrait of paper Fig. 5: every plotted point against MODEL.md's one-degree-of-freedom
-formulas written with mpmath (tests/reduction/plain.py), and the shading against the NumPy
-reference's normal force."""
+"""The phase portrait of paper Fig. 5: every plotted point against docs/model.md's
+one-degree-of-freedom formulas written with mpmath (tests/reduction/plain.py), and the shading
+against the NumPy reference's normal force."""
 
 import matplotlib.colors as mcolors
 import mpmath as mp

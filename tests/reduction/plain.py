@@ -1,7 +1,7 @@
-"""MODEL.md's one-degree-of-freedom formulas, written plainly with mpmath for the tests.
+"""docs/model.md's one-degree-of-freedom formulas, written plainly with mpmath for the tests.
 
 Independent of the package (which works in a signed nutation angle with analytic derivatives):
-these follow ``MODEL.md``, "One degree of freedom" and "Reduced variables", literally, in the
+these follow ``docs/model.md``, "One degree of freedom" and "Reduced variables", literally, in the
 paper's variable ``gamma3``, at any mpmath precision.
 """
 
@@ -9,7 +9,7 @@ import mpmath as mp
 
 
 def U(b, M3, C1, C2, g3):
-    """``U(gamma3)`` of MODEL.md."""
+    """``U(gamma3)`` of docs/model.md."""
     g3 = mp.mpf(g3)
     s = mp.sqrt(1 - g3**2)
     I1v = (b.R * (M3 - C1 * g3) + b.a3 * (M3 * g3 - C1)) / s + C2 + M3 * b.a3 * mp.acos(g3)

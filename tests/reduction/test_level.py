@@ -1,4 +1,4 @@
-"""Effective potential and level sets against MODEL.md's formulas evaluated with mpmath."""
+"""Effective potential and level sets against docs/model.md's formulas evaluated with mpmath."""
 
 import math
 
@@ -64,11 +64,11 @@ def test_pole_cases_are_regular(paper_body, C1, pole, theta0):
             assert np.isfinite([level.U(t), level.dU(t), level.d2U(t), level.w_n(t)]).all()
     with mp.workdps(30):
         for t in (0.3, 0.7) if pole == "south" else (math.pi - 0.3, math.pi - 0.7):
-            exact = plain.U(paper_body, 1, C1, -0.3, mp.cos(t))  # MODEL.md with C1 = +-M3 exactly
+            exact = plain.U(paper_body, 1, C1, -0.3, mp.cos(t))  # model sheet, C1 = +-M3 exactly
             assert level.U(t) == pytest.approx(float(exact), rel=U_RTOL)
             d1 = mp.diff(lambda x: plain.U(paper_body, 1, C1, -0.3, mp.cos(x)), t)
             assert level.dU(t) == pytest.approx(float(d1), rel=DU_RTOL)
-    # at the pole U is MODEL.md's limit: only the v_tau term and gravity remain
+    # at the pole U is docs/model.md's limit: only the v_tau term and gravity remain
     I1v = -0.3 + (1.0 * paper_body.a3 * theta0)
     expected = paper_body.m * I1v**2 / (2 * paper_body.I1**2) + paper_body.m * paper_body.g * (
         paper_body.a3 * math.cos(theta0)

@@ -46,7 +46,7 @@ DISTANCES = [
 def oracle(b: dict, M3: float, C1: float, C2: float, h: float, pole: str):
     """The orbit next to the pole's wall by mpmath (40 digits), in the distance q from the pole.
 
-    MODEL.md's U(gamma3) with gamma3 = cos(theta), theta = q (south) or pi - q (north); the
+    docs/model.md's U(gamma3) with gamma3 = cos(theta), theta = q (south) or pi - q (north); the
     turning points by bracketing on a log grid and refining; the period
     2 int sqrt(rho / (2 (h - U))) and delta_psi = 2 int psi' dt, psi' = (C1 - M3 gamma3) /
     (I1 s^2), by tanh-sinh quadrature with break points that resolve the wall.

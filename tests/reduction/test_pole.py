@@ -31,7 +31,7 @@ def pole_h(level):
 
 
 def U_theta_plain(b, M3, C1, C2, theta):
-    """MODEL.md's U with s = sin(theta), arccos -> theta (signed), evaluated with mpmath."""
+    """docs/model.md's U with s = sin(theta), arccos -> theta (signed), evaluated with mpmath."""
     s, c = mp.sin(theta), mp.cos(theta)
     P = (b.R * (M3 - C1 * c) + b.a3 * (M3 * c - C1)) / s + C2 + M3 * b.a3 * theta
     return (
@@ -49,7 +49,7 @@ def test_reduced_orbit_through_the_pole(paper_body, C1, C2):
     assert orbit.pole_passage and "passes through the pole" in orbit.note
     assert (orbit.gamma3_max if C1 > 0 else orbit.gamma3_min) == (1.0 if C1 > 0 else -1.0)
     assert orbit.theta_min < level.pole_theta < orbit.theta_max
-    # period against mpmath in the signed angle, MODEL.md's formula with C1 = +-M3 exactly
+    # period against mpmath in the signed angle, docs/model.md's formula with C1 = +-M3 exactly
     with mp.workdps(30):
 
         def f(t):

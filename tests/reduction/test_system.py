@@ -1,5 +1,5 @@
-"""The reduced system (3.3): agrees with MODEL.md, with the full simulation, keeps its integrals
-and its invariant measure."""
+"""The reduced system (3.3): agrees with docs/model.md, with the full simulation, keeps its
+integrals and its invariant measure."""
 
 import mpmath as mp
 import numpy as np

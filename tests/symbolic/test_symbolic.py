@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from rollingtop.contact import MODELS
 from rollingtop.dynamics import _kernel
 from rollingtop.symbolic import check, claims_for, discover_linear_integrals, rhs_function, verify
 from rollingtop.symbolic.claims import Claim, _integrals, s_sym, theta_sym
@@ -16,10 +17,9 @@ from ..dynamics.test_kernel import random_body, random_state
 from ..test_cli import run_cli
 
 AGREE_RTOL = 1e-12  # issue 6: symbolic right-hand side vs compiled kernel
-CODES = {"meridian": 0, "smooth": 1, "rough": 2}
 
 
-@pytest.mark.parametrize("model", ["meridian", "smooth", "rough"])
+@pytest.mark.parametrize("model", list(MODELS))
 def test_derived_equations_match_the_kernel(model, rng):
     general = rhs_function(model, symmetric=False)
     symmetric = rhs_function(model, symmetric=True)
@@ -28,7 +28,7 @@ def test_derived_equations_match_the_kernel(model, rng):
     for _ in range(40):
         body = random_body(rng)
         y = random_state(rng, body, model)
-        _kernel.rhs(CODES[model], body.params, y, dy, ws)
+        _kernel.rhs(MODELS[model].code, body.params, y, dy, ws)
         got = np.array(general(body.params, y), dtype=float)
         scale = np.max(np.abs(dy[:15]))
         np.testing.assert_allclose(got, dy[:15], rtol=0, atol=AGREE_RTOL * scale)
@@ -37,7 +37,7 @@ def test_derived_equations_match_the_kernel(model, rng):
         p[4] = p[5] = max(p[4], p[5])  # symmetric, triangle inequality kept
         sym_body = type(body)(R=p[0], m=p[1], g=p[2], a3=p[3], I1=p[4], I3=p[6])
         y = random_state(rng, sym_body, model)
-        _kernel.rhs(CODES[model], p, y, dy, ws)
+        _kernel.rhs(MODELS[model].code, p, y, dy, ws)
         got = np.array(symmetric(p, y), dtype=float)
         np.testing.assert_allclose(got, dy[:15], rtol=0, atol=AGREE_RTOL * np.abs(dy).max())
 

@@ -28,7 +28,7 @@ from rollingtop.contact import meridian, rough, smooth
 from rollingtop.contact._base import ContactModel, Kernel
 
 #: The registry: the model modules, one line each. Kernel codes follow this order (each model's
-#: own kernel first, then the variants).
+#: own kernel, then its variants), so a new model goes at the end.
 MODULES: tuple[ModuleType, ...] = (
     meridian,
     smooth,
@@ -41,9 +41,10 @@ DEFAULT_MODEL: str = MODULES[0].MODEL.name
 
 
 def _kernels() -> tuple[Kernel, ...]:
-    own = [(m.MODEL.name, None) for m in MODULES]
-    variants = [(m.MODEL.name, v) for m in MODULES for v in m.MODEL.variants]
-    return tuple(Kernel(name, v, code) for code, (name, v) in enumerate(own + variants))
+    """Model by model in registry order, each model's own kernel then its variants: a model
+    added at the end of :data:`MODULES` leaves every existing code as it was."""
+    pairs = [(m.MODEL.name, v) for m in MODULES for v in (None, *m.MODEL.variants)]
+    return tuple(Kernel(name, v, code) for code, (name, v) in enumerate(pairs))
 
 
 #: Every compiled kernel, indexed by its code.

@@ -128,6 +128,11 @@ def main() -> None:
     """Write :data:`TARGET`."""
     TARGET.write_text(source())
     print(f"wrote {TARGET}")
+    print(
+        "numba's cache does not notice this change in the functions that call the dispatch: "
+        "clear __pycache__ (or point NUMBA_CACHE_DIR at a new folder) before the next run "
+        "outside the test suite, which keys its cache by the sources"
+    )
 
 
 if __name__ == "__main__":

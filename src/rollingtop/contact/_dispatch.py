@@ -4,10 +4,10 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 (:data:`rollingtop.contact.MODULES`); see that generator for why. Kernel codes:
 
 - 0: ``meridian``
-- 1: ``smooth``
-- 2: ``rough``
-- 3: ``meridian``, variant ``south``
-- 4: ``meridian``, variant ``north``
+- 1: ``meridian``, variant ``south``
+- 2: ``meridian``, variant ``north``
+- 3: ``smooth``
+- 4: ``rough``
 """
 
 from __future__ import annotations
@@ -25,13 +25,13 @@ def rows(
     if code == 0:
         return meridian.rows(p, y, J, bias, dirs, 0)
     if code == 1:
-        return smooth.rows(p, y, J, bias, dirs, 0)
-    if code == 2:
-        return rough.rows(p, y, J, bias, dirs, 0)
-    if code == 3:
         return meridian.rows(p, y, J, bias, dirs, 1)
-    if code == 4:
+    if code == 2:
         return meridian.rows(p, y, J, bias, dirs, 2)
+    if code == 3:
+        return smooth.rows(p, y, J, bias, dirs, 0)
+    if code == 4:
+        return rough.rows(p, y, J, bias, dirs, 0)
     return -1
 
 
@@ -42,13 +42,13 @@ def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace
     if code == 0:
         return meridian.accel(p, y, dy, ws, 0)
     if code == 1:
-        return smooth.accel(p, y, dy, ws, 0)
-    if code == 2:
-        return rough.accel(p, y, dy, ws, 0)
-    if code == 3:
         return meridian.accel(p, y, dy, ws, 1)
-    if code == 4:
+    if code == 2:
         return meridian.accel(p, y, dy, ws, 2)
+    if code == 3:
+        return smooth.accel(p, y, dy, ws, 0)
+    if code == 4:
+        return rough.accel(p, y, dy, ws, 0)
     return -1
 
 
@@ -59,16 +59,16 @@ def project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool:
         meridian.project_velocity(p, y, 0)
         return True
     if code == 1:
-        smooth.project_velocity(p, y, 0)
-        return True
-    if code == 2:
-        rough.project_velocity(p, y, 0)
-        return True
-    if code == 3:
         meridian.project_velocity(p, y, 1)
         return True
-    if code == 4:
+    if code == 2:
         meridian.project_velocity(p, y, 2)
+        return True
+    if code == 3:
+        smooth.project_velocity(p, y, 0)
+        return True
+    if code == 4:
+        rough.project_velocity(p, y, 0)
         return True
     return False
 
@@ -78,9 +78,9 @@ def direction_rate(code: int, p: FloatArray, y: FloatArray) -> float:
     """``psi_nu'`` under kernel ``code`` (0 unless it carries a constraint direction)."""
     if code == 0:
         return meridian.direction_rate(p, y, 0)
-    if code == 3:
+    if code == 1:
         return meridian.direction_rate(p, y, 1)
-    if code == 4:
+    if code == 2:
         return meridian.direction_rate(p, y, 2)
     return _rows.direction_rate(p, y, 0)
 
@@ -91,10 +91,10 @@ def sync_direction(code: int, y: FloatArray) -> None:
     if code == 0:
         meridian.sync_direction(y, 0)
         return
-    if code == 3:
+    if code == 1:
         meridian.sync_direction(y, 1)
         return
-    if code == 4:
+    if code == 2:
         meridian.sync_direction(y, 2)
         return
     _rows.sync_direction(y, 0)
@@ -103,4 +103,4 @@ def sync_direction(code: int, y: FloatArray) -> None:
 @inline
 def carries_direction(code: int) -> bool:
     """Whether kernel ``code`` carries its constraint direction in ``psi_nu``."""
-    return code == 3 or code == 4
+    return code == 1 or code == 2

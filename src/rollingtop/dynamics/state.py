@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._errors import InitialStateError
+from rollingtop._jit import call
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
@@ -91,8 +92,8 @@ def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: Array
     """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
     model = get_model(model)
     state = np.asarray(y, dtype=float)
-    J, bias, dirs, _, _ = _kernel.new_workspace()
-    nc = _kernel.constraint_rows(model.code, body.params, state, J, bias, dirs)
+    J, bias, dirs, _, _ = call(_kernel.new_workspace)
+    nc = call(_kernel.constraint_rows, model.code, body.params, state, J, bias, dirs)
     residuals: FloatArray = J[:nc] @ state[:6]
     return residuals
 
@@ -211,7 +212,7 @@ def initial_state(
             else:
                 values[name] = _vector(name, raw, length)
         y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
-    _kernel.project(_start_code(body, model, y), body.params, y, _kernel.new_workspace())
+    call(_kernel.project, _start_code(body, model, y), body.params, y, call(_kernel.new_workspace))
     return y
 
 
@@ -238,5 +239,5 @@ def project_state(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -
         y[9:12] = np.cross(gamma, y[6:9])
     if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
         y[17] = model.vertical_direction(y[3:6], y[6:9], y[9:12], y[17])
-    _kernel.project(_start_code(body, model, y), body.params, y, _kernel.new_workspace())
+    call(_kernel.project, _start_code(body, model, y), body.params, y, call(_kernel.new_workspace))
     return y

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._errors import IntegrationError
+from rollingtop._jit import call
 from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import KERNELS
 from rollingtop.dynamics import _kernel
@@ -97,7 +98,7 @@ def _workspace(n_samples: int) -> _Work:
         ytmp=np.zeros(N_STATE),
         y_old=np.zeros(N_STATE),
         Fd=np.zeros((7, N_STATE)),
-        ws=_kernel.new_workspace(),
+        ws=call(_kernel.new_workspace),
         out=np.full((n_samples, N_STATE), np.nan),
     )
 
@@ -117,9 +118,9 @@ def compile_kernels() -> float:
     y[3:6] = (0.1, 0.2, 0.3)
     for code in (k.code for k in KERNELS):
         yy = y.copy()
-        _kernel.project(code, p, yy, _kernel.new_workspace())
+        call(_kernel.project, code, p, yy, call(_kernel.new_workspace))
         _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
-        _kernel.diagnostics(code, p, yy[None, :].copy(), np.zeros((1, 8)))
+        call(_kernel.diagnostics, code, p, yy[None, :].copy(), np.zeros((1, 8)))
     _compile_time = time.perf_counter() - start
     return _compile_time
 
@@ -144,7 +145,7 @@ def _run_compiled(
     ev_y = np.empty((capacity, N_STATE))
     y = y0.copy()
     f = np.zeros(N_STATE)
-    ctrl, counts, track = dop.start(code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
+    ctrl, counts, track = call(dop.start, code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
                                     w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
     t_end = float(t_eval[-1])
     start = time.perf_counter()
@@ -152,7 +153,8 @@ def _run_compiled(
         budget = PROGRESS_CHUNK
         if max_steps is not None:
             budget = min(budget, max_steps - int(counts[dop.STEPS]))
-        status = dop.run(
+        status = call(
+            dop.run,
             code,
             p,
             y,

@@ -26,7 +26,7 @@ from numba import prange, types
 from numba.extending import intrinsic
 from numpy.typing import ArrayLike
 
-from rollingtop._jit import compiled
+from rollingtop._jit import call, compiled
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
@@ -152,7 +152,7 @@ def compile_ensemble() -> float:
     y = np.zeros((1, N_STATE))
     y[0, 6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
     P = np.array([[1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5]])
-    _batch(np.zeros(1, dtype=np.int64), P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
+    call(_batch, np.zeros(1, dtype=np.int64), P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
            np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
            np.zeros(1, dtype=np.int64))  # fmt: skip
     _compiled = True
@@ -233,7 +233,7 @@ def integrate_batch(
             for lo in range(0, N, step):
                 hi = min(N, lo + step)
                 with numba.parallel_chunksize(CHUNK):
-                    _batch(codes[lo:hi], params[lo:hi], states[lo:hi], t_eval, rtol, atol,
+                    call(_batch, codes[lo:hi], params[lo:hi], states[lo:hi], t_eval, rtol, atol,
                            max_steps, out[lo:hi], final[lo:hi], stats[lo:hi], stop)  # fmt: skip
                 if stop[0]:
                     return

@@ -21,6 +21,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from rollingtop._jit import call
 from rollingtop.contact.meridian import MODEL
 from rollingtop.dynamics import _kernel
 from rollingtop.reduction import (
@@ -93,7 +94,7 @@ def _normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatA
             states.append(state_from_level(level, h, gg, branch=1 if ww >= 0 else -1))
     Y = np.ascontiguousarray(states)
     out = np.empty((len(Y), 8))
-    _kernel.diagnostics(MODEL.code, level.body.params, Y, out)
+    call(_kernel.diagnostics, MODEL.code, level.body.params, Y, out)
     return out[:, 0].reshape(len(g3), len(w)).T
 
 

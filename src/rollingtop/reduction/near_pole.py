@@ -109,6 +109,7 @@ def friction_needed(
 
 def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[float, float]:
     """:func:`friction_needed` on the canonical level and orbit (``canonical_orbit``)."""
+    from rollingtop._jit import call
     from rollingtop.contact.meridian import MODEL
     from rollingtop.dynamics import _kernel
     from rollingtop.reduction.variables import state_from_level
@@ -130,7 +131,7 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[flo
             states.append(state_from_level(lv, hh, 0.0, theta=float(theta), branch=branch))
     Y = np.ascontiguousarray(states)
     out = np.zeros((Y.shape[0], 8))
-    _kernel.diagnostics(MODEL.code, lv.body.params, Y, out)
+    call(_kernel.diagnostics, MODEL.code, lv.body.params, Y, out)
     N, F = out[:, 0], out[:, 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(N > 0, np.abs(F) / N, np.inf)

@@ -43,7 +43,10 @@ S = SYMBOLS
 s_sym, theta_sym = sp.symbols("s theta", positive=True)
 q, k = sp.symbols("q k", positive=True)  # rational parametrisation of gamma
 j = sp.Symbol("j", real=True)  # azimuth of the fixed x axis, rationally
-free = sp.symbols("c1 c2", real=True)  # free velocity components
+# free velocity components: as many symbols as the registered model with the most has
+free = sp.symbols(
+    f"c1:{1 + max(2, *(sum(m.free_velocity.values()) for m in MODELS.values()))}", real=True
+)
 
 
 @dataclass(frozen=True)
