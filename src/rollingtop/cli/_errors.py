@@ -15,6 +15,7 @@ in one place, :func:`reported`; click's standalone mode then shows it
 from __future__ import annotations
 
 import contextlib
+import functools
 import re
 from collections.abc import Iterator
 from typing import IO, Any
@@ -64,12 +65,21 @@ class RunFailed(Reported):
 
 
 class Stopped(Reported):
-    """A signal stopped the run: exit status ``128 + signum`` (130 SIGINT, 143 SIGTERM)."""
+    """A signal stopped the run: exit status ``128 + signum`` (130 SIGINT, 143 SIGTERM).
+
+    click reads the status from the class (``ClickException.exit_code`` is a class variable), so
+    :meth:`of` makes one subclass per signal.
+    """
 
     def __init__(self, signum: int) -> None:
         name = _SIGNAL_NAMES.get(signum, f"signal {signum}")
         super().__init__(f"interrupted by {name}; no output was written")
-        self.exit_code = 128 + signum
+
+    @classmethod
+    @functools.cache
+    def of(cls, signum: int) -> type[Stopped]:
+        """The subclass whose exit status is ``128 + signum``."""
+        return type(f"Stopped{signum}", (cls,), {"exit_code": 128 + signum})
 
 
 @contextlib.contextmanager
@@ -87,6 +97,6 @@ def reported() -> Iterator[None]:
     except (IntegrationError, WriteFailed) as exc:
         raise RunFailed(str(exc)) from None
     except Interrupted as exc:
-        raise Stopped(exc.signum) from None
+        raise Stopped.of(exc.signum)(exc.signum) from None
     except OSError as exc:
         raise RunFailed(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": ")) from None
