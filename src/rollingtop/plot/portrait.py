@@ -220,6 +220,7 @@ def phase_portrait(
                    if level.pole else r"$\gamma_3$")  # fmt: skip
     axu.set_ylabel(r"$U,\ h$")
     what = r"$U(\theta)$" if level.pole else r"$U(\gamma_3)$"
-    axu.text(0.01, 0.95, what + r" and the levels $h$", transform=axu.transAxes,
-             va="top", fontsize=8)  # fmt: skip
+    label_box = {"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5}
+    axu.text(0.01, 0.95, what + r" and the levels $h$", transform=axu.transAxes, va="top",
+             fontsize=8, zorder=5, bbox=label_box)  # fmt: skip
     return fig
