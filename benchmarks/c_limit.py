@@ -310,6 +310,63 @@ def compare_flags(sc: Any, rt: dict[str, Any]) -> None:
               f"{np.max(np.abs(c['y'] - rt['y'])):.2e}  {ns_per_eval(c):6.1f} ns/eval")  # fmt: skip
 
 
+def paired_rounds(
+    sc: Any, code: int, lib: ctypes.CDLL, rounds: int = 7, verbose: bool = False
+) -> dict[str, Any]:
+    """W1 with C and with rollingtop, alternately first, ``rounds`` times: the per-round ns per
+    rhs evaluation of each, the ratios rollingtop / C and their median, and the ratio of the
+    fastest rounds."""
+    ratios, loop_ratios, c_ns, rt_ns = [], [], [], []
+    if verbose:
+        print(f"paired, interleaved rounds ({rounds}):")
+    for k in range(rounds):
+        # alternate which goes first, so that neither always runs second
+        order = ("c", "rt") if k % 2 == 0 else ("rt", "c")
+        res: dict[str, dict[str, Any]] = {}
+        for who in order:
+            result = run_c(sc, lib) if who == "c" else integrate_rollingtop(sc, code)
+            assert result is not None
+            res[who] = result
+        ratios.append(res["rt"]["wall_s"] / res["c"]["wall_s"])
+        loop_ratios.append(res["rt"]["loop_s"] / res["c"]["wall_s"])
+        c_ns.append(ns_per_eval(res["c"]))
+        rt_ns.append(ns_per_eval(res["rt"]))
+        if verbose:
+            print(f"  round {k + 1}: C {c_ns[-1]:6.1f} ns/eval, rollingtop {rt_ns[-1]:6.1f} "
+                  f"ns/eval ({ns_per_eval(res['rt'], 'loop_s'):6.1f} in its compiled loop), "
+                  f"ratio {ratios[-1]:.3f}")  # fmt: skip
+    return {
+        "c_ns_per_eval": c_ns, "rollingtop_ns_per_eval": rt_ns, "ratios": ratios,
+        "ratio_median": statistics.median(ratios),
+        "loop_ratio_median": statistics.median(loop_ratios),
+        "ratio_fastest": min(rt_ns) / min(c_ns),
+    }  # fmt: skip
+
+
+def c_limit_w1(rounds: int = 9) -> dict[str, Any] | None:
+    """The C limit on W1 for ``run_benchmarks.py``: step counts of both (they must agree), the
+    final-state difference and the paired rounds; ``None`` without a compiler."""
+    lib = build()
+    if lib is None:
+        return None
+    sc, code = w1_problem()
+    from rollingtop.integrate.driver import compile_kernels
+
+    compile_kernels()
+    c, rt = run_c(sc, lib), integrate_rollingtop(sc, code)
+    assert c is not None
+    counts = {
+        who: [r["steps"], r["rejected"], r["rhs_evals"]]
+        for who, r in (("c", c), ("rollingtop", rt))
+    }
+    return {
+        "flags": _built["flags"], "counts": counts,
+        "identical_steps": counts["c"] == counts["rollingtop"],
+        "final_state_difference": float(np.max(np.abs(c["y"] - rt["y"]))),
+        **paired_rounds(sc, code, lib, rounds),
+    }  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     ap.add_argument("--rounds", type=int, default=7, help="paired rounds (default 7)")
@@ -356,31 +413,20 @@ def main(argv: list[str] | None = None) -> int:
         print("other floating-point flags:")
         compare_flags(sc, rt)
 
-    ratios, loop_ratios, c_ns, rt_ns = [], [], [], []
-    print(f"paired, interleaved rounds ({args.rounds}):")
-    for k in range(args.rounds):
-        # alternate which goes first, so that neither always runs second
-        order = ("c", "rt") if k % 2 == 0 else ("rt", "c")
-        res: dict[str, dict[str, Any]] = {}
-        for who in order:
-            result = run_c(sc, lib) if who == "c" else integrate_rollingtop(sc, code)
-            assert result is not None
-            res[who] = result
-        ratios.append(res["rt"]["wall_s"] / res["c"]["wall_s"])
-        loop_ratios.append(res["rt"]["loop_s"] / res["c"]["wall_s"])
-        c_ns.append(ns_per_eval(res["c"]))
-        rt_ns.append(ns_per_eval(res["rt"]))
-        print(f"  round {k + 1}: C {c_ns[-1]:6.1f} ns/eval, rollingtop {rt_ns[-1]:6.1f} ns/eval "
-              f"({ns_per_eval(res['rt'], 'loop_s'):6.1f} in its compiled loop), "
-              f"ratio {ratios[-1]:.3f}")  # fmt: skip
+    paired = paired_rounds(sc, code, lib, args.rounds, verbose=True)
+    c_ns, rt_ns, ratios = (
+        paired["c_ns_per_eval"],
+        paired["rollingtop_ns_per_eval"],
+        paired["ratios"],
+    )
     print(f"median: C {statistics.median(c_ns):.1f} ns/eval, rollingtop "
           f"{statistics.median(rt_ns):.1f} ns/eval; rollingtop / C = "
-          f"{statistics.median(ratios):.3f} (call), {statistics.median(loop_ratios):.3f} "
+          f"{paired['ratio_median']:.3f} (call), {paired['loop_ratio_median']:.3f} "
           f"(rollingtop's compiled loop only)")  # fmt: skip
     # On a shared (virtual) machine the speed of both drifts between regimes within seconds;
     # the fastest round of each is the least disturbed figure.
     print(f"fastest rounds: C {min(c_ns):.1f} ns/eval, rollingtop {min(rt_ns):.1f} ns/eval "
-          f"(ratio {min(rt_ns) / min(c_ns):.3f}); per-round ratios {min(ratios):.3f} to "
+          f"(ratio {paired['ratio_fastest']:.3f}); per-round ratios {min(ratios):.3f} to "
           f"{max(ratios):.3f}")  # fmt: skip
     assert counts_c == counts_rt, f"different steps on W1: C {counts_c}, rollingtop {counts_rt}"
     return 0

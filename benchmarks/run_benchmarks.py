@@ -1,6 +1,6 @@
 """rollingtop benchmarks: side-by-side timings against scipy.integrate.solve_ivp.
 
-Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs] [--only W1,W2,W3,cold_start]
+Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs] [--only W1,W2,W3,cold_start,C,peers,scaling]
                                           [--out benchmarks/results.json]
 
 --write-docs (old name: --readme) rewrites the results block of docs/guide/performance.md.
@@ -371,6 +371,22 @@ def table(res) -> str:
                  f"{cs['simulate_empty_cache_s']:.1f} s with an empty numba cache (everything it "
                  f"uses compiled), {cs['simulate_warm_cache_s']:.2f} s with a warm one (median of "
                  f"5 processes)."]  # fmt: skip
+    if res.get("C"):
+        c = res["C"]
+        rows += ["", f"C limit (benchmarks/c_limit/dop853.c, {c['flags']}): identical steps "
+                 f"{c['identical_steps']} ({c['counts']['c'][0]} accepted, {c['counts']['c'][1]} "
+                 f"rejected), final states differ by {c['final_state_difference']:.1e}; rollingtop "
+                 f"/ C = {c['ratio_median']:.2f} (median of {len(c['ratios'])} paired rounds; "
+                 f"{min(c['ratios']):.2f}-{max(c['ratios']):.2f}), {c['ratio_fastest']:.2f} "
+                 f"between the fastest rounds."]  # fmt: skip
+    if res.get("peers"):
+        import peers
+
+        rows += ["", peers.table(res["peers"])]
+    if res.get("scaling"):
+        import scaling
+
+        rows += ["", scaling.table(res["scaling"])]
     return "\n".join(rows)
 
 
@@ -413,6 +429,23 @@ def write_docs(res, path: Path = DOCS_PAGE) -> None:
     os.replace(tmp, path)
 
 
+def run_scaling(quick: bool) -> dict:
+    """How cost grows: time against t_end and rtol, ensembles against size and threads
+    (benchmarks/scaling.py; figures benchmarks/scaling_*.png)."""
+    import scaling
+
+    small = quick or None
+    return {
+        "ensemble": scaling.scaling_ensemble(
+            **({"ns": (100, 200, 400), "t_end": 20.0} if small else {})
+        ),
+        "t_end": scaling.scaling_t_end(
+            **({"t_ends": (1e2, 3e2, 1e3), "rounds": 3} if small else {})
+        ),
+        "rtol": scaling.scaling_rtol(**({"t_end": 100.0, "rounds": 2} if small else {})),
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, for a smoke test")
@@ -433,7 +466,8 @@ def main() -> None:
     ap.add_argument(
         "--only",
         metavar="PARTS",
-        help="comma-separated subset of W1,W2,W3,cold_start to measure; the rest is kept from --out",
+        help="comma-separated subset of W1,W2,W3,cold_start,C,peers,scaling to measure; the rest "
+        "is kept from --out",
     )
     args = ap.parse_args()
     if args.from_json:
@@ -443,7 +477,7 @@ def main() -> None:
         print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
         return
     quick = args.quick
-    parts = {"W2", "W3", "cold_start", "W1"}
+    parts = {"W2", "W3", "cold_start", "W1", "C", "peers", "scaling"}
     only = set(args.only.split(",")) if args.only else parts
     if only - parts:
         raise SystemExit(f"--only: unknown part(s) {', '.join(sorted(only - parts))}")
@@ -463,9 +497,24 @@ def main() -> None:
     if "cold_start" in only:
         print("cold start ...", flush=True)
         res["cold_start"] = cold_start()
+    if "scaling" in only:
+        print("scaling ...", flush=True)
+        res["scaling"] = run_scaling(quick)
     if "W1" in only:
         print("W1 ...", flush=True)
         res["W1"] = w1(1e3 if quick else 1e4, 3 if quick else 5, 1)
+    if "C" in only:
+        print("C limit ...", flush=True)
+        from c_limit import c_limit_w1
+
+        res["C"] = c_limit_w1(3 if quick else 9)
+    if "peers" in only:
+        print("peers ...", flush=True)
+        from peers import PEERS, peers_w1
+
+        # the NumPy solve_ivp baseline is W1's already (hundreds of seconds)
+        names = tuple(n for n in PEERS if n != "solve_ivp_numpy_rhs")
+        res["peers"] = peers_w1(1e3 if quick else 1e4, 2 if quick else 5, peers=names)
     res["table_markdown"] = table(res)
     Path(args.out).write_text(json.dumps(res, indent=2))
     print(res["table_markdown"])
