@@ -86,6 +86,15 @@ def _fit_line(ax, x, fit, style, label, colour):
             label=f"{label}: fit $\\propto x^{{{fit['exponent']:.3f}}}$")  # fmt: skip
 
 
+def _time_panel(ax, x, points, out) -> None:
+    """Wall time of the whole ``simulate`` call and of the compiled kernel, with their fits."""
+    ax.loglog(x, [p["wall_s"] for p in points], "o", color="C0", label="simulate() call")
+    _fit_line(ax, x, out["fit_wall"], "-", "call", "C0")
+    ax.loglog(x, [p["kernel_wall_s"] for p in points], "s", color="C1", mfc="none",
+              label="compiled kernel")  # fmt: skip
+    _fit_line(ax, x, out["fit_kernel"], "--", "kernel", "C1")
+
+
 def _save(fig, path: Path | None) -> str | None:
     if path is None:
         return None
@@ -163,11 +172,7 @@ def scaling_t_end(t_ends=(1e2, 3e2, 1e3, 3e3, 1e4), rounds: int = 5, rtol: float
 
     plt = _plt()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    a1.loglog(x, [p["wall_s"] for p in points], "o", color="C0", label="simulate() call")
-    _fit_line(a1, x, out["fit_wall"], "-", "call", "C0")
-    a1.loglog(x, [p["kernel_wall_s"] for p in points], "s", color="C1", mfc="none",
-              label="compiled kernel")  # fmt: skip
-    _fit_line(a1, x, out["fit_kernel"], "--", "kernel", "C1")
+    _time_panel(a1, x, points, out)
     a1.set_xlabel("t_end")
     a1.set_ylabel("wall time (s)")
     a1.set_title("time against t_end")
@@ -247,11 +252,7 @@ def scaling_rtol(rtols=(1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13), t_e
     _log_ticks(a1, x=False)
     a1.invert_xaxis()
     a1.legend()
-    a2.loglog(x, [p["wall_s"] for p in points], "o", color="C0", label="simulate() call")
-    _fit_line(a2, x, out["fit_wall"], "-", "call", "C0")
-    a2.loglog(x, [p["kernel_wall_s"] for p in points], "s", color="C1", mfc="none",
-              label="compiled kernel")  # fmt: skip
-    _fit_line(a2, x, out["fit_kernel"], "--", "kernel", "C1")
+    _time_panel(a2, x, points, out)
     a2.set_xlabel("rtol (atol = rtol / 100)")
     a2.set_ylabel("wall time (s)")
     a2.set_title("time against rtol")

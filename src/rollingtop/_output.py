@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -12,11 +13,12 @@ if TYPE_CHECKING:
     import xarray as xr
 
 
-class NetCDFOutput:
+class NetCDFOutput(ABC):
     """Mixin: :meth:`to_netcdf` from the class's ``to_xarray()``."""
 
-    def to_xarray(self) -> xr.Dataset:  # pragma: no cover - every subclass defines it
-        raise NotImplementedError
+    @abstractmethod
+    def to_xarray(self) -> xr.Dataset:
+        """The result as an :class:`xarray.Dataset`."""
 
     def to_netcdf(self, path: str | os.PathLike[str]) -> Path:
         """Write :meth:`to_xarray` as NetCDF-4 (engine ``h5netcdf``), atomically: the file
