@@ -33,9 +33,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
+from rollingtop import IntegrationOptions
 from rollingtop.cli import main
 
 from .conftest import EXAMPLES
@@ -359,9 +360,18 @@ def scenario_bytes(draw) -> bytes:
 # ---- scenarios through simulate, equilibria, orbits -------------------------------------------
 
 
+# A scenario without [integration] (found by CI): the default samples hold
+NO_INTEGRATION_TABLE = (
+    b"[body]\nR = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n"
+    b'\n[contact]\nmodel = "meridian"\n'
+    b"\n[initial]\ngamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nv_tau = 0.25\n"
+)
+
+
 @pytest.mark.slow
 @fuzz(120)
 @given(data=scenario_bytes(), output=st.sampled_from([None, "out.nc", "out.csv"]))
+@example(data=NO_INTEGRATION_TABLE, output="out.nc")
 def test_fuzz_simulate_scenarios(data, output):
     with workdir() as folder:
         scenario = folder / "s.toml"
@@ -375,7 +385,9 @@ def test_fuzz_simulate_scenarios(data, output):
         if code != 0:
             assert listing(folder) == before, err
         elif output is not None:
-            samples = tomllib.loads(data.decode("utf-8-sig"))["integration"].get("samples")
+            # A scenario may leave out [integration] (or its samples): the default then holds
+            table = tomllib.loads(data.decode("utf-8-sig")).get("integration", {})
+            samples = table.get("samples", IntegrationOptions().samples)
             check_trajectory_file(folder / output, summary, samples)
 
 
