@@ -19,11 +19,14 @@ give the same step counts on W1 and final states within a few 1e-10 (``--flags``
 
 Run from the repository root:
 
-    python benchmarks/c_limit.py [--rounds 7] [--check] [--flags]
+    python benchmarks/c_limit.py [--rounds 7] [--check] [--flags] [--processes P]
 
 W1 once with C and once with rollingtop: step counts (asserted identical), the largest difference
 of the final states, ns per right-hand-side evaluation; then paired, interleaved rounds (the
-order alternating within each round) and the median of the per-round ratios rollingtop / C.
+order alternating within each round) and the median of the per-round ratios rollingtop / C. The
+process pins itself to one CPU (:func:`pin_to_one_cpu`). ``--processes P`` instead pools the
+rounds of P fresh processes, as ``run_benchmarks.py`` does (:func:`c_limit_w1`): the speed of
+rollingtop's compiled code differs by a few per cent from one process to the next.
 Times are of the whole call (rollingtop: :func:`rollingtop.integrate.driver.integrate`, compiled
 kernels already loaded; C: the ``ctypes`` call).
 """
@@ -33,6 +36,7 @@ from __future__ import annotations
 import argparse
 import ctypes
 import hashlib
+import json
 import os
 import shlex
 import shutil
@@ -343,12 +347,28 @@ def paired_rounds(
     }  # fmt: skip
 
 
-def c_limit_w1(rounds: int = 9) -> dict[str, Any] | None:
-    """The C limit on W1 for ``run_benchmarks.py``: step counts of both (they must agree), the
-    final-state difference and the paired rounds; ``None`` without a compiler."""
-    lib = build()
+def pin_to_one_cpu() -> int | None:
+    """Pin this process to the last CPU it may run on (Linux), so that the scheduler does not
+    migrate it between rounds; returns that CPU (``None`` where affinity is not supported).
+
+    Measured on the 2-core development VM: unpinned, the per-process median ratio of W1 ranged
+    over 1.02-1.16 for the same compiled code; pinned, over 1.00-1.05 in the same machine state.
+    """
+    if not hasattr(os, "sched_setaffinity"):
+        return None
+    cpu = max(os.sched_getaffinity(0))
+    os.sched_setaffinity(0, {cpu})
+    return cpu
+
+
+def measure(rounds: int) -> dict[str, Any] | None:
+    """One process's part of :func:`c_limit_w1`: pinned, the step counts of both (they must
+    agree), the final-state difference and ``rounds`` paired rounds; ``None`` without a
+    compiler."""
+    lib = build(quiet=True)
     if lib is None:
         return None
+    cpu = pin_to_one_cpu()
     sc, code = w1_problem()
     from rollingtop.integrate.driver import compile_kernels
 
@@ -360,10 +380,40 @@ def c_limit_w1(rounds: int = 9) -> dict[str, Any] | None:
         for who, r in (("c", c), ("rollingtop", rt))
     }
     return {
-        "flags": _built["flags"], "counts": counts,
+        "flags": _built["flags"], "cpu": cpu, "counts": counts,
         "identical_steps": counts["c"] == counts["rollingtop"],
         "final_state_difference": float(np.max(np.abs(c["y"] - rt["y"]))),
         **paired_rounds(sc, code, lib, rounds),
+    }  # fmt: skip
+
+
+def c_limit_w1(rounds: int = 9, processes: int = 3) -> dict[str, Any] | None:
+    """The C limit on W1 for ``run_benchmarks.py``: :func:`measure` in ``processes`` fresh
+    processes of ``rounds`` paired rounds each (the compiled code's speed differs from one
+    process to the next by a few per cent, so one process is not enough), pooled: the median of
+    all per-round ratios, and each process's median. ``None`` without a compiler."""
+    if build() is None:
+        return None
+    parts = []
+    for _ in range(processes):
+        proc = subprocess.run(
+            [sys.executable, str(Path(__file__).resolve()), "--measure", str(rounds)],
+            capture_output=True, text=True, check=True,
+        )  # fmt: skip
+        parts.append(json.loads(proc.stdout.strip().splitlines()[-1]))
+    first = parts[0]
+    pooled = {key: [v for part in parts for v in part[key]]
+              for key in ("c_ns_per_eval", "rollingtop_ns_per_eval", "ratios")}  # fmt: skip
+    return {
+        "flags": first["flags"], "counts": first["counts"],
+        "identical_steps": all(part["identical_steps"] for part in parts),
+        "final_state_difference": max(part["final_state_difference"] for part in parts),
+        "processes": processes, "rounds_per_process": rounds, "pinned": first["cpu"] is not None,
+        **pooled,
+        "ratio_median": statistics.median(pooled["ratios"]),
+        "ratio_median_per_process": [part["ratio_median"] for part in parts],
+        "loop_ratio_median": statistics.median(part["loop_ratio_median"] for part in parts),
+        "ratio_fastest": min(pooled["rollingtop_ns_per_eval"]) / min(pooled["c_ns_per_eval"]),
     }  # fmt: skip
 
 
@@ -373,11 +423,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--check", action="store_true",
                     help="compare the C pieces with rollingtop's, bit for bit")  # fmt: skip
     ap.add_argument("--flags", action="store_true", help="also try other floating-point flags")
+    ap.add_argument("--processes", type=int, default=0, metavar="P",
+                    help="instead: P fresh, pinned processes of ROUNDS rounds each, pooled")  # fmt: skip
+    ap.add_argument("--measure", type=int, metavar="ROUNDS", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.measure is not None:  # one process of c_limit_w1: JSON on the last line
+        print(json.dumps(measure(args.measure)))
+        return 0
+    if args.processes > 0:
+        pooled = c_limit_w1(args.rounds, args.processes)
+        if pooled is not None:
+            print(f"{args.processes} pinned processes x {args.rounds} rounds: rollingtop / C = "
+                  f"{pooled['ratio_median']:.3f} (median of all rounds); per process "
+                  + ", ".join(f"{r:.3f}" for r in pooled["ratio_median_per_process"]))  # fmt: skip
+        return 0
 
     lib = build()
     if lib is None:
         return 0
+    cpu = pin_to_one_cpu()
+    print(f"pinned to CPU {cpu}" if cpu is not None else "not pinned (no CPU affinity here)")
     sc, code = w1_problem()
     if code != 0:
         print(f"W1 starts in kernel code {code}, but the C limit implements code 0 only")

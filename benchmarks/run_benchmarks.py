@@ -3,7 +3,9 @@
 Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs] [--only W1,W2,W3,cold_start,C,peers,scaling]
                                           [--out benchmarks/results.json]
 
---write-docs (old name: --readme) rewrites the results block of docs/guide/performance.md.
+--write-docs (old name: --readme) rewrites the results block of docs/guide/performance.md and
+the performance table of README.md (tests/benchmarks/test_results_docs.py holds both to
+results.json).
 
 W1  one long trajectory (paper's body, examples/paper.toml, t = 1e4, rtol 1e-10, atol 1e-12):
     rollingtop vs solve_ivp(DOP853) with a plain NumPy right-hand side and with rollingtop's
@@ -373,10 +375,12 @@ def table(res) -> str:
                  f"5 processes)."]  # fmt: skip
     if res.get("C"):
         c = res["C"]
+        where = (f"{len(c['ratios'])} paired rounds in {c['processes']} pinned processes"
+                 if "processes" in c else f"{len(c['ratios'])} paired rounds")  # fmt: skip
         rows += ["", f"C limit (benchmarks/c_limit/dop853.c, {c['flags']}): identical steps "
                  f"{c['identical_steps']} ({c['counts']['c'][0]} accepted, {c['counts']['c'][1]} "
                  f"rejected), final states differ by {c['final_state_difference']:.1e}; rollingtop "
-                 f"/ C = {c['ratio_median']:.2f} (median of {len(c['ratios'])} paired rounds; "
+                 f"/ C = {c['ratio_median']:.2f} (median of {where}; "
                  f"{min(c['ratios']):.2f}-{max(c['ratios']):.2f}), {c['ratio_fastest']:.2f} "
                  f"between the fastest rounds."]  # fmt: skip
     if res.get("peers"):
@@ -429,6 +433,63 @@ def write_docs(res, path: Path = DOCS_PAGE) -> None:
     os.replace(tmp, path)
 
 
+README = ROOT / "README.md"
+README_START = (
+    "<!-- readme-performance:start (written by benchmarks/run_benchmarks.py --write-docs) -->"
+)
+README_END = "<!-- readme-performance:end -->"
+
+
+def readme_block(res) -> str:
+    """The README's short performance table: W1 time of the C limit and of each peer over
+    rollingtop's, then start-up and ensemble figures (every number from ``res``)."""
+    m, w1r, c, peer, cs = (
+        res["machine"],
+        res["W1"],
+        res.get("C"),
+        res.get("peers"),
+        res["cold_start"],
+    )
+    rows = [
+        f"W1 (the paper's body and state, t = {w1r['t_end']:g}, rtol {w1r['rtol']:g}) on "
+        f"{m['cpu']}, {m['cores']} cores, numba {m['numba']}: time of each over rollingtop's "
+        "(which also projects onto the constraints and monitors the reaction at every step; "
+        "medians of paired, interleaved runs):",
+        "",
+        "| W1 | time / rollingtop's |",
+        "|---|---|",
+    ]
+    if c:
+        rows.append(f"| the same integration hand-written in C ({c['flags']}; identical steps) | "
+                    f"{1.0 / c['ratio_median']:.2f} |")  # fmt: skip
+    if peer:
+        import peers
+
+        for name in peers.PEERS:
+            if name in peer:
+                rows.append(f"| {peer[name]['label']} | {peer[name]['ratio_to_rollingtop']:.3g} |")
+    numpy_rhs = w1r["solve_ivp_numpy_rhs"]["speedup_of_rollingtop"]  # paired with rollingtop
+    rows.append(f"| SciPy solve_ivp DOP853, NumPy rhs (one run) | {numpy_rhs:.0f} |")
+    w2r = res["W2"]
+    rows += ["", f"Cold start (import and compile, empty numba cache): {cs['empty_cache_s']:.0f} s; "
+             f"a short `rollingtop simulate` with a warm cache: {cs['simulate_warm_cache_s']:.2f} s "
+             f"(whole process). Ensemble of {w2r['n']} trajectories on 2 threads: "
+             f"{100 * w2r['parallel_efficiency_2']:.0f} % parallel efficiency. Details, all "
+             "tables and how to rerun: [performance](docs/guide/performance.md)."]  # fmt: skip
+    return "\n".join(rows)
+
+
+def write_readme(res, path: Path = README) -> None:
+    """Replace the README's performance block with the new results (atomically)."""
+    head, sep, rest = path.read_text().partition(README_START)
+    _, sep2, tail = rest.partition(README_END)
+    if not sep or not sep2:
+        raise SystemExit(f"{path}: performance markers not found")
+    tmp = path.with_suffix(".md.tmp")
+    tmp.write_text(f"{head}{README_START}\n{readme_block(res)}\n{README_END}{tail}")
+    os.replace(tmp, path)
+
+
 def run_scaling(quick: bool) -> dict:
     """How cost grows: time against t_end and rtol, ensembles against size and threads
     (benchmarks/scaling.py; figures benchmarks/scaling_*.png)."""
@@ -455,7 +516,7 @@ def main() -> None:
         "--readme",
         dest="write_docs",
         action="store_true",
-        help="also write the tables into docs/guide/performance.md (between its markers); "
+        help="also write the tables into docs/guide/performance.md and README.md (between their markers); "
         "--readme is the old name",
     )
     ap.add_argument(
@@ -474,7 +535,8 @@ def main() -> None:
         res = json.loads(Path(args.from_json).read_text())
         res["table_markdown"] = table(res)
         write_docs(res)
-        print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
+        write_readme(res)
+        print(f"wrote {DOCS_PAGE.relative_to(ROOT)} and {README.relative_to(ROOT)}")
         return
     quick = args.quick
     parts = {"W2", "W3", "cold_start", "W1", "C", "peers", "scaling"}
@@ -507,7 +569,7 @@ def main() -> None:
         print("C limit ...", flush=True)
         from c_limit import c_limit_w1
 
-        res["C"] = c_limit_w1(3 if quick else 9)
+        res["C"] = c_limit_w1(rounds=3 if quick else 5, processes=2 if quick else 5)
     if "peers" in only:
         print("peers ...", flush=True)
         from peers import PEERS, peers_w1
@@ -521,7 +583,8 @@ def main() -> None:
     print(f"wrote {args.out}")
     if args.write_docs and not quick:
         write_docs(res)
-        print(f"wrote {DOCS_PAGE.relative_to(ROOT)}")
+        write_readme(res)
+        print(f"wrote {DOCS_PAGE.relative_to(ROOT)} and {README.relative_to(ROOT)}")
 
 
 if __name__ == "__main__":
