@@ -91,7 +91,10 @@ def test_reduction_errors(capsys, tmp_path, monkeypatch, args, message):
 
 def test_level_table_errors(capsys, tmp_path):
     bad = [
-        (scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5"), r"\[level\] is missing C2"),
+        (
+            scenario_text(initial=None, level="M3 = 1.0\nC1 = 0.5\nh = 1.0"),
+            r"\[level\] is missing C2",
+        ),
         (scenario_text(level="M3 = 1.0\nC1 = 0.5\nC2 = 0.0\nE = 3"), "unknown key level.E"),
         (scenario_text(level="M3 = 1.0\nC1 = 0.5\nC2 = 0.0\nbranch = 2"), "branch = 2"),
         (

@@ -116,7 +116,7 @@ class LevelSpec:
 
     M3: float
     C1: float
-    C2: float
+    C2: float | None = None
     h: float | None = None
     gamma3: float | None = None
     branch: int = 1
@@ -138,6 +138,9 @@ class LevelSpec:
         """The :class:`~rollingtop.reduction.LevelSet` ``(M3, C1, C2)`` of ``body``."""
         from rollingtop.reduction.level import LevelSet
 
+        if self.C2 is None:
+            raise ScenarioError("[level] is missing C2 (only `rollingtop bifurcation` does "
+                                "without it)")  # fmt: skip
         return LevelSet(body, self.M3, self.C1, self.C2)
 
 
@@ -201,6 +204,15 @@ class Scenario:
 
         return level_of_state(self.body, self.require_state())
 
+    def level_integrals(self) -> tuple[float, float, float | None]:
+        """``(M3, C1, C2)`` of ``[level]`` (``C2`` may be absent: ``None``), else of the initial
+        state (:func:`~rollingtop.reduction.start.level_of_state`)."""
+        self._require_reduction("the reduction to one degree of freedom")
+        if self.level is not None:
+            return self.level.M3, self.level.C1, self.level.C2
+        level = self.level_set()
+        return level.M3, level.C1, level.C2
+
     def level_h(self) -> float:
         """The reduced energy ``h`` of ``[level]``, else of the initial state
         (:func:`~rollingtop.reduction.start.reduced_energy`)."""
@@ -262,7 +274,7 @@ class Scenario:
         if "level" in data:
             level_t = data["level"]
             _reject_unknown("level", level_t, _LEVEL_KEYS)
-            missing = [k for k in ("M3", "C1", "C2") if k not in level_t]
+            missing = [k for k in ("M3", "C1") if k not in level_t]
             if missing:
                 raise ScenarioError(f"[level] is missing {', '.join(missing)}")
             level = LevelSpec(**level_t)

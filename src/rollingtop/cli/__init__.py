@@ -5,6 +5,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 
 - :mod:`._simulate`: ``simulate``;
 - :mod:`._level`: ``equilibria``, ``orbits``, ``portrait`` (the reduction);
+- :mod:`._bifurcation`: ``bifurcation`` (the classification of the reduced motions);
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;
 - :mod:`._verify`: ``verify``;
@@ -14,6 +15,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 from __future__ import annotations
 
 from rollingtop.cli._app import cli
+from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
@@ -23,8 +25,8 @@ from rollingtop.cli._warmup import warmup
 
 __all__ = ["cli", "main"]
 
-for _command in (simulate, equilibria, orbits, portrait, path, plot, compare, animate, ensemble,
-                 verify, warmup):  # fmt: skip
+for _command in (simulate, equilibria, orbits, portrait, bifurcation, path, plot, compare, animate,
+                 ensemble, verify, warmup):  # fmt: skip
     cli.add_command(_command)
 
 

@@ -1,0 +1,108 @@
+"""``rollingtop bifurcation``: the classification of the reduced motions at fixed ``(M3, C1)``."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import click
+
+from rollingtop.cli import _output
+from rollingtop.cli._errors import BadInput
+from rollingtop.cli._options import json_option, scenario_argument
+
+__all__ = ["bifurcation"]
+
+
+def _range(flag: str, text: str | None) -> tuple[float, float] | None:
+    """``"LO,HI"`` as two finite, increasing numbers (``None`` for no option)."""
+    from rollingtop._checks import short_repr
+
+    if text is None:
+        return None
+    parts = text.split(",")
+    try:
+        lo, hi = (float(x) for x in parts)
+    except ValueError:
+        raise BadInput(f"{flag} {short_repr(text)}: expected two numbers LO,HI") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise BadInput(f"{flag} {short_repr(text)}: expected finite LO < HI")
+    return lo, hi
+
+
+def _table(summary: dict[str, Any]) -> Any:
+    from rich.table import Table
+
+    table = Table(title=f"regions of the (C2, h) plane, M3 = {summary['M3']:g}, "
+                        f"C1 = {summary['C1']:g}")  # fmt: skip
+    text = ("region", "what a level holds", "centres at gamma3")
+    for col in (*text, "C2", "h", "C2 from", "to"):
+        table.add_column(col, justify="left" if col in text else "right")
+    for r in summary["regions"]:
+        where = " | ".join(", ".join(f"{g:.3f}" for g in orbit) for orbit in r["centre_gamma3"])
+        table.add_row(r["name"], r["label"], where, f"{r['C2']:.5g}", f"{r['h']:.5g}",
+                      f"{r['C2_range'][0]:.5g}", f"{r['C2_range'][1]:.5g}")  # fmt: skip
+    return table
+
+
+@click.command()
+@scenario_argument
+@json_option
+@click.option("-o", "--output", type=click.Path(), default=None,
+              help="Also draw the diagram: FIG.png, .svg or .pdf.")  # fmt: skip
+@click.option("--c2-range", default=None, metavar="LO,HI",
+              help="C2 window (default: around the folds).")  # fmt: skip
+@click.option("--h-range", default=None, metavar="LO,HI",
+              help="h window (default: min U to above the saddles).")  # fmt: skip
+@click.option("--c1-range", default=None, metavar="LO,HI",
+              help="C1 window of the steady-motion count (default +-2 max |M3|,|C1|).")  # fmt: skip
+def bifurcation(
+    scenario: str,
+    as_json: bool,
+    output: str | None,
+    c2_range: str | None,
+    h_range: str | None,
+    c1_range: str | None,
+) -> None:
+    """Bifurcation diagram of the reduced system at the scenario's (M3, C1).
+
+    M3 and C1 come from [level] (its other keys are ignored), else from the initial state.
+    Prints the folds (where a centre and a saddle are born) and the regions of the (C2, h) plane
+    with what a level in each holds, and the number of steady motions over (C1, C2).
+    """
+    from rollingtop.reduction.bifurcation import bifurcation_diagram, steady_count_map
+    from rollingtop.scenario import load_scenario
+
+    ranges = {"C2": _range("--c2-range", c2_range), "h": _range("--h-range", h_range),
+              "C1": _range("--c1-range", c1_range)}  # fmt: skip
+    if output is not None:
+        from rollingtop.io import check_output_path
+        from rollingtop.plot import FIGURE_SUFFIXES
+
+        check_output_path(output, FIGURE_SUFFIXES)
+    sc = load_scenario(scenario)
+    M3, C1, C2 = sc.level_integrals()
+    diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=ranges["C2"], h_range=ranges["h"])
+    width = 2.0 * max(abs(M3), abs(C1), 1e-3)
+    c1_window = ranges["C1"] or (-width, width)
+    fold_c2 = [f.C2 for f in diagram.folds]
+    lo, hi = diagram.C2_grid[0], diagram.C2_grid[-1]
+    counts = steady_count_map(sc.body, M3, C1_range=c1_window,
+                              C2_range=(min([lo, *fold_c2]), max([hi, *fold_c2])))  # fmt: skip
+    summary = {**diagram.to_dict(), "C2": C2, "steady_count": counts.to_dict()}
+    if output is not None:
+        from rollingtop.plot import save_figure
+        from rollingtop.plot.bifurcation import bifurcation_figure
+
+        save_figure(bifurcation_figure(diagram, counts, mark_C2=C2), output)
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    console = _output.console()
+    folds = ", ".join(f"C2 = {f['C2']:.10g} at gamma3 = {f['gamma3']:.10g}, h = {f['h']:.10g}"
+                      for f in summary["folds"]) or "none"  # fmt: skip
+    console.print(f"folds: {folds}")
+    console.print(_table(summary))
+    if output is not None:
+        click.echo(f"wrote {output}")
