@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 FloatArray: TypeAlias = NDArray[np.float64]
 IntArray: TypeAlias = NDArray[np.int64]
+ComplexArray: TypeAlias = NDArray[np.complex128]
 #: Work arrays ``(J, bias, dirs, A, lam)`` of the kernels, shapes ``(4, 6), (4,), (4, 3), (4, 4),
 #: (4,)`` (:func:`rollingtop.dynamics._kernel.new_workspace`).
 Workspace: TypeAlias = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]

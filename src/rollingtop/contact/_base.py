@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 import numpy as np
 
-from rollingtop._types import FloatArray
+from rollingtop._types import ComplexArray, FloatArray
 
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
@@ -117,6 +117,16 @@ class ContactModel:
     select_variant : callable or None
         ``select_variant(body, y) -> str | None``: the variant for a motion from state ``y``
         (:func:`rollingtop.contact.meridian.select_variant`); ``None``: never a variant.
+    vertical_spin : callable or None
+        ``vertical_spin(body, pole) -> omega3``: closed form of the critical spin rate of the
+        vertical spin on the pole ``pole`` (+1: ``gamma3 = 1``, the south pole on the plane; -1:
+        north) for a dynamically symmetric body, above which it is linearly stable; 0 when every
+        spin rate is (:mod:`rollingtop.dynamics.stability`). ``None``: no closed form.
+    vertical_eigenvalues : callable or None
+        ``vertical_eigenvalues(body, omega3, pole) -> complex ndarray``: the eigenvalues of the
+        linearisation at the vertical spin, for a model whose equations are singular at the
+        vertical (the meridian model: its constraint direction is undefined there). ``None``: the
+        generic linearisation in ``(v, w, gamma)`` on the constraint manifold applies.
     has_reduction : bool
         Whether the model's motions of a dynamically symmetric body reduce to one degree of
         freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
@@ -139,6 +149,8 @@ class ContactModel:
     vertical_direction: VerticalDirection | None = None
     variants: tuple[str, ...] = ()
     select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
+    vertical_spin: Callable[[SphericalTop, int], float] | None = None
+    vertical_eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
     has_reduction: bool = False
     colour: str = "#7f7f7f"
 

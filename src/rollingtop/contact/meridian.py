@@ -58,7 +58,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rollingtop._jit import inline, kernel
-from rollingtop._types import Float6, FloatArray, Workspace
+from rollingtop._types import ComplexArray, Float6, FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import contact_row, normal_row, sync_azimuth
@@ -327,6 +327,48 @@ def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
     return -wxr + free[0] * tau  # contact velocity along tau only
 
 
+def _vertical_spin(body: SphericalTop, pole: int) -> float:
+    """Critical spin of the vertical spin on the pole ``pole`` (+1 south, -1 north).
+
+    The vertical spin lies on the pole level ``C1 = pole M3`` of the reduction, where ``U`` is
+    smooth through the pole (:mod:`rollingtop.reduction.level`); there, with ``a = pole a3`` and
+    ``l = R + a``, ``U''(pole) = M3^2 (I1 + m l^2) / (4 I1^2) - m g a`` (expand
+    ``q1 = M3 tan(theta/2)``, ``P = M3 ((R - a) tan(theta/2) + a theta)`` and
+    ``m g a cos(theta)`` to second order). Stable for ``U'' > 0``:
+    ``w3 > 2 I1 sqrt(m g a / (I1 + m l^2)) / I3``; every spin when ``a <= 0``. The constraint
+    direction is undefined at the vertical, so this (and :func:`_vertical_eigenvalues`) comes
+    from the reduction rather than from a linearisation in ``(v, w, gamma)``.
+    """
+    a = pole * body.a3
+    if a <= 0.0:
+        return 0.0
+    height = body.R + a
+    return (
+        2.0
+        * body.I1
+        * math.sqrt(body.m * body.g * a / (body.I1 + body.m * height * height))
+        / body.I3
+    )
+
+
+def _vertical_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
+    """Eigenvalues of the reduced linearisation at the vertical spin: ``+-sqrt(-U''/rho)`` at
+    the pole of the pole level ``(M3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north,
+    the value of ``F6`` at the vertical spin); the other directions are integrals (0)."""
+    from rollingtop.reduction.level import LevelSet
+
+    if not body.symmetric:
+        raise ValueError("the meridian model's vertical spin is analysed through the reduction: "
+                         "it needs a dynamically symmetric body (I1 = I2)")  # fmt: skip
+    M3 = body.I3 * omega3
+    C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3
+    level = LevelSet(body, M3, pole * M3, C2)
+    theta = 0.0 if pole > 0 else math.pi
+    lam2 = -float(level.d2U(theta)) / float(level.rho(theta))
+    root = np.sqrt(complex(lam2))
+    return np.array([root, -root, 0.0, 0.0], dtype=complex)
+
+
 MODEL = ContactModel(
     name="meridian",
     description="contact kept, no slip along the horizontal projection of the axis (the paper)",
@@ -342,6 +384,8 @@ MODEL = ContactModel(
     vertical_direction=vertical_direction,
     variants=VARIANTS,
     select_variant=select_variant,
+    vertical_spin=_vertical_spin,
+    vertical_eigenvalues=_vertical_eigenvalues,
     has_reduction=True,
     colour="#1f77b4",
 )

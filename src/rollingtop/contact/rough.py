@@ -147,6 +147,29 @@ def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
     return -wxr
 
 
+def _vertical_spin(body: SphericalTop, pole: int) -> float:
+    """Critical spin of the vertical spin on the pole ``pole`` (+1 south, -1 north), rolling
+    without slipping: with ``a = pole a3`` (the centre of mass above the sphere's centre) and
+    ``l = R + a`` its height above the plane, stable for
+    ``w3 > 2 sqrt(m g a (I1 + m l^2)) / (I3 + m R l)``; every spin when ``a <= 0``.
+
+    ``I1 + m l^2`` is the moment of inertia about the contact point across the axis, and
+    ``I3 + m R l`` the spin's gyroscopic moment once rolling couples the tilt rate to the
+    centre's velocity. Found by the linearisation (:mod:`rollingtop.dynamics.stability`) and
+    held to it in the tests to round-off on several bodies; it reduces to Routh's classical
+    condition for an eccentric sphere.
+    """
+    a = pole * body.a3
+    if a <= 0.0:
+        return 0.0
+    height = body.R + a
+    return (
+        2.0
+        * math.sqrt(body.m * body.g * a * (body.I1 + body.m * height * height))
+        / (body.I3 + body.m * body.R * height)
+    )
+
+
 MODEL = ContactModel(
     name="rough",
     description="rolling without slipping (vp = 0)",
@@ -157,5 +180,6 @@ MODEL = ContactModel(
     velocity=_velocity,
     symbolic_directions=_symbolic_directions,
     symbolic_velocity=_symbolic_velocity,
+    vertical_spin=_vertical_spin,
     colour="#d62728",
 )

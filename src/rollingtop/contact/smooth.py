@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
@@ -62,6 +63,16 @@ def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
     return -wxr + free[0] * tau + free[1] * gamma.cross(tau)  # contact velocity horizontal
 
 
+def _vertical_spin(body: SphericalTop, pole: int) -> float:
+    """Critical spin of the vertical spin on the pole ``pole`` (+1 south, -1 north): on a smooth
+    plane the centre of mass moves only vertically, to second order not at all at the vertical,
+    so the body is Lagrange's top about its centre of mass with ``m g l`` replaced by
+    ``m g a`` (``a = pole a3``, the height of the centre of mass above the sphere's centre):
+    stable for ``I3^2 w3^2 > 4 I1 m g a``; every spin when ``a <= 0``."""
+    a = pole * body.a3
+    return 0.0 if a <= 0.0 else 2.0 * math.sqrt(body.I1 * body.m * body.g * a) / body.I3
+
+
 MODEL = ContactModel(
     name="smooth",
     description="contact kept, frictionless plane",
@@ -72,5 +83,6 @@ MODEL = ContactModel(
     velocity=_velocity,
     symbolic_directions=_symbolic_directions,
     symbolic_velocity=_symbolic_velocity,
+    vertical_spin=_vertical_spin,
     colour="#2ca02c",
 )

@@ -53,6 +53,11 @@ class SteadyMotion:
     w_n, v_tau, spin, precession_rate, com_speed, com_radius : float
         ``w_n``, ``v_tau``, ``w3 = M3/I3``, ``psi'``, ``|v_tau|`` and ``|v_tau / psi'|`` (inf when
         the axis does not precess).
+    eigenvalues : tuple of (float, float)
+        ``(real, imaginary)`` parts of the eigenvalues of the full equations linearised at this
+        steady rolling (:func:`linearised_eigenvalues`); empty at a pole.
+    linearly_stable : bool or None
+        Whether every eigenvalue has a zero real part (``None`` at a pole).
     """
 
     gamma3: float
@@ -70,6 +75,8 @@ class SteadyMotion:
     precession_rate: float
     com_speed: float
     com_radius: float
+    eigenvalues: tuple[tuple[float, float], ...] = ()
+    linearly_stable: bool | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite values become ``None``)."""
@@ -115,6 +122,38 @@ def _scale(level: LevelSet, theta: float) -> float:
     return max(abs(float(level.U(theta))), abs(float(level.d2U(theta))), 1e-300)
 
 
+#: Relative step of the central differences in :func:`linearised_eigenvalues`.
+DIFF_STEP = 1e-6
+#: Real parts below this times the eigenvalues' size count as zero.
+STABLE_TOLERANCE = 1e-6
+
+
+def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex128]:
+    """Eigenvalues of the full equations linearised at the steady rolling at ``gamma3``.
+
+    A steady rolling of the symmetric body is a relative equilibrium: in the body frame ``gamma``
+    turns about the axis, so the full equations have no fixed point there, but the reduced
+    system (paper eq. 3.3, :func:`rollingtop.reduction.reduced_rhs`) is the full dynamics up to
+    the symmetries (rotation about the vertical, translation) and the Lagrange integral, and has
+    one at ``(gamma3, v_tau, w_n, 0)``. Its 4x4 Jacobian (central differences) has two zero
+    eigenvalues (the integrals ``C1, C2``) and ``+-sqrt(-U''_theta / rho)``, which the tests
+    compare with the potential's curvature.
+    """
+    from rollingtop.reduction.system import reduced_rhs
+
+    theta = math.acos(gamma3)
+    x0 = np.array([gamma3, float(level.v_tau(theta)), float(level.w_n(theta)), 0.0])
+    D = np.zeros((4, 4))
+    for i in range(4):
+        h = DIFF_STEP * max(1.0, abs(x0[i]))
+        e = np.zeros(4)
+        e[i] = h
+        D[:, i] = (reduced_rhs(level.body, level.M3, x0 + e)
+                   - reduced_rhs(level.body, level.M3, x0 - e)) / (2 * h)  # fmt: skip
+    out: NDArray[np.complex128] = np.linalg.eigvals(D).astype(complex)
+    return out
+
+
 def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     """Describe the steady motion at the critical point ``theta``."""
     body = level.body
@@ -129,6 +168,13 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     omega = math.sqrt(U2t / rho) if kind == "center" else math.nan
     v_tau = float(level.v_tau(theta))
     psi_dot = float(level.psi_dot(theta))
+    eig: tuple[tuple[float, float], ...] = ()
+    stable = None
+    if abs(s) > 1e-8 and 0.0 < theta < math.pi:
+        ev = linearised_eigenvalues(level, math.cos(theta))
+        eig = tuple((float(z.real), float(z.imag)) for z in ev)
+        size = max(1.0, float(np.max(np.abs(ev))))
+        stable = bool(np.max(np.abs(ev.real)) <= STABLE_TOLERANCE * size)
     return SteadyMotion(
         gamma3=math.cos(theta),
         theta=theta,
@@ -145,6 +191,8 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
         precession_rate=psi_dot,
         com_speed=abs(v_tau),
         com_radius=abs(v_tau / psi_dot) if psi_dot != 0 else math.inf,
+        eigenvalues=eig,
+        linearly_stable=stable,
     )
 
 

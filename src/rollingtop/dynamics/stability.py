@@ -1,0 +1,217 @@
+"""Stability of vertical spins, for every contact model (issue 14, section 2).
+
+A vertical spin -- a pole on the plane, the symmetry axis vertical, spin ``w3`` about it, the
+centre of mass at rest -- is a steady motion of every model: the contact velocity
+``v + w x r`` vanishes because ``r`` and ``w`` are both vertical, and no force has a torque. In
+the body frame ``(v, w, gamma)`` is then constant, and for a model whose equations are regular at
+the vertical these nine variables obey a closed system (they do not involve the frame's other
+vectors or the position). Its linearisation on the constraint manifold -- ``|gamma| = 1`` and the
+model's velocity constraints ``J(gamma) (v, w) = 0`` -- decides linear stability: the Jacobian of
+the right-hand side (central differences of the compiled kernel) restricted to the null space of
+the constraints' Jacobian, whose eigenvalues are purely imaginary or zero for a stable spin.
+
+A model whose constraint is singular at the vertical supplies its own eigenvalues
+(:attr:`~rollingtop.contact.ContactModel.vertical_eigenvalues`: the meridian model, through the
+reduction on the pole level). A model may also give a closed form of the threshold
+(:attr:`~rollingtop.contact.ContactModel.vertical_spin`), which is reported beside the one found
+from the eigenvalues.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rollingtop._errors import RollingTopError
+from rollingtop._jit import call
+from rollingtop._types import ComplexArray, FloatArray
+from rollingtop.body import SphericalTop
+from rollingtop.contact import ContactModel, get_model
+from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._layout import N_STATE
+
+__all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]
+
+#: Relative step of the central differences of the Jacobian.
+DIFF_STEP = 1e-6
+#: A spin counts as unstable when an eigenvalue's real part exceeds this, relative to the
+#: eigenvalues' size (the differences' error is ~1e-10 of it).
+UNSTABLE_TOLERANCE = 1e-6
+#: Bisection steps for the critical spin (each halves the bracket).
+BISECTIONS = 60
+POLES = {"south": 1, "north": -1}
+
+
+class StabilityError(RollingTopError):
+    """A stability question this module cannot answer (a body the model's analysis needs to be
+    symmetric, a spin that never stabilises)."""
+
+
+def _frame(gamma: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``alpha, beta`` completing ``gamma`` to an orthonormal frame (valid near the vertical)."""
+    a = np.array([1.0, 0.0, 0.0]) - gamma[0] * gamma
+    a /= np.linalg.norm(a)
+    return a, np.cross(gamma, a)
+
+
+def _state(x: FloatArray) -> FloatArray:
+    """The full state of ``x = (v, w, gamma)`` (frame completed, position and azimuth 0)."""
+    y = np.zeros(N_STATE)
+    y[0:6] = x[0:6]
+    gamma = x[6:9]
+    y[6:9], y[9:12] = _frame(gamma / np.linalg.norm(gamma))
+    y[12:15] = gamma
+    return y
+
+
+def _jacobian(fun: Any, x: FloatArray) -> FloatArray:
+    f0 = fun(x)
+    D = np.zeros((len(f0), len(x)))
+    for i in range(len(x)):
+        h = DIFF_STEP * max(1.0, abs(x[i]))
+        e = np.zeros(len(x))
+        e[i] = h
+        D[:, i] = (fun(x + e) - fun(x - e)) / (2.0 * h)
+    return D
+
+
+def _generic_eigenvalues(
+    model: ContactModel, body: SphericalTop, omega3: float, pole: int
+) -> ComplexArray:
+    x0 = np.zeros(9)
+    x0[5] = omega3
+    x0[8] = float(pole)
+    code = model.kernel_code(body, _state(x0))
+    p = body.params
+    ws = call(_kernel.new_workspace)
+
+    def rhs(x: FloatArray) -> FloatArray:
+        dy = np.zeros(N_STATE)
+        call(_kernel.rhs, code, p, _state(x), dy, ws)
+        return np.concatenate([dy[0:6], dy[12:15]])
+
+    def constraints(x: FloatArray) -> FloatArray:
+        J, bias, dirs = np.zeros((4, 6)), np.zeros(4), np.zeros((4, 3))
+        nc = call(_kernel.constraint_rows, code, p, _state(x), J, bias, dirs)
+        return np.concatenate([[x[6:9] @ x[6:9] - 1.0], J[:nc] @ x[0:6]])
+
+    G = _jacobian(constraints, x0)
+    _, sv, vt = np.linalg.svd(G)
+    rank = int(np.sum(sv > 1e-9 * sv[0]))
+    T = vt[rank:].T  # orthonormal basis of the tangent space of the constraint manifold
+    A = T.T @ _jacobian(rhs, x0) @ T
+    out: ComplexArray = np.linalg.eigvals(A).astype(complex)
+    return out
+
+
+def vertical_spin_eigenvalues(
+    body: SphericalTop, model: str | ContactModel, omega3: float, pole: str = "south"
+) -> ComplexArray:
+    """Eigenvalues of the linearisation at the vertical spin ``omega3`` on ``pole``.
+
+    Parameters
+    ----------
+    body : SphericalTop
+    model : str or ContactModel
+    omega3 : float
+        Spin rate about the vertical symmetry axis.
+    pole : {"south", "north"}
+        Which pole is on the plane: ``"south"``, ``gamma3 = 1`` (the body's ``-e3`` end down);
+        ``"north"``, ``gamma3 = -1``.
+
+    Returns
+    -------
+    ndarray of complex, shape (k,)
+        ``k`` is the dimension of the constraint manifold in ``(v, w, gamma)`` (the model's own
+        linearisation for a model singular at the vertical). Linearly stable when every real part
+        is zero (to :data:`UNSTABLE_TOLERANCE`).
+    """
+    model = get_model(model)
+    if pole not in POLES:
+        raise StabilityError(f"pole = {pole!r} must be 'south' or 'north'")
+    if not math.isfinite(omega3):
+        raise StabilityError(f"omega3 = {omega3!r} must be finite")
+    if model.vertical_eigenvalues is not None:
+        try:
+            return model.vertical_eigenvalues(body, float(omega3), POLES[pole])
+        except ValueError as exc:
+            raise StabilityError(str(exc)) from None
+    return _generic_eigenvalues(model, body, float(omega3), POLES[pole])
+
+
+def _unstable(eigenvalues: ComplexArray) -> bool:
+    size = max(1.0, float(np.max(np.abs(eigenvalues))))
+    return bool(np.max(eigenvalues.real) > UNSTABLE_TOLERANCE * size)
+
+
+@dataclass(frozen=True)
+class VerticalSpin:
+    """The stability of the vertical spin on one pole.
+
+    Attributes
+    ----------
+    pole : {"south", "north"}
+    com_above_centre : bool
+        Whether the centre of mass is above the sphere's centre (``pole a3 > 0``).
+    omega3_critical : float
+        Spin rate above which the spin is linearly stable (from the eigenvalues, by bisection to
+        round-off); 0 when every spin rate is.
+    omega3_closed_form : float or None
+        The model's closed form of the same (``None``: none, or a body it does not cover).
+    """
+
+    pole: str
+    com_above_centre: bool
+    omega3_critical: float
+    omega3_closed_form: float | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"pole": self.pole, "com_above_centre": self.com_above_centre,
+                "omega3_critical": self.omega3_critical,
+                "omega3_closed_form": self.omega3_closed_form}  # fmt: skip
+
+
+def _critical(body: SphericalTop, model: ContactModel, pole: str) -> float:
+    def unstable(w: float) -> bool:
+        return _unstable(vertical_spin_eigenvalues(body, model, w, pole))
+
+    if not unstable(0.0):
+        return 0.0
+    scale = math.sqrt(body.m * body.g * body.R / max(body.I3, 1e-300)) + 1.0
+    hi = scale
+    for _ in range(60):
+        if not unstable(hi):
+            break
+        hi *= 2.0
+    else:
+        raise StabilityError(f"the vertical spin on the {pole} pole is unstable up to "
+                             f"omega3 = {hi:g}")  # fmt: skip
+    lo = 0.0
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        if unstable(mid):
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def vertical_spins(body: SphericalTop, model: str | ContactModel) -> list[VerticalSpin]:
+    """The vertical spins of ``body`` under ``model`` on both poles, with their thresholds.
+
+    Returns
+    -------
+    list of VerticalSpin
+        South, then north.
+    """
+    model = get_model(model)
+    out = []
+    for pole, sign in POLES.items():
+        closed = None
+        if model.vertical_spin is not None and body.symmetric:
+            closed = float(model.vertical_spin(body, sign))
+        out.append(VerticalSpin(pole, sign * body.a3 > 0.0, _critical(body, model, pole), closed))
+    return out
