@@ -55,7 +55,8 @@ class SteadyMotion:
         the axis does not precess).
     eigenvalues : tuple of (float, float)
         ``(real, imaginary)`` parts of the eigenvalues of the full equations linearised at this
-        steady rolling (:func:`linearised_eigenvalues`); empty at a pole.
+        steady rolling (:func:`linearised_eigenvalues`); empty at a pole (or within round-off of
+        one, where the reduced variables cannot be differenced).
     linearly_stable : bool or None
         Whether every eigenvalue has a zero real part (``None`` at a pole).
     """
@@ -146,10 +147,14 @@ def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex
     D = np.zeros((4, 4))
     for i in range(4):
         h = DIFF_STEP * max(1.0, abs(x0[i]))
+        if i == 0:  # stay inside (-1, 1): near a pole the step shrinks with the distance to it
+            h = min(h, 0.25 * (1.0 - abs(gamma3)))
         e = np.zeros(4)
         e[i] = h
         D[:, i] = (reduced_rhs(level.body, level.M3, x0 + e)
                    - reduced_rhs(level.body, level.M3, x0 - e)) / (2 * h)  # fmt: skip
+    if not np.all(np.isfinite(D)):  # a steady motion at round-off distance from a pole
+        return np.full(4, complex(math.nan, math.nan))
     out: NDArray[np.complex128] = np.linalg.eigvals(D).astype(complex)
     return out
 
@@ -172,9 +177,10 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     stable = None
     if abs(s) > 1e-8 and 0.0 < theta < math.pi:
         ev = linearised_eigenvalues(level, math.cos(theta))
-        eig = tuple((float(z.real), float(z.imag)) for z in ev)
-        size = max(1.0, float(np.max(np.abs(ev))))
-        stable = bool(np.max(np.abs(ev.real)) <= STABLE_TOLERANCE * size)
+        if np.all(np.isfinite(ev)):
+            eig = tuple((float(z.real), float(z.imag)) for z in ev)
+            size = max(1.0, float(np.max(np.abs(ev))))
+            stable = bool(np.max(np.abs(ev.real)) <= STABLE_TOLERANCE * size)
     return SteadyMotion(
         gamma3=math.cos(theta),
         theta=theta,
