@@ -6,6 +6,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._simulate`: ``simulate``;
 - :mod:`._level`: ``equilibria``, ``orbits``, ``portrait`` (the reduction);
 - :mod:`._bifurcation`: ``bifurcation`` (the classification of the reduced motions);
+- :mod:`._rotation`: ``rotation`` (rotation numbers, classes of motion in absolute space);
 - :mod:`._stability`: ``stability`` (vertical spins, every model);
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;
@@ -20,6 +21,7 @@ from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
+from rollingtop.cli._rotation import rotation
 from rollingtop.cli._simulate import simulate
 from rollingtop.cli._stability import stability
 from rollingtop.cli._verify import verify
@@ -27,8 +29,8 @@ from rollingtop.cli._warmup import warmup
 
 __all__ = ["cli", "main"]
 
-for _command in (simulate, equilibria, orbits, portrait, bifurcation, stability, path, plot,
-                 compare, animate, ensemble, verify, warmup):  # fmt: skip
+for _command in (simulate, equilibria, orbits, portrait, bifurcation, rotation, stability, path,
+                 plot, compare, animate, ensemble, verify, warmup):  # fmt: skip
     cli.add_command(_command)
 
 

@@ -1,0 +1,91 @@
+"""``rollingtop rotation``: rotation numbers and the classes of motion in absolute space."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import click
+
+from rollingtop.cli import _output
+from rollingtop.cli._bifurcation import _range
+from rollingtop.cli._errors import BadInput
+from rollingtop.cli._options import json_option, scenario_argument
+
+__all__ = ["rotation"]
+
+
+@click.command()
+@scenario_argument
+@json_option
+@click.option("-o", "--output", type=click.Path(), default=None,
+              help="Also draw the map and a path of each class: FIG.png, .svg, .pdf.")  # fmt: skip
+@click.option("--c2-range", default=None, metavar="LO,HI",
+              help="C2 window (default: the bifurcation diagram's).")  # fmt: skip
+@click.option("--h-range", default=None, metavar="LO,HI",
+              help="h window (default: the bifurcation diagram's).")  # fmt: skip
+@click.option("--resolution", type=int, default=41, show_default=True,
+              help="Grid points along C2 and along h.")  # fmt: skip
+def rotation(
+    scenario: str,
+    as_json: bool,
+    output: str | None,
+    c2_range: str | None,
+    h_range: str | None,
+    resolution: int,
+) -> None:
+    """Rotation numbers N = Delta psi / 2 pi over the (C2, h) plane at the scenario's (M3, C1):
+    where the body drifts (N an integer), where its paths close (N = p/q) and where they fill
+    an annulus (quasi-periodic), with the limit of N at each centre of the scenario's level."""
+    from rollingtop.reduction import LevelSet, steady_motions
+    from rollingtop.reduction.bifurcation import bifurcation_diagram
+    from rollingtop.reduction.rotation import (
+        centre_rotation_number,
+        class_examples,
+        rotation_map,
+    )
+    from rollingtop.scenario import load_scenario
+
+    if not 3 <= resolution <= 1000:
+        raise BadInput(f"--resolution {resolution}: must be between 3 and 1000")
+    c2_window, h_window = _range("--c2-range", c2_range), _range("--h-range", h_range)
+    if output is not None:
+        from rollingtop.io import check_output_path
+        from rollingtop.plot import FIGURE_SUFFIXES
+
+        check_output_path(output, FIGURE_SUFFIXES)
+    sc = load_scenario(scenario)
+    M3, C1, C2 = sc.level_integrals()
+    diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=c2_window, h_range=h_window)
+    c2w = (float(diagram.C2_grid[0]), float(diagram.C2_grid[-1]))
+    hw = (float(diagram.h_grid[0]), float(diagram.h_grid[-1]))
+    with _output.counting("rotation numbers", resolution) as progress:
+        rmap = rotation_map(sc.body, M3, C1, C2_range=c2w, h_range=hw,
+                            resolution=(resolution, resolution), progress=progress)  # fmt: skip
+    examples = class_examples(sc.body, rmap)
+    summary: dict[str, Any] = {**rmap.to_dict(), "classes": examples}
+    if C2 is not None:
+        level = LevelSet(sc.body, M3, C1, C2)
+        summary["centres"] = [{"C2": C2, "gamma3": m.gamma3, "h": m.U,
+                               "N": centre_rotation_number(m)}
+                              for m in steady_motions(level) if m.type == "center"]  # fmt: skip
+    if output is not None:
+        from rollingtop.plot import save_figure
+        from rollingtop.plot.rotation import rotation_figure
+
+        save_figure(rotation_figure(diagram, rmap, examples), output)
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    console = _output.console()
+    lo, hi = summary["N_range"]
+    console.print(f"rotation number N over C2 in [{c2w[0]:.5g}, {c2w[1]:.5g}], h in "
+                  f"[{hw[0]:.5g}, {hw[1]:.5g}]: N from {lo:.6g} to {hi:.6g}; "
+                  f"{len(rmap.resonances)} points with N an integer")  # fmt: skip
+    for name, ex in examples.items():
+        frac = "" if ex["q"] in (None, 1) else f" = {ex['p']}/{ex['q']}"
+        console.print(f"{name}: N = {ex['N']:.6g}{frac} at C2 = {ex['C2']:.6g}, h = {ex['h']:.6g}")
+    for c in summary.get("centres", []):
+        console.print(f"centre at gamma3 = {c['gamma3']:.6g} (C2 = {c['C2']:g}): N -> {c['N']:.6g}")
+    if output is not None:
+        click.echo(f"wrote {output}")

@@ -1,0 +1,310 @@
+"""Rotation numbers: the classes of motion in absolute space (issue 14, section 3).
+
+Over one period ``T`` of ``gamma3`` the axis azimuth advances by ``Delta psi`` and the motion on
+the plane is a rigid motion (:mod:`rollingtop.absolute`). The **rotation number**
+``N = Delta psi / (2 pi)`` decides what the contact point and the centre of mass do:
+
+- ``N`` an integer: the rigid motion is a translation -- the body **drifts** without bound;
+- ``N = p/q`` in lowest terms with ``q >= 2``: after ``q`` periods the motion repeats -- the
+  paths are **closed**;
+- otherwise the paths fill an annulus -- **bounded, quasi-periodic**.
+
+``N`` depends on the level ``(C2, h)`` continuously along a family of orbits; the levels with
+``N`` an integer form the *resonance curves* of the ``(C2, h)`` plane, and those with small ``q``
+the low-order closed paths. At a centre ``N`` tends to ``psi' / omega`` (small oscillations
+of frequency ``omega`` while the axis precesses at ``psi'``); towards a separatrix the period
+grows like ``ln(1 / |h - h_s|) / lambda`` (``lambda`` the saddle's growth rate), so ``N``
+diverges logarithmically with slope ``-k psi'_s / (2 pi lambda)`` against ``ln |h - h_s|``
+(``k`` = 1 for an orbit that passes the saddle once a period, 2 for one around two wells) and
+the resonance curves accumulate at the separatrix.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import brentq
+
+from rollingtop._json import json_ready
+from rollingtop.body import SphericalTop
+from rollingtop.reduction._quadrature import period
+from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits
+from rollingtop.reduction.steady import SteadyMotion, critical_points
+
+__all__ = [
+    "RESONANCE_TOLERANCE",
+    "RotationMap",
+    "centre_rotation_number",
+    "classify_rotation",
+    "rotation_map",
+    "rotation_number",
+    "rotation_numbers",
+]
+
+FloatArray = NDArray[np.float64]
+
+#: ``|N - p/q|`` below this: resonant (drifting for ``q = 1``, closed for ``q >= 2``).
+RESONANCE_TOLERANCE = 1e-9
+#: Largest denominator of a rotation number classified as closed.
+MAX_DENOMINATOR = 12
+
+
+def rotation_number(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, float]:
+    """``N = Delta psi / (2 pi)`` of a periodic orbit on ``level`` at energy ``h``, with its
+    estimated absolute error (the quadrature of ``psi'`` over a period, as for the period)."""
+    if orbit.kind != "periodic":
+        raise LevelSetError(f"no rotation number for a {orbit.kind} orbit ({orbit.note})")
+    if level.pole == "both":  # no spin: the axis does not precess
+        return 0.0, 0.0
+    exact_level, exact_orbit = canonical_orbit(level, h, orbit)
+    lo, hi = exact_orbit.theta_min, exact_orbit.theta_max
+    # break points of the quadrature: the pole, and the critical points inside the orbit (a
+    # saddle there makes the integrand's logarithmic peak near a separatrix)
+    inside = [float(c) for c in critical_points(exact_level) if lo < c < hi]
+    peaks = [t for t in (exact_level.pole_theta,) if t is not None] + inside
+    dpsi, err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max, peaks=peaks,
+                       weight=exact_level.psi_dot)  # fmt: skip
+    return dpsi / (2 * math.pi), err / (2 * math.pi)
+
+
+def rotation_numbers(level: LevelSet, h: float) -> list[float]:
+    """``N`` of each periodic orbit of the level ``h`` (in order of increasing ``gamma3``)."""
+    return [rotation_number(level, h, o)[0] for o in orbits(level, h) if o.kind == "periodic"]
+
+
+def centre_rotation_number(motion: SteadyMotion) -> float:
+    """The limit of ``N`` at a centre: ``psi' / omega``."""
+    if motion.type != "center":
+        raise LevelSetError(f"a {motion.type} has no small oscillations")
+    return motion.precession_rate / motion.frequency
+
+
+def classify_rotation(N: float, max_denominator: int = MAX_DENOMINATOR) -> dict[str, Any]:
+    """The class of motion of rotation number ``N``: ``{"class": "drifting" | "closed" |
+    "quasi-periodic", "p", "q"}`` (``p/q`` the nearest fraction with ``q <= max_denominator``;
+    ``None`` for quasi-periodic)."""
+    frac = Fraction(N).limit_denominator(max_denominator)
+    if abs(N - float(frac)) <= RESONANCE_TOLERANCE:
+        kind = "drifting" if frac.denominator == 1 else "closed"
+        return {"class": kind, "p": frac.numerator, "q": frac.denominator}
+    return {"class": "quasi-periodic", "p": None, "q": None}
+
+
+@dataclass(frozen=True)
+class RotationMap:
+    """``N`` over a grid of the ``(C2, h)`` plane at fixed ``(M3, C1)``.
+
+    Attributes
+    ----------
+    C2_grid, h_grid : ndarray, shapes (nc,), (nh,)
+    N : ndarray, shape (nh, nc, k)
+        Rotation number of each periodic orbit of the level (in order of increasing
+        ``gamma3``; NaN where the level has fewer than ``k`` orbits or none).
+    family : ndarray of int, shape (nh, nc, k)
+        Which family each orbit belongs to, for joining grid points: a code of the centres
+        (minima of ``U``, numbered in order of ``gamma3`` among all critical points) the orbit
+        encloses; -1 where there is no orbit. Along a column ``N`` is continuous within a
+        family.
+    resonances : list of dict
+        Points ``{"N", "C2", "h", "orbit"}`` of the curves where ``N`` is an integer, found by
+        Brent's method along each column between grid points of the same orbit family.
+    """
+
+    M3: float
+    C1: float
+    C2_grid: FloatArray
+    h_grid: FloatArray
+    N: FloatArray
+    family: NDArray[np.int64]
+    resonances: list[dict[str, Any]]
+
+    def to_dict(self) -> dict[str, Any]:
+        finite = self.N[np.isfinite(self.N)]
+        return json_ready({
+            "M3": self.M3, "C1": self.C1,
+            "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
+            "h_range": [float(self.h_grid[0]), float(self.h_grid[-1])],
+            "grid": [len(self.C2_grid), len(self.h_grid)],
+            "N_range": [float(finite.min()), float(finite.max())] if finite.size else None,
+            "resonances": self.resonances,
+        })  # fmt: skip
+
+
+def _family_code(theta_c: FloatArray, centre: NDArray[np.bool_], orbit: Orbit) -> int:
+    """The centres inside ``orbit`` as a bit mask over the critical points (and their count)."""
+    code = len(theta_c)
+    for n, (t, c) in enumerate(zip(theta_c, centre, strict=True)):
+        if c and orbit.theta_min <= t <= orbit.theta_max:
+            code += 1 << (n + 8)
+    return code
+
+
+def _offset(h: float, level: LevelSet, k: int, count: int, target: float) -> float:
+    """``N - target`` of the ``k``-th of ``count`` orbits at ``h`` (for Brent's method)."""
+    return _family_n(level, h, k, count) - target
+
+
+def _family_n(level: LevelSet, h: float, k: int, count: int) -> float:
+    """``N`` of the ``k``-th of ``count`` periodic orbits at ``h`` (NaN if the count differs)."""
+    periodic = [o for o in orbits(level, h) if o.kind == "periodic"]
+    if len(periodic) != count:
+        return math.nan
+    return rotation_number(level, h, periodic[k])[0]
+
+
+def rotation_map(
+    body: SphericalTop,
+    M3: float,
+    C1: float,
+    *,
+    C2_range: tuple[float, float],
+    h_range: tuple[float, float],
+    resolution: tuple[int, int] = (41, 41),
+    max_orbits: int = 2,
+    progress: Callable[[int, int], None] | None = None,
+) -> RotationMap:
+    """Rotation numbers over a grid of ``(C2, h)`` and the integer-resonance points.
+
+    Parameters
+    ----------
+    body : SphericalTop
+    M3, C1 : float
+        Not a pole level.
+    C2_range, h_range : (float, float)
+        The window.
+    resolution : (int, int)
+        ``(nc, nh)`` grid points.
+    max_orbits : int
+        Orbits per level kept in ``N`` (levels with more are truncated).
+    progress : callable, optional
+        ``progress(done, total)`` after each column of ``C2``.
+    """
+    nc, nh = (int(x) for x in resolution)
+    C2_grid = np.linspace(*C2_range, nc)
+    h_grid = np.linspace(*h_range, nh)
+    N = np.full((nh, nc, max_orbits), np.nan)
+    family = np.full((nh, nc, max_orbits), -1, dtype=np.int64)
+    resonances: list[dict[str, Any]] = []
+    for j, c2 in enumerate(C2_grid):
+        level = LevelSet(body, M3, C1, float(c2))
+        if level.pole is not None:
+            raise LevelSetError(f"{level.describe()} is a pole level: not mapped")
+        theta_c = critical_points(level)
+        centre = level.d2U(theta_c) > 0 if theta_c.size else np.zeros(0, dtype=bool)
+        for i, h in enumerate(h_grid):
+            try:
+                found = [o for o in orbits(level, float(h)) if o.kind == "periodic"]
+            except LevelSetError:
+                continue  # no motion below min U
+            for k, o in enumerate(found[:max_orbits]):
+                N[i, j, k] = rotation_number(level, float(h), o)[0]
+                family[i, j, k] = _family_code(theta_c, centre, o)
+        counts = np.sum(np.isfinite(N[:, j, :]), axis=1)
+        for i in range(nh - 1):
+            if counts[i] != counts[i + 1] or counts[i] == 0:
+                continue
+            for k in range(int(counts[i])):
+                a, b = N[i, j, k], N[i + 1, j, k]
+                if family[i, j, k] != family[i + 1, j, k]:
+                    continue  # another family: N need not be continuous between
+                for m in range(math.ceil(min(a, b)), math.floor(max(a, b)) + 1):
+                    if not min(a, b) < m < max(a, b):
+                        continue
+                    bracket = (float(h_grid[i]), float(h_grid[i + 1]))
+                    args = (level, k, int(counts[i]), float(m))
+                    try:
+                        h_res = brentq(_offset, *bracket, args=args, xtol=1e-12)
+                    except ValueError:
+                        continue
+                    resonances.append({"N": m, "C2": float(c2), "h": float(h_res), "orbit": k})
+        if progress is not None:
+            progress(j + 1, nc)
+    return RotationMap(float(M3), float(C1), C2_grid, h_grid, N, family, resonances)
+
+
+def _crossing(
+    body: SphericalTop, rmap: RotationMap, target: float, k: int = 0
+) -> tuple[float, float] | None:
+    """A level ``(C2, h)`` of the map where orbit ``k`` has ``N = target`` exactly (Brent's
+    method between neighbouring grid points of one family), or ``None``."""
+    nh, nc, _ = rmap.N.shape
+    for j in range(nc):
+        level = LevelSet(body, rmap.M3, rmap.C1, float(rmap.C2_grid[j]))
+        counts = np.sum(np.isfinite(rmap.N[:, j, :]), axis=1)
+        for i in range(nh - 1):
+            a, b = rmap.N[i, j, k], rmap.N[i + 1, j, k]
+            if counts[i] != counts[i + 1] or not (min(a, b) < target < max(a, b)):
+                continue
+            if rmap.family[i, j, k] != rmap.family[i + 1, j, k]:
+                continue
+            try:
+                h = brentq(_offset, float(rmap.h_grid[i]), float(rmap.h_grid[i + 1]),
+                           args=(level, k, int(counts[i]), target), xtol=1e-13)  # fmt: skip
+            except ValueError:
+                continue
+            return float(rmap.C2_grid[j]), float(h)
+    return None
+
+
+def _simplest_fraction(a: float, b: float, max_q: int = 200) -> Fraction | None:
+    """The fraction with the smallest denominator ``2 <= q <= max_q`` strictly inside ``(a, b)``
+    (integers excluded: they are the drifting class)."""
+    lo, hi = min(a, b), max(a, b)
+    for q in range(2, max_q + 1):
+        p = math.floor(lo * q) + 1
+        while p / q < hi:
+            if math.gcd(p, q) == 1:
+                return Fraction(p, q)
+            p += 1
+    return None
+
+
+def class_examples(body: SphericalTop, rmap: RotationMap) -> dict[str, dict[str, Any]]:
+    """One level of each class of motion found on the map: ``{"drifting", "closed",
+    "quasi-periodic"} -> {"C2", "h", "orbit", "N", "p", "q"}`` (the first orbit of the level;
+    classes the map does not reach are left out). Drifting: an integer ``N``; closed: the
+    fraction ``p/q`` with the smallest ``q >= 2`` crossed between two grid levels of one
+    family; quasi-periodic: the grid level whose ``N`` is farthest from every fraction with
+    denominator at most 4."""
+    out: dict[str, dict[str, Any]] = {}
+    n0 = rmap.N[:, :, 0]
+    if not np.isfinite(n0).any():
+        return out
+    if rmap.resonances:
+        r = next((r for r in rmap.resonances if r["orbit"] == 0), None)
+        if r is not None:
+            out["drifting"] = {"C2": r["C2"], "h": r["h"], "orbit": 0, "N": float(r["N"]),
+                               "p": int(r["N"]), "q": 1}  # fmt: skip
+    best: Fraction | None = None
+    nh, nc = n0.shape
+    for j in range(nc):
+        for i in range(nh - 1):
+            a, b = n0[i, j], n0[i + 1, j]
+            same = rmap.family[i, j, 0] == rmap.family[i + 1, j, 0] >= 0
+            if not (same and np.isfinite(a) and np.isfinite(b)):
+                continue
+            frac = _simplest_fraction(float(a), float(b))
+            if frac is not None and (best is None or frac.denominator < best.denominator):
+                best = frac
+    if best is not None:
+        found = _crossing(body, rmap, float(best))
+        if found is not None:
+            out["closed"] = {"C2": found[0], "h": found[1], "orbit": 0, "N": float(best),
+                             "p": best.numerator, "q": best.denominator}  # fmt: skip
+    dist = np.full(n0.shape, -1.0)
+    ok = np.isfinite(n0)
+    fracs = np.array(sorted({p / q for q in range(1, 5) for p in range(-8 * q, 8 * q + 1)}))
+    dist[ok] = np.min(np.abs(n0[ok][:, None] - fracs[None, :]), axis=1)
+    row, col = (int(x) for x in np.unravel_index(int(np.argmax(dist)), dist.shape))
+    if dist[row, col] > 0:
+        out["quasi-periodic"] = {"C2": float(rmap.C2_grid[col]), "h": float(rmap.h_grid[row]),
+                                 "orbit": 0, "N": float(n0[row, col]), "p": None,
+                                 "q": None}  # fmt: skip
+    return out
