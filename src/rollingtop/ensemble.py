@@ -36,6 +36,7 @@ from rollingtop.scenario import (
 
 if TYPE_CHECKING:
     import xarray as xr
+    from distributed import Client
 
 __all__ = [
     "MAX_TABLE_BYTES",
@@ -190,8 +191,9 @@ def simulate_ensemble(
     max_steps: int = 10**7,
     threads: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    client: Client | None = None,
 ) -> EnsembleResult:
-    """Integrate ``N`` initial states in parallel on all cores.
+    """Integrate ``N`` initial states in parallel on all cores, or on a Dask cluster.
 
     Parameters
     ----------
@@ -214,6 +216,10 @@ def simulate_ensemble(
         the result's ``threads`` says how many ran.
     progress : callable, optional
         ``progress(done, N)``.
+    client : distributed.Client, optional
+        Run on this Dask cluster instead: the states go to the workers in chunks
+        (:data:`CLIENT_CHUNKS` per worker thread), each integrated by the compiled kernel on one
+        thread (``threads`` is then ignored); the results are the same as in-process.
     """
     model = get_model(model)
     if samples is not None:
@@ -260,11 +266,16 @@ def simulate_ensemble(
                      dtype=np.int64)  # fmt: skip
     params = np.array([b.params for b in bodies])
     t_eval = np.linspace(0.0, t_end, samples) if samples else np.array([0.0, float(t_end)])
-    compile_s = compile_kernels() + compile_ensemble()
-    out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol, atol=atol,
-                                              max_steps=max_steps, threads=threads,
-                                              progress=progress)  # fmt: skip
-    used = numba.get_num_threads() if threads is None else int(threads)
+    if client is not None:
+        compile_s = 0.0
+        out, final, stats, wall, used = _on_client(client, codes, params, states, t_eval, rtol,
+                                                   atol, max_steps, progress)  # fmt: skip
+    else:
+        compile_s = compile_kernels() + compile_ensemble()
+        out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol,
+                                                  atol=atol, max_steps=max_steps, threads=threads,
+                                                  progress=progress)  # fmt: skip
+        used = numba.get_num_threads() if threads is None else int(threads)
     integrals = _ensemble_integrals(model, bodies, codes, states, final)
     return EnsembleResult(
         model=model, bodies=bodies, initial=states, final=final, t_end=float(t_end),
@@ -274,6 +285,50 @@ def simulate_ensemble(
         wall_time_s=wall, compile_time_s=compile_s, threads=used,
         t=t_eval if samples else None, samples=out if samples else None,
     )  # fmt: skip
+
+
+#: Chunks of states per worker thread when :func:`simulate_ensemble` runs on a Dask client.
+CLIENT_CHUNKS = 4
+
+
+def _integrate_chunk(
+    codes: IntArray, params: FloatArray, states: FloatArray, t_eval: FloatArray, rtol: float,
+    atol: float, max_steps: int,
+) -> tuple[FloatArray, FloatArray, FloatArray, float]:  # fmt: skip
+    """One Dask task of :func:`simulate_ensemble`: a chunk on one thread of a worker."""
+    compile_kernels()
+    compile_ensemble()
+    return integrate_batch(codes, params, states, t_eval, rtol=rtol, atol=atol,
+                           max_steps=max_steps, threads=1)  # fmt: skip
+
+
+def _on_client(
+    client: Client, codes: IntArray, params: FloatArray, states: FloatArray, t_eval: FloatArray,
+    rtol: float, atol: float, max_steps: int, progress: Callable[[int, int], None] | None,
+) -> tuple[FloatArray, FloatArray, FloatArray, float, int]:  # fmt: skip
+    from distributed import as_completed
+
+    slots = max(1, sum(client.nthreads().values()))
+    N = len(states)
+    bounds = np.linspace(0, N, min(N, CLIENT_CHUNKS * slots) + 1).astype(int)
+    futures = {
+        client.submit(_integrate_chunk, codes[a:b], params[a:b], states[a:b], t_eval, rtol, atol,
+                      max_steps, pure=False): k
+        for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))
+    }  # fmt: skip
+    parts: dict[int, tuple[FloatArray, FloatArray, FloatArray, float]] = {}
+    done = 0
+    for fut in as_completed(futures):
+        k = futures[fut]
+        parts[k] = fut.result()
+        done += len(parts[k][1])
+        if progress is not None:
+            progress(done, N)
+    order = sorted(parts)
+    out = np.concatenate([parts[k][0] for k in order])
+    final = np.concatenate([parts[k][1] for k in order])
+    stats = np.concatenate([parts[k][2] for k in order])
+    return out, final, stats, max(parts[k][3] for k in order), slots
 
 
 def _ensemble_integrals(

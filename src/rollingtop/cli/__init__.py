@@ -8,6 +8,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._bifurcation`: ``bifurcation`` (the classification of the reduced motions);
 - :mod:`._rotation`: ``rotation`` (rotation numbers, classes of motion in absolute space);
 - :mod:`._stability`: ``stability`` (vertical spins, every model);
+- :mod:`._atlas`: ``atlas`` (the classification over a parameter grid, on Dask);
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;
 - :mod:`._verify`: ``verify``;
@@ -17,6 +18,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 from __future__ import annotations
 
 from rollingtop.cli._app import cli
+from rollingtop.cli._atlas import atlas
 from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._figures import animate, compare, path, plot
@@ -29,8 +31,8 @@ from rollingtop.cli._warmup import warmup
 
 __all__ = ["cli", "main"]
 
-for _command in (simulate, equilibria, orbits, portrait, bifurcation, rotation, stability, path,
-                 plot, compare, animate, ensemble, verify, warmup):  # fmt: skip
+for _command in (simulate, equilibria, orbits, portrait, bifurcation, rotation, stability, atlas,
+                 path, plot, compare, animate, ensemble, verify, warmup):  # fmt: skip
     cli.add_command(_command)
 
 

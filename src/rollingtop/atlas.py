@@ -1,0 +1,497 @@
+"""A parameter atlas of the classification, computed on Dask (issue 14, section 4).
+
+Body parameters (``R, m, g, a3, I1, I3`` of a dynamically symmetric body) times integrals
+(``M3, C1, C2``) on a grid; every cell classified as :mod:`rollingtop.reduction.bifurcation`
+classifies a level: the number of steady motions (critical points of ``U`` in ``(-1, 1)``) and
+of centres and saddles among them, the folds of the ``(M3, C1)`` diagram, and the rotation number
+at each centre (:func:`rollingtop.reduction.rotation.centre_rotation_number`).
+
+The grid is cut into chunks of cells, each a Dask task (``dask.distributed``): by default on an
+embedded local cluster of worker processes (no setup), or on an existing cluster given by its
+scheduler's address or a :class:`distributed.Client`. Every finished chunk is saved at once in a
+folder beside the output (``OUTPUT.partial/``, one ``.npz`` per chunk, each written atomically,
+with the spec's digest): a run that stops (a signal, a lost worker, a crash) resumes where it
+stopped and computes only the chunks not saved. The output (NetCDF ``.nc`` or a Zarr store
+``.zarr``) appears only when complete, atomically; then the partial folder is removed.
+
+The spec is a scenario file (``[body]``, ``[contact]``, ``[level]`` give the fixed values) plus
+an ``[axes]`` table whose keys are body or level keys, each a list of values or
+``{start, stop, num}``; the Dataset's dimensions follow the order of ``[axes]``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import io
+import json
+import os
+import shutil
+import tomllib
+import warnings
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from rollingtop._checks import short_repr
+from rollingtop._errors import BodyError, RollingTopError, ScenarioError
+from rollingtop._types import FloatArray
+from rollingtop.body import SphericalTop
+from rollingtop.io import check_output_path, netcdf_bytes, read_input_text, write_bytes_atomic
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from distributed import Client
+
+__all__ = ["AtlasError", "AtlasSpec", "atlas", "classify_cells", "load_atlas_spec"]
+
+BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3")
+LEVEL_KEYS = ("M3", "C1", "C2")
+AXIS_KEYS = BODY_KEYS + LEVEL_KEYS
+#: Largest number of cells of one atlas.
+MAX_CELLS = 10_000_000
+#: Cells per Dask task (a chunk, and a file of the partial folder).
+DEFAULT_CHUNK = 200
+#: Centres whose rotation number is kept per cell.
+MAX_CENTRES = 3
+#: Bumped when the classification changes: partial results of another version are not reused.
+ATLAS_VERSION = 1
+#: Status of a cell.
+STATUS = {
+    0: "classified",
+    1: "inadmissible body",
+    2: "pole level (C1 = +-M3)",
+    3: "level too large",
+}
+SUFFIXES = (".nc", ".zarr")
+MAX_SPEC_BYTES = 1_000_000
+
+
+class AtlasError(RollingTopError):
+    """A bad atlas spec, output, or cluster."""
+
+
+@dataclass(frozen=True)
+class AtlasSpec:
+    """A validated atlas spec.
+
+    Attributes
+    ----------
+    fixed : dict of str to float
+        Every key of :data:`AXIS_KEYS` with its fixed value (the first axis value for keys on
+        an axis).
+    axes : dict of str to ndarray
+        The axes, in order (the Dataset's dimensions).
+    """
+
+    fixed: dict[str, float]
+    axes: dict[str, FloatArray]
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(v) for v in self.axes.values())
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape))
+
+    def digest(self, chunk: int) -> str:
+        """What a partial result must match to be reused."""
+        axes = {k: v.tolist() for k, v in self.axes.items()}
+        text = json.dumps({"version": ATLAS_VERSION, "fixed": self.fixed, "chunk": chunk,
+                           "axes": axes}, sort_keys=True)  # fmt: skip
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def cells(self) -> FloatArray:
+        """Every cell's axis values, shape (size, n_axes), in C order of the axes."""
+        grids = np.meshgrid(*self.axes.values(), indexing="ij")
+        return np.stack([g.ravel() for g in grids], axis=1)
+
+
+def _axis(key: str, value: object) -> FloatArray:
+    try:
+        return _axis_values(key, value)
+    except ScenarioError as exc:  # a value that is not a finite number (rollingtop._checks)
+        raise AtlasError(str(exc)) from None
+
+
+def _axis_values(key: str, value: object) -> FloatArray:
+    from rollingtop._checks import number
+
+    where = f"axes.{key}"
+    if isinstance(value, list):
+        if not value:
+            raise AtlasError(f"{where} is empty")
+        out = np.array([number("axes", key, v) for v in value], dtype=float)
+    elif isinstance(value, dict):
+        unknown = set(value) - {"start", "stop", "num"}
+        if unknown or {"start", "stop", "num"} - set(value):
+            raise AtlasError(f"{where} must be a list or {{start, stop, num}}, got "
+                             f"{short_repr(value)}")  # fmt: skip
+        num = int(number("axes", f"{key}.num", value["num"], integer=True))
+        if num < 1:
+            raise AtlasError(f"{where}.num = {num} must be >= 1")
+        if num > MAX_CELLS:
+            raise AtlasError(f"{where}.num = {num} is more than {MAX_CELLS} values")
+        start = number("axes", f"{key}.start", value["start"])
+        stop = number("axes", f"{key}.stop", value["stop"])
+        out = np.linspace(start, stop, num)
+    else:
+        raise AtlasError(f"{where} must be a list of numbers or {{start, stop, num}}, got "
+                         f"{short_repr(value)}")  # fmt: skip
+    if not np.all(np.isfinite(out)):
+        raise AtlasError(f"{where} has non-finite values")
+    return out
+
+
+def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
+    """Validate a parsed spec (module docstring)."""
+    from rollingtop.scenario import Scenario
+
+    data = dict(data)
+    axes_t = data.pop("axes", None)
+    if not isinstance(axes_t, dict) or not axes_t:
+        raise AtlasError("missing or empty table [axes] (keys: " + ", ".join(AXIS_KEYS) + ")")
+    for key in axes_t:
+        if key not in AXIS_KEYS:
+            raise AtlasError(f"unknown axis {short_repr(key)} (allowed: {', '.join(AXIS_KEYS)})")
+    axes = {key: _axis(key, value) for key, value in axes_t.items()}
+    size = int(np.prod([len(v) for v in axes.values()], dtype=float))
+    if size > MAX_CELLS:
+        raise AtlasError(f"the atlas has {size} cells, more than {MAX_CELLS}")
+    # the fixed values: the scenario's, with each axis at its first value
+    level_t = dict(data.get("level", {})) if isinstance(data.get("level", {}), dict) else {}
+    for key in LEVEL_KEYS:
+        if key in axes:
+            level_t[key] = float(axes[key][0])
+    missing = [k for k in LEVEL_KEYS if k not in level_t]
+    if missing:
+        raise AtlasError(f"[level] or [axes] must give {', '.join(missing)}")
+    level_t = {k: v for k, v in level_t.items() if k in LEVEL_KEYS}
+    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    for key in BODY_KEYS:
+        if key in axes:
+            body_t[key] = float(axes[key][0])
+    data["body"], data["level"] = body_t, level_t
+    data.pop("initial", None)
+    sc = Scenario.from_dict(data)
+    if not sc.model.has_reduction:
+        raise AtlasError(f"the atlas classifies the reduction of the meridian model, not model "
+                         f"{sc.model.name!r}")  # fmt: skip
+    if not sc.body.symmetric:
+        raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
+                         f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
+    fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
+    fixed.update({k: float(level_t[k]) for k in LEVEL_KEYS})
+    return AtlasSpec(fixed, axes)
+
+
+def load_atlas_spec(path: str | os.PathLike[str]) -> AtlasSpec:
+    """Read and validate an atlas spec (a TOML scenario file with an ``[axes]`` table)."""
+    path = Path(path)
+    text = read_input_text(path, "atlas spec", MAX_SPEC_BYTES, ScenarioError)
+    try:
+        data = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError, ValueError) as exc:
+        raise AtlasError(f"{path}: invalid TOML: {exc}") from None
+    try:
+        return atlas_spec_from_dict(data)
+    except RollingTopError as exc:
+        raise AtlasError(f"{path}: {exc}") from None
+
+
+# ---- the classification of cells (pure functions: Dask tasks) ---------------------------------
+
+FIELDS = ("status", "n_steady", "n_centres", "n_saddles", "n_folds")
+
+
+def classify_cells(
+    fixed: Mapping[str, float], names: tuple[str, ...], values: FloatArray
+) -> dict[str, np.ndarray]:
+    """Classify the cells ``values`` (shape (k, len(names))): one Dask task.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``status, n_steady, n_centres, n_saddles, n_folds``, shape (k,), int (-1 where the cell
+        is not classified, see :data:`STATUS`); ``rotation_centre`` and ``centre_gamma3``,
+        shape (k, :data:`MAX_CENTRES`), NaN-padded, the centres in order of ``gamma3``.
+    """
+    from rollingtop.reduction.bifurcation import _classify_grid, _critical, folds
+    from rollingtop.reduction.level import LevelSet, LevelSetError
+    from rollingtop.reduction.rotation import centre_rotation_number
+    from rollingtop.reduction.steady import steady_motion
+
+    k = values.shape[0]
+    out = {name: np.full(k, -1, dtype=np.int16) for name in FIELDS}
+    out["rotation_centre"] = np.full((k, MAX_CENTRES), np.nan)
+    out["centre_gamma3"] = np.full((k, MAX_CENTRES), np.nan)
+    theta = _classify_grid()
+    fold_cache: dict[tuple[float, ...], int] = {}
+    for n in range(k):
+        p = dict(fixed)
+        p.update(zip(names, (float(x) for x in values[n]), strict=True))
+        try:
+            body = SphericalTop(**{key: p[key] for key in BODY_KEYS})
+        except BodyError:
+            out["status"][n] = 1
+            continue
+        try:
+            level = LevelSet(body, p["M3"], p["C1"], p["C2"])
+        except LevelSetError:
+            out["status"][n] = 3
+            continue
+        if level.pole is not None:
+            out["status"][n] = 2
+            continue
+        g3, _, u2 = _critical(level, theta)
+        out["status"][n] = 0
+        out["n_steady"][n] = len(g3)
+        out["n_centres"][n] = int(np.sum(u2 > 0))
+        out["n_saddles"][n] = int(np.sum(u2 < 0))
+        key = tuple(p[key] for key in (*BODY_KEYS, "M3", "C1"))
+        if key not in fold_cache:
+            fold_cache[key] = len(folds(body, p["M3"], p["C1"]))
+        out["n_folds"][n] = fold_cache[key]
+        centres = [t for t, c in zip(np.arccos(g3), u2 > 0, strict=True) if c][:MAX_CENTRES]
+        for c, t in enumerate(centres):
+            m = steady_motion(level, float(t))
+            out["centre_gamma3"][n, c] = m.gamma3
+            out["rotation_centre"][n, c] = centre_rotation_number(m)
+    return out
+
+
+# ---- running it on Dask, resumably --------------------------------------------------------------
+
+
+@contextlib.contextmanager
+def _client(client: Client | None, workers: int | None, scheduler: str | None) -> Iterator[Client]:
+    """The given client; else one connected to ``scheduler``; else an embedded local cluster of
+    ``workers`` processes (default: the cores), closed at the end."""
+    if client is not None:
+        yield client
+        return
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            remote = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise AtlasError(f"cannot reach the Dask scheduler at {short_repr(scheduler)}: "
+                             f"{why}") from None  # fmt: skip
+        try:
+            yield remote
+        finally:
+            remote.close()
+        return
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=50)  # fmt: skip
+    local = Client(cluster)
+    try:
+        yield local
+    finally:
+        local.close()
+        cluster.close()
+
+
+def _partial_folder(output: Path) -> Path:
+    return output.with_name(output.name + ".partial")
+
+
+def _load_partial(folder: Path, digest: str) -> dict[int, dict[str, np.ndarray]]:
+    """Chunks saved by an earlier run of the same spec (``{}`` if none)."""
+    if not folder.exists():
+        return {}
+    try:
+        saved = json.loads((folder / "spec.json").read_text())
+    except (OSError, ValueError):
+        saved = {}
+    if saved.get("digest") != digest:
+        raise AtlasError(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
+                         "remove it to start over")  # fmt: skip
+    done = {}
+    for f in folder.glob("chunk-*.npz"):
+        with contextlib.suppress(OSError, ValueError, KeyError):
+            with np.load(f) as z:
+                done[int(f.stem.split("-")[1])] = {key: z[key] for key in z.files}
+    return done
+
+
+def _save_chunk(folder: Path, k: int, result: Mapping[str, np.ndarray]) -> None:
+    buf = io.BytesIO()
+    np.savez(buf, **result)  # type: ignore[arg-type]
+    write_bytes_atomic(folder / f"chunk-{k:06d}.npz", buf.getvalue())
+
+
+def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> xr.Dataset:
+    import xarray as xr
+
+    dims = tuple(spec.axes)
+    merged = {key: np.concatenate([parts[k][key] for k in sorted(parts)])
+              for key in parts[min(parts)]}  # fmt: skip
+    data_vars = {}
+    docs = {
+        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large",
+        "n_steady": "steady motions (critical points of U in (-1, 1)); -1: not classified",
+        "n_centres": "steady motions that are centres (U'' > 0)",
+        "n_saddles": "steady motions that are saddles (U'' < 0)",
+        "n_folds": "folds of the (C2, h) bifurcation diagram of (M3, C1)",
+        "rotation_centre": "rotation number psi'/omega at each centre (in order of gamma3)",
+        "centre_gamma3": "gamma3 of each centre",
+    }
+    for key, values in merged.items():
+        if values.ndim == 1:
+            data_vars[key] = (dims, values.reshape(spec.shape), {"description": docs[key]})
+        else:
+            data_vars[key] = ((*dims, "centre"), values.reshape((*spec.shape, values.shape[1])),
+                              {"description": docs[key]})  # fmt: skip
+    attrs = {"fixed_json": json.dumps(spec.fixed), "axes": " ".join(dims),
+             "description": "rollingtop atlas: classification of the meridian model's reduced "
+                            "motions over body parameters and integrals (issue 14)"}  # fmt: skip
+    return xr.Dataset(data_vars, coords={k: v for k, v in spec.axes.items()}, attrs=attrs)
+
+
+def _write(ds: xr.Dataset, output: Path) -> None:
+    """The finished atlas, atomically: NetCDF through a temporary file, Zarr through a
+    temporary store renamed into place."""
+    if output.suffix.lower() == ".nc":
+        write_bytes_atomic(output, netcdf_bytes(ds))
+        return
+    tmp = output.with_name(f".{output.name}.tmp{os.getpid()}")
+    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        with warnings.catch_warnings():  # zarr 3: consolidated metadata is an extension
+            warnings.filterwarnings("ignore", message=".*[Cc]onsolidated metadata.*")
+            ds.to_zarr(tmp, mode="w")
+        old = output.with_name(f".{output.name}.old{os.getpid()}")
+        if output.exists():
+            os.replace(output, old)
+        os.replace(tmp, output)
+        shutil.rmtree(old, ignore_errors=True)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def check_atlas_output(output: str | os.PathLike[str]) -> Path:
+    """The output path, checked before any work (``.nc`` or ``.zarr``; a ``.zarr`` store may
+    exist and is replaced)."""
+    path = Path(output)
+    if path.suffix.lower() == ".zarr" and path.is_dir():
+        return path
+    try:
+        return check_output_path(path, SUFFIXES)
+    except RollingTopError as exc:
+        raise AtlasError(str(exc)) from None
+
+
+def atlas(
+    spec: AtlasSpec,
+    output: str | os.PathLike[str] | None = None,
+    *,
+    client: Client | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    chunk: int = DEFAULT_CHUNK,
+    progress: Callable[[int, int], None] | None = None,
+) -> xr.Dataset:
+    """Classify every cell of ``spec`` on Dask; write ``output`` (``.nc`` or ``.zarr``) if given.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    output : path, optional
+        Where to write the Dataset. With an output the run is resumable: finished chunks are
+        kept in ``OUTPUT.partial/`` until the output is written.
+    client : distributed.Client, optional
+        Run on this client's cluster (not closed here).
+    workers : int, optional
+        Worker processes of the embedded local cluster (default: the cores); ignored with
+        ``client`` or ``scheduler``.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:port``).
+    chunk : int
+        Cells per task.
+    progress : callable, optional
+        ``progress(done_cells, total_cells)``.
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per axis (in the spec's order), coordinates the axis values; the
+        variables of :func:`classify_cells`.
+    """
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+        raise AtlasError(f"chunk = {short_repr(chunk)} must be an integer >= 1")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):  # fmt: skip
+        raise AtlasError(f"workers = {short_repr(workers)} must be an integer >= 1")
+    out_path = None if output is None else check_atlas_output(output)
+    cells = spec.cells()
+    names = tuple(spec.axes)
+    starts = list(range(0, spec.size, chunk))
+    digest = spec.digest(chunk)
+    folder = None if out_path is None else _partial_folder(out_path)
+    done = {} if folder is None else _load_partial(folder, digest)
+    created = False
+    if folder is not None and not folder.exists():
+        folder.mkdir()
+        created = True
+        write_bytes_atomic(folder / "spec.json", json.dumps({"digest": digest}).encode())
+    try:
+        _compute(spec, cells, names, starts, chunk, done, folder, client, workers, scheduler,
+                 progress)  # fmt: skip
+    except BaseException:
+        if created and folder is not None and not any(folder.glob("chunk-*.npz")):
+            shutil.rmtree(folder, ignore_errors=True)  # nothing saved: leave no trace
+        raise
+    ds = _dataset(spec, done)
+    if out_path is not None and folder is not None:
+        _write(ds, out_path)
+        shutil.rmtree(folder, ignore_errors=True)
+    return ds
+
+
+def _compute(
+    spec: AtlasSpec,
+    cells: FloatArray,
+    names: tuple[str, ...],
+    starts: list[int],
+    chunk: int,
+    done: dict[int, dict[str, np.ndarray]],
+    folder: Path | None,
+    client: Client | None,
+    workers: int | None,
+    scheduler: str | None,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Submit the chunks not in ``done`` and collect them into it (saving each at once)."""
+    finished = sum(min(chunk, spec.size - starts[k]) for k in done)
+    if progress is not None:
+        progress(finished, spec.size)
+    todo = [k for k in range(len(starts)) if k not in done]
+    if todo:
+        from distributed import as_completed
+
+        with _client(client, workers, scheduler) as c:
+            futures = {c.submit(classify_cells, spec.fixed, names,
+                                cells[starts[k] : starts[k] + chunk], pure=False): k
+                       for k in todo}  # fmt: skip
+            for fut in as_completed(futures):
+                k = futures[fut]
+                result = fut.result()
+                done[k] = result
+                if folder is not None:
+                    _save_chunk(folder, k, result)
+                finished += len(result["status"])
+                if progress is not None:
+                    progress(finished, spec.size)
+
+
+def classify_in_process(spec: AtlasSpec) -> xr.Dataset:
+    """The same Dataset computed in this process, without Dask (small atlases, tests)."""
+    return _dataset(spec, {0: classify_cells(spec.fixed, tuple(spec.axes), spec.cells())})

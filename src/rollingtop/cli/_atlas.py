@@ -1,0 +1,70 @@
+"""``rollingtop atlas``: the classification over a grid of body parameters and integrals, on
+Dask."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import click
+import numpy as np
+
+from rollingtop.cli import _output
+from rollingtop.cli._errors import BadInput
+from rollingtop.cli._options import json_option
+
+__all__ = ["atlas"]
+
+
+@click.command()
+@click.argument("spec", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(), required=True,
+              help="ATLAS.nc or ATLAS.zarr (written when complete; resumable).")  # fmt: skip
+@click.option("--workers", type=int, default=None,
+              help="Worker processes of the embedded local cluster (default: cores).")  # fmt: skip
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Run on an existing Dask cluster (tcp://host:port).")  # fmt: skip
+@click.option("--chunk", type=int, default=None, help="Cells per task (default 200).")
+@json_option
+def atlas(
+    spec: str,
+    output: str,
+    workers: int | None,
+    scheduler: str | None,
+    chunk: int | None,
+    as_json: bool,
+) -> None:
+    """Classify every cell of SPEC's grid: a scenario file whose [axes] table sets the axes
+    (body keys a3, I1, I3, R, m, g and level keys M3, C1, C2; each a list or {start, stop,
+    num}). An interrupted run resumes where it stopped (OUTPUT.partial/)."""
+    from rollingtop.atlas import DEFAULT_CHUNK, atlas, check_atlas_output, load_atlas_spec
+
+    if workers is not None and workers < 1:
+        raise BadInput(f"--workers {workers}: must be >= 1")
+    if chunk is not None and chunk < 1:
+        raise BadInput(f"--chunk {chunk}: must be >= 1")
+    check_atlas_output(output)
+    atlas_spec = load_atlas_spec(spec)
+    start = time.perf_counter()
+    with _output.counting("cells", atlas_spec.size) as progress:
+        ds = atlas(atlas_spec, output, workers=workers, scheduler=scheduler,
+                   chunk=chunk or DEFAULT_CHUNK, progress=progress)  # fmt: skip
+    wall = time.perf_counter() - start
+    classified = ds["status"].values == 0
+    counts: dict[str, dict[str, int]] = {}
+    for name in ("n_steady", "n_centres", "n_saddles", "n_folds"):
+        uniq, cnt = np.unique(ds[name].values[classified], return_counts=True)
+        counts[name] = {str(int(u)): int(c) for u, c in zip(uniq, cnt, strict=True)}
+    dims = {str(k): int(v) for k, v in ds.sizes.items() if k != "centre"}
+    summary = {"output": output, "dims": dims, "cells": atlas_spec.size,
+               "classified": int(classified.sum()), "counts": counts, "wall_s": wall}  # fmt: skip
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    console = _output.console()
+    shape = " x ".join(f"{k} {v}" for k, v in dims.items())
+    console.print(f"{atlas_spec.size} cells ({shape}), {summary['classified']} classified, "
+                  f"in {wall:.1f} s")  # fmt: skip
+    for name, c in counts.items():
+        console.print(f"  {name}: " + ", ".join(f"{k}: {v} cells" for k, v in c.items()))
+    click.echo(f"wrote {output}")

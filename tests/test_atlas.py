@@ -1,0 +1,182 @@
+"""The parameter atlas on Dask (rollingtop.atlas): the same cells as in-process and as an
+independent count of steady motions, resumable, atomic, and bad specs refused in one line."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from rollingtop import SphericalTop
+from rollingtop.atlas import (
+    AtlasError,
+    atlas,
+    atlas_spec_from_dict,
+    classify_in_process,
+)
+from rollingtop.reduction import LevelSet, steady_motions
+
+from .test_cli import run_cli
+
+BODY = {"R": 1.0, "m": 1.0, "g": 1.0, "a3": 0.1, "I1": 0.3, "I3": 0.5}
+
+
+def spec_dict(axes, level=None):
+    return {"body": dict(BODY), "contact": {"model": "meridian"},
+            "level": level or {"M3": 1.0, "C1": 0.5, "C2": -2.0}, "axes": axes}  # fmt: skip
+
+
+SMALL = {"a3": [0.05, 0.2], "C2": {"start": -3.0, "stop": 0.0, "num": 4}, "C1": [0.0, 0.5, 1.0]}
+
+
+@pytest.fixture(scope="module")
+def client():
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster) as c:  # fmt: skip
+        yield c
+
+
+def test_cells_match_steady_motions():
+    """Each classified cell's counts equal those of steady_motions (an independent search on a
+    finer grid) for the same body and level."""
+    spec = atlas_spec_from_dict(spec_dict(SMALL))
+    ds = classify_in_process(spec)
+    assert list(ds["n_steady"].dims) == ["a3", "C2", "C1"]
+    for a3 in SMALL["a3"]:
+        for c2 in ds["C2"].values:
+            for c1 in SMALL["C1"]:
+                cell = ds.sel(a3=a3, C2=c2, C1=c1)
+                if c1 == 1.0:  # the pole line C1 = M3
+                    assert int(cell["status"]) == 2 and int(cell["n_steady"]) == -1
+                    continue
+                body = SphericalTop(**{**BODY, "a3": a3})
+                motions = steady_motions(LevelSet(body, 1.0, c1, float(c2)))
+                assert int(cell["status"]) == 0
+                assert int(cell["n_steady"]) == len(motions)
+                assert int(cell["n_centres"]) == sum(m.type == "center" for m in motions)
+                assert int(cell["n_saddles"]) == sum(m.type == "saddle" for m in motions)
+                centres = [m for m in motions if m.type == "center"]
+                for k, m in enumerate(centres):
+                    assert float(cell["rotation_centre"][k]) == pytest.approx(
+                        m.precession_rate / m.frequency, rel=1e-12)  # fmt: skip
+
+
+def test_dask_equals_in_process(client, tmp_path):
+    spec = atlas_spec_from_dict(spec_dict(SMALL))
+    expected = classify_in_process(spec)
+    seen = []
+    ds = atlas(spec, tmp_path / "a.nc", client=client, chunk=5,
+               progress=lambda done, n: seen.append((done, n)))  # fmt: skip
+    assert ds.identical(expected)
+    with xr.open_dataset(tmp_path / "a.nc") as f:
+        assert f["n_steady"].equals(expected["n_steady"])
+        assert f["rotation_centre"].equals(expected["rotation_centre"])
+    assert seen[-1] == (spec.size, spec.size)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.nc"]  # partial folder removed
+
+
+def test_zarr_output(client, tmp_path):
+    spec = atlas_spec_from_dict(spec_dict({"C2": [-2.0, -1.0]}))
+    atlas(spec, tmp_path / "a.zarr", client=client)
+    with xr.open_zarr(tmp_path / "a.zarr") as f:
+        assert f["n_steady"].values.tolist() == [3, 1]
+
+
+def test_an_interrupted_run_resumes_without_recomputing(client, tmp_path):
+    spec = atlas_spec_from_dict(spec_dict(SMALL))
+    out = tmp_path / "a.nc"
+
+    def stop_after_two_chunks(done, n):
+        if done >= 10:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        atlas(spec, out, client=client, chunk=5, progress=stop_after_two_chunks)
+    assert not out.exists()
+    saved = sorted((tmp_path / "a.nc.partial").glob("chunk-*.npz"))
+    assert len(saved) >= 2
+    first = []
+    ds = atlas(spec, out, client=client, chunk=5, progress=lambda d, n: first.append(d))
+    assert first[0] == 5 * len(saved)  # the saved chunks count as done from the start
+    assert ds.identical(classify_in_process(spec))
+    assert out.exists() and not (tmp_path / "a.nc.partial").exists()
+
+
+def test_partial_results_of_another_spec_are_not_reused(client, tmp_path):
+    spec = atlas_spec_from_dict(spec_dict(SMALL))
+    (tmp_path / "a.nc.partial").mkdir()
+    (tmp_path / "a.nc.partial" / "spec.json").write_text(json.dumps({"digest": "other"}))
+    with pytest.raises(AtlasError, match="another spec"):
+        atlas(spec, tmp_path / "a.nc", client=client)
+
+
+@pytest.mark.parametrize(
+    ("axes", "message"),
+    [
+        ({}, "missing or empty table"),
+        ({"a3": []}, "axes.a3 is empty"),
+        ({"foo": [1.0]}, "unknown axis"),
+        ({"C2": {"start": 0.0, "stop": 1.0}}, "must be a list or"),
+        ({"C2": {"start": 0.0, "stop": 1.0, "num": 0}}, "num = 0"),
+        ({"C2": [math.inf]}, "axes.C2 = inf"),
+        ({"C2": "x"}, "must be a list"),
+    ],
+)
+def test_bad_axes(axes, message):
+    with pytest.raises(AtlasError, match=message):
+        atlas_spec_from_dict(spec_dict(axes))
+
+
+def test_non_symmetric_body_is_refused():
+    data = spec_dict({"C2": [0.0]})
+    data["body"]["I2"] = 0.35
+    with pytest.raises(AtlasError, match="symmetric"):
+        atlas_spec_from_dict(data)
+
+
+def test_inadmissible_bodies_are_cells_not_errors():
+    """I3 > 2 I1 breaks the triangle inequality: status 1, not a failure of the whole atlas."""
+    ds = classify_in_process(atlas_spec_from_dict(spec_dict({"I3": [0.5, 0.7]})))
+    assert ds["status"].values.tolist() == [0, 1]
+
+
+def _spec_file(tmp_path, axes_toml):
+    text = ("[body]\nR = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n"
+            '[contact]\nmodel = "meridian"\n[level]\nM3 = 1.0\nC1 = 0.5\nC2 = -2.0\n'
+            f"[axes]\n{axes_toml}\n")  # fmt: skip
+    path = tmp_path / "spec.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.slow
+def test_cli_atlas_on_the_embedded_cluster(capsys, tmp_path):
+    """The default: an embedded local cluster of worker processes."""
+    spec = _spec_file(tmp_path, "C2 = [-2.0, -1.0]\nC1 = [0.0, 0.5]")
+    out = tmp_path / "a.nc"
+    code, stdout, err = run_cli(capsys, "atlas", str(spec), "-o", str(out), "--workers", "2",
+                                "--json")  # fmt: skip
+    assert code == 0, err
+    summary = json.loads(stdout)
+    assert summary["dims"] == {"C2": 2, "C1": 2} and summary["classified"] == 4
+    with xr.open_dataset(out) as f:
+        assert f["n_steady"].values.tolist() == [[3, 3], [1, 1]]
+
+
+@pytest.mark.parametrize(
+    ("extra", "axes", "message"),
+    [
+        ([], "C2 = []", "axes.C2 is empty"),
+        (["--scheduler", "tcp://127.0.0.1:1"], "C2 = [0.0]", "cannot reach the Dask scheduler"),
+        (["--workers", "0"], "C2 = [0.0]", "--workers 0"),
+    ],
+)
+def test_cli_atlas_errors(capsys, tmp_path, extra, axes, message):
+    spec = _spec_file(tmp_path, axes)
+    code, out, err = run_cli(capsys, "atlas", str(spec), "-o", str(tmp_path / "a.nc"), *extra)
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and message in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
