@@ -1,6 +1,7 @@
 """rollingtop benchmarks: side-by-side timings against scipy.integrate.solve_ivp.
 
-Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs] [--only W1,W2,W3,cold_start,C,peers,scaling]
+Run:  python benchmarks/run_benchmarks.py [--quick] [--write-docs]
+                                          [--only W1,W2,W3,cold_start,C,peers,scaling,atlas]
                                           [--out benchmarks/results.json]
 
 --write-docs (old name: --readme) rewrites the results block of docs/guide/performance.md and
@@ -391,6 +392,10 @@ def table(res) -> str:
         import scaling
 
         rows += ["", scaling.table(res["scaling"])]
+    if res.get("atlas"):
+        import atlas
+
+        rows += ["", atlas.table(res["atlas"])]
     return "\n".join(rows)
 
 
@@ -474,8 +479,12 @@ def readme_block(res) -> str:
     rows += ["", f"Cold start (import and compile, empty numba cache): {cs['empty_cache_s']:.0f} s; "
              f"a short `rollingtop simulate` with a warm cache: {cs['simulate_warm_cache_s']:.2f} s "
              f"(whole process). Ensemble of {w2r['n']} trajectories on 2 threads: "
-             f"{100 * w2r['parallel_efficiency_2']:.0f} % parallel efficiency. Details, all "
-             "tables and how to rerun: [performance](docs/guide/performance.md)."]  # fmt: skip
+             f"{100 * w2r['parallel_efficiency_2']:.0f} % parallel efficiency."]  # fmt: skip
+    if res.get("atlas"):
+        a = res["atlas"]
+        rows[-1] += (f" The atlas on Dask: {a['workers']['2']['cells_per_s']:.0f} cells/s on 2 "
+                     f"workers, {100 * a['parallel_efficiency_2']:.0f} % parallel efficiency.")  # fmt: skip
+    rows[-1] += " Details, all tables and how to rerun: [performance](docs/guide/performance.md)."
     return "\n".join(rows)
 
 
@@ -527,7 +536,7 @@ def main() -> None:
     ap.add_argument(
         "--only",
         metavar="PARTS",
-        help="comma-separated subset of W1,W2,W3,cold_start,C,peers,scaling to measure; the rest "
+        help="comma-separated subset of W1,W2,W3,cold_start,C,peers,scaling,atlas to measure; the rest "
         "is kept from --out",
     )
     args = ap.parse_args()
@@ -539,7 +548,7 @@ def main() -> None:
         print(f"wrote {DOCS_PAGE.relative_to(ROOT)} and {README.relative_to(ROOT)}")
         return
     quick = args.quick
-    parts = {"W2", "W3", "cold_start", "W1", "C", "peers", "scaling"}
+    parts = {"W2", "W3", "cold_start", "W1", "C", "peers", "scaling", "atlas"}
     only = set(args.only.split(",")) if args.only else parts
     if only - parts:
         raise SystemExit(f"--only: unknown part(s) {', '.join(sorted(only - parts))}")
@@ -577,6 +586,11 @@ def main() -> None:
         # the NumPy solve_ivp baseline is W1's already (hundreds of seconds)
         names = tuple(n for n in PEERS if n != "solve_ivp_numpy_rhs")
         res["peers"] = peers_w1(1e3 if quick else 1e4, 2 if quick else 5, peers=names)
+    if "atlas" in only:
+        print("atlas ...", flush=True)
+        from atlas import atlas_benchmark
+
+        res["atlas"] = atlas_benchmark(rounds=2 if quick else 3)
     res["table_markdown"] = table(res)
     Path(args.out).write_text(json.dumps(res, indent=2))
     print(res["table_markdown"])

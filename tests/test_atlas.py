@@ -4,7 +4,6 @@ independent count of steady motions, resumable, atomic, and bad specs refused in
 import json
 import math
 
-import numpy as np
 import pytest
 import xarray as xr
 

@@ -22,6 +22,7 @@ an ``[axes]`` table whose keys are body or level keys, each a list of values or
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import io
 import json
@@ -208,6 +209,16 @@ def load_atlas_spec(path: str | os.PathLike[str]) -> AtlasSpec:
 FIELDS = ("status", "n_steady", "n_centres", "n_saddles", "n_folds")
 
 
+@functools.lru_cache(maxsize=4096)
+def _fold_count(*key: float) -> int:
+    """Folds of the diagram of ``(body, M3, C1)`` (independent of ``C2``): cached in each worker
+    process across its tasks, since neighbouring cells share them."""
+    from rollingtop.reduction.bifurcation import folds
+
+    body = SphericalTop(**dict(zip(BODY_KEYS, key[:6], strict=True)))
+    return len(folds(body, key[6], key[7]))
+
+
 def classify_cells(
     fixed: Mapping[str, float], names: tuple[str, ...], values: FloatArray
 ) -> dict[str, np.ndarray]:
@@ -220,7 +231,7 @@ def classify_cells(
         is not classified, see :data:`STATUS`); ``rotation_centre`` and ``centre_gamma3``,
         shape (k, :data:`MAX_CENTRES`), NaN-padded, the centres in order of ``gamma3``.
     """
-    from rollingtop.reduction.bifurcation import _classify_grid, _critical, folds
+    from rollingtop.reduction.bifurcation import _classify_grid, _critical
     from rollingtop.reduction.level import LevelSet, LevelSetError
     from rollingtop.reduction.rotation import centre_rotation_number
     from rollingtop.reduction.steady import steady_motion
@@ -230,7 +241,6 @@ def classify_cells(
     out["rotation_centre"] = np.full((k, MAX_CENTRES), np.nan)
     out["centre_gamma3"] = np.full((k, MAX_CENTRES), np.nan)
     theta = _classify_grid()
-    fold_cache: dict[tuple[float, ...], int] = {}
     for n in range(k):
         p = dict(fixed)
         p.update(zip(names, (float(x) for x in values[n]), strict=True))
@@ -252,10 +262,7 @@ def classify_cells(
         out["n_steady"][n] = len(g3)
         out["n_centres"][n] = int(np.sum(u2 > 0))
         out["n_saddles"][n] = int(np.sum(u2 < 0))
-        key = tuple(p[key] for key in (*BODY_KEYS, "M3", "C1"))
-        if key not in fold_cache:
-            fold_cache[key] = len(folds(body, p["M3"], p["C1"]))
-        out["n_folds"][n] = fold_cache[key]
+        out["n_folds"][n] = _fold_count(*(p[key] for key in (*BODY_KEYS, "M3", "C1")))
         centres = [t for t, c in zip(np.arccos(g3), u2 > 0, strict=True) if c][:MAX_CENTRES]
         for c, t in enumerate(centres):
             m = steady_motion(level, float(t))
