@@ -240,7 +240,7 @@ def classify_cells(
     out = {name: np.full(k, -1, dtype=np.int16) for name in FIELDS}
     out["rotation_centre"] = np.full((k, MAX_CENTRES), np.nan)
     out["centre_gamma3"] = np.full((k, MAX_CENTRES), np.nan)
-    theta = _classify_grid()
+    theta = _classify_grid()  # (0, pi): pole levels are not classified here (status 2)
     for n in range(k):
         p = dict(fixed)
         p.update(zip(names, (float(x) for x in values[n]), strict=True))
@@ -257,13 +257,14 @@ def classify_cells(
         if level.pole is not None:
             out["status"][n] = 2
             continue
-        g3, _, u2 = _critical(level, theta)
+        th, _, u2 = _critical(level, theta)
+        g3 = np.cos(th)
         out["status"][n] = 0
         out["n_steady"][n] = len(g3)
         out["n_centres"][n] = int(np.sum(u2 > 0))
         out["n_saddles"][n] = int(np.sum(u2 < 0))
         out["n_folds"][n] = _fold_count(*(p[key] for key in (*BODY_KEYS, "M3", "C1")))
-        centres = [t for t, c in zip(np.arccos(g3), u2 > 0, strict=True) if c][:MAX_CENTRES]
+        centres = [t for t, c in zip(th, u2 > 0, strict=True) if c][:MAX_CENTRES]
         for c, t in enumerate(centres):
             m = steady_motion(level, float(t))
             out["centre_gamma3"][n, c] = m.gamma3

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rollingtop import SphericalTop
-from rollingtop.reduction import LevelSet, LevelSetError, steady_motions
+from rollingtop.reduction import LevelSet, LevelSetError, orbits, steady_motions
 from rollingtop.reduction import bifurcation as bf
 
 from ..conftest import EXAMPLES, PAPER_BODY
@@ -145,8 +145,11 @@ def test_regions_of_the_paper_level_are_labelled_as_a_sampled_u_says():
     assert wells[0] < 0.6 < wells[1]
 
 
-def test_region_index_agrees_with_the_signature_at_grid_points():
-    d = bf.bifurcation_diagram(PAPER, 1.0, 0.5, resolution=(41, 41))
+@pytest.mark.parametrize("C1", [0.5, 1.0])
+def test_region_index_agrees_with_the_signature_at_grid_points(C1):
+    """Also on the pole level, where the pole's energy cuts a region in two (orbits below it
+    turn back before the pole, those above pass through it)."""
+    d = bf.bifurcation_diagram(PAPER, 1.0, C1, resolution=(41, 41))
     rng = np.random.default_rng(3)
     checked = 0
     for _ in range(40):
@@ -154,8 +157,11 @@ def test_region_index_agrees_with_the_signature_at_grid_points():
         k = d.region_index[i, j]
         if k < 0:
             continue
-        level = LevelSet(PAPER, 1.0, 0.5, float(d.C2_grid[j]))
-        assert bf.region_signature(level, float(d.h_grid[i])) == d.regions[k].signature
+        level = LevelSet(PAPER, 1.0, C1, float(d.C2_grid[j]))
+        got = bf.region_orbits(level, float(d.h_grid[i]))
+        r = d.regions[k]
+        assert [n for n, _ in got] == list(r.signature)
+        assert [p for _, p in got] == list(r.through_pole)
         checked += 1
     assert checked > 20
 
@@ -170,9 +176,23 @@ def test_steady_count_map_matches_steady_motions():
     assert set(m.to_dict()["steady_counts"]) <= {"1", "3"}
 
 
-def test_pole_levels_and_bad_windows_are_refused():
-    with pytest.raises(LevelSetError, match="pole level"):
-        bf.bifurcation_diagram(PAPER, 1.0, 1.0)
+@pytest.mark.parametrize("C1", [1.0, -1.0])
+def test_pole_levels_label_the_orbits_through_the_pole(C1):
+    """On the pole lines C1 = +-M3 orbits pass through the pole: each region's orbits and their
+    pole passages are those rollingtop.reduction.orbits finds at its representative level."""
+    d = bf.bifurcation_diagram(PAPER, 1.0, C1)
+    assert any(any(r.through_pole) for r in d.regions)
+    for r in d.regions:
+        found = [o for o in orbits(LevelSet(PAPER, 1.0, C1, r.C2), r.h) if o.kind == "periodic"]
+        assert len(found) == len(r.signature), r
+        assert sorted(o.pole_passage for o in found) == sorted(r.through_pole), r
+        if any(r.through_pole):
+            assert "through the pole" in r.label
+
+
+def test_the_level_without_spin_and_bad_windows_are_refused():
+    with pytest.raises(LevelSetError, match="without spin"):
+        bf.bifurcation_diagram(PAPER, 0.0, 0.0)
     with pytest.raises(LevelSetError, match="C2 range"):
         bf.bifurcation_diagram(PAPER, 1.0, 0.5, C2_range=(1.0, 0.0))
 
@@ -215,10 +235,10 @@ def test_cli_bad_options(capsys, tmp_path, monkeypatch, args, message):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_cli_pole_level_is_one_line(capsys, tmp_path):
+def test_cli_no_spin_level_is_one_line(capsys, tmp_path):
     from ..conftest import scenario_text
 
     path = tmp_path / "s.toml"
-    path.write_text(scenario_text(initial=None, level="M3 = 1.0\nC1 = 1.0"))
+    path.write_text(scenario_text(initial=None, level="M3 = 0.0\nC1 = 0.0"))
     code, out, err = run_cli(capsys, "bifurcation", str(path))
-    assert code == 2 and "pole level" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "without spin" in err and len(err.strip().splitlines()) == 1

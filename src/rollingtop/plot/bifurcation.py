@@ -24,21 +24,31 @@ def _thumbnail(ax, diagram: BifurcationDiagram, k: int) -> None:  # type: ignore
     """The level curve ``h`` of region ``k``'s representative level in ``(gamma3, w_tau)``."""
     region = diagram.regions[k]
     level = LevelSet(diagram.body, diagram.M3, diagram.C1, region.C2)
-    g = np.linspace(-1.0, 1.0, 2001)[1:-1]
-    theta = LevelSet.theta_of(g)
+    if level.pole is None:
+        g = np.linspace(-1.0, 1.0, 2001)[1:-1]
+        theta = LevelSet.theta_of(g)
+    else:  # a pole level: the signed angle, in which orbits pass the pole regularly
+        lo, hi = level.theta_domain
+        theta = np.linspace(lo, hi, 2001)[1:-1]
+        g = theta
     with np.errstate(over="ignore", invalid="ignore"):
         gap = 2.0 * (region.h - level.U(theta)) / level.rho(theta)
     w = np.where(gap >= 0.0, np.sqrt(np.clip(gap, 0.0, None)), np.nan)
     ax.plot(g, w, color=CENTRE_COLOUR, lw=1.2)
     ax.plot(g, -w, color=CENTRE_COLOUR, lw=1.2)
     ax.axhline(0.0, color="0.8", lw=0.5, zorder=0)
-    ax.set_xlim(-1.0, 1.0)
+    ax.set_xlim(g[0], g[-1])
     top = np.nanmax(w) if np.isfinite(w).any() else 1.0
     ax.set_ylim(-1.15 * top, 1.15 * top)
-    ax.set_xticks([-1, 0, 1])
+    if level.pole is None:
+        ax.set_xticks([-1, 0, 1])
     ax.set_yticks([])
     ax.tick_params(labelsize=6, length=2, pad=1)
     ax.set_title(f"{region.name}: {region.label}", fontsize=7, pad=2)
+
+
+def _on_pole_level(diagram: BifurcationDiagram) -> bool:
+    return LevelSet(diagram.body, diagram.M3, diagram.C1, 0.0).pole is not None
 
 
 def bifurcation_figure(
@@ -62,6 +72,9 @@ def bifurcation_figure(
     ax.pcolormesh(diagram.C2_grid, diagram.h_grid, shade, cmap=cmap, shading="nearest",
                   vmin=-0.5, vmax=len(regions) - 0.5, alpha=0.8, rasterized=True)  # fmt: skip
     ax.plot(diagram.C2_grid, diagram.min_U, color="0.3", lw=0.8, ls=":", label="min U")
+    if np.isfinite(diagram.pole_energy).any():
+        ax.plot(diagram.C2_grid, diagram.pole_energy, color="#7b3294", lw=1.2, ls="-.",
+                label="U at the pole (above: through the pole)")  # fmt: skip
     for br in diagram.branches:
         for is_centre, style, colour in ((True, "-", CENTRE_COLOUR), (False, "--", SADDLE_COLOUR)):
             c2 = np.where(br.centre == is_centre, br.C2, np.nan)
@@ -90,7 +103,8 @@ def bifurcation_figure(
         sub = fig.add_subplot(grid[k % rows_t, 3 + k // rows_t])
         _thumbnail(sub, diagram, k)
         if k % rows_t == rows_t - 1 or k == len(regions) - 1:
-            sub.set_xlabel("gamma3", fontsize=7, labelpad=1)
+            axis = "gamma3" if diagram.regions and _on_pole_level(diagram) is False else "theta"
+            sub.set_xlabel(axis, fontsize=7, labelpad=1)
     if count_map is not None:
         axc = fig.add_subplot(grid[:, 3 + cols :])
         counts = np.ma.masked_less(count_map.count, 0)

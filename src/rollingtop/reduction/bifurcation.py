@@ -26,7 +26,10 @@ intervals, each one periodic orbit of ``gamma3`` around the centres (minima of `
 In the plane ``(C1, C2)`` at fixed ``M3`` the number of steady motions changes across the fold
 curves ``C1 -> C2*(fold)``.
 
-Pole levels (``C1 = +-M3``, where an orbit can pass through the pole) are not classified here yet.
+On a pole level (``C1 = +-M3``) the signed nutation angle covers both sides of the pole, where
+``U`` is finite and smooth (:mod:`rollingtop.reduction.level`): an orbit whose interval of
+``{U < h}`` contains the pole passes through it, and the regions say which do. The level without
+spin (``M3 = C1 = 0``, ``U`` periodic) is refused.
 """
 
 from __future__ import annotations
@@ -69,12 +72,14 @@ _COMPLEX_STEP = 1e-30
 
 
 def _base_level(body: SphericalTop, M3: float, C1: float) -> LevelSet:
-    """The level ``(M3, C1, 0)``: its ``U`` and ``P`` are ``U0`` and ``P0``; pole levels refused."""
+    """The level ``(M3, C1, 0)``: its ``U`` and ``P`` are ``U0`` and ``P0``. On a pole level
+    (``C1 = +-M3``) the signed nutation angle's domain holds both sides of the pole
+    (:attr:`LevelSet.theta_domain`); the level without spin (``M3 = C1 = 0``) is refused."""
     level = LevelSet(body, M3, C1, 0.0)
-    if level.pole is not None:
+    if level.pole == "both":
         raise LevelSetError(
-            f"M3 = {M3:g}, C1 = {C1:g} is a pole level (C1 = +-M3): its orbits can pass "
-            "through the pole, and the bifurcation diagram does not classify those yet"
+            f"M3 = {M3:g}, C1 = {C1:g}: without spin U is periodic in theta (rolling over both "
+            "poles, rollingtop.reduction.no_spin); the bifurcation diagram needs M3 != 0"
         )
     return level
 
@@ -133,19 +138,28 @@ def _dc2_star(level: LevelSet, theta: FloatArray) -> FloatArray:
 
 
 def _cuts(level: LevelSet) -> list[float]:
-    """The poles of ``C2*`` in ``(0, pi)``, sorted: ``theta`` of ``gamma3 = C1/M3`` and of
-    ``gamma3 = -R/a3`` where these lie in ``(-1, 1)``."""
+    """The poles of ``C2*`` inside the theta domain, sorted: where ``gamma3 = C1/M3`` (not on a
+    pole level, where ``C1/M3 = +-1``) and ``gamma3 = -R/a3``, if in ``(-1, 1)``."""
     b = level.body
-    cuts = []
-    if level.M3 != 0.0 and abs(level.C1 / level.M3) < 1.0:
-        cuts.append(math.acos(level.C1 / level.M3))
+    values = []
+    if level.pole is None and level.M3 != 0.0 and abs(level.C1 / level.M3) < 1.0:
+        values.append(level.C1 / level.M3)
     if b.a3 != 0.0 and abs(b.R / b.a3) < 1.0:
-        cuts.append(math.acos(-b.R / b.a3))
-    return sorted(cuts)
+        values.append(-b.R / b.a3)
+    lo, hi = level.theta_domain
+    cuts = []
+    for c in values:
+        t = math.acos(c)
+        for k in (-1, 0, 1):
+            for x in (t + 2 * math.pi * k, -t + 2 * math.pi * k):
+                if lo < x < hi:
+                    cuts.append(x)
+    return sorted(set(cuts))
 
 
 def _intervals(level: LevelSet) -> list[tuple[float, float]]:
-    edges = [0.0, *_cuts(level), math.pi]
+    lo, hi = level.theta_domain
+    edges = [lo, *_cuts(level), hi]
     return [(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
 
 
@@ -166,19 +180,24 @@ class Fold:
         The level ``C2``, the steady motion's ``gamma3`` and its energy ``h``.
     kind : {"max", "min"}
         Whether ``C2*`` has a local maximum or minimum there (in ``gamma3``).
+    theta : float
+        The signed nutation angle (``gamma3 = cos theta``; negative beyond a pole passage).
     """
 
     C2: float
     gamma3: float
     h: float
     kind: str
+    theta: float = math.nan
 
     def to_dict(self) -> dict[str, Any]:
-        return {"C2": self.C2, "gamma3": self.gamma3, "h": self.h, "kind": self.kind}
+        return {"C2": self.C2, "gamma3": self.gamma3, "h": self.h, "kind": self.kind,
+                "theta": self.theta}  # fmt: skip
 
 
 def folds(body: SphericalTop, M3: float, C1: float) -> list[Fold]:
-    """Every fold of the ``(C2, h)`` diagram of ``(M3, C1)``, sorted by ``gamma3``.
+    """Every fold of the ``(C2, h)`` diagram of ``(M3, C1)``, sorted by ``gamma3`` (by
+    decreasing signed ``theta`` on a pole level).
 
     The zeros of ``dC2*/dtheta`` (complex step) bracketed on :data:`BRANCH_POINTS` points per
     interval between poles and refined by Brent's method to round-off; a pair of folds closer
@@ -201,8 +220,8 @@ def folds(body: SphericalTop, M3: float, C1: float) -> list[Fold]:
                 # C2* has a maximum in theta where its derivative goes from + to -; in gamma3
                 # (decreasing in theta) the same point is a maximum too
                 kind = "max" if d[k] > 0 else "min"
-                found.append(Fold(c2, math.cos(t), h, kind))
-    return sorted(found, key=lambda f: f.gamma3)
+                found.append(Fold(c2, math.cos(t), h, kind, float(t)))
+    return sorted(found, key=lambda f: -f.theta)
 
 
 @dataclass(frozen=True)
@@ -213,6 +232,8 @@ class Branch:
     ----------
     gamma3, C2, h : ndarray, shape (n,)
         Points ``(C2*(gamma3), h*(gamma3))`` of the curve.
+    theta : ndarray, shape (n,)
+        The signed nutation angle of each point (``gamma3 = cos theta``).
     centre : ndarray of bool, shape (n,)
         Whether the steady motion there is a centre (``U'' > 0``); saddles elsewhere.
     """
@@ -221,6 +242,7 @@ class Branch:
     C2: FloatArray
     h: FloatArray
     centre: NDArray[np.bool_]
+    theta: FloatArray
 
 
 def _branches(level: LevelSet, n: int = BRANCH_POINTS) -> list[Branch]:
@@ -234,13 +256,14 @@ def _branches(level: LevelSet, n: int = BRANCH_POINTS) -> list[Branch]:
             _, _, _, dq2 = level._q(th)
             # U'' = -m P' C2*' / I1^2 (derivative of U'(theta; C2*(theta)) = 0 along the curve)
             u2 = -b.m * (dq2 + level.M3 * b.a3) * _dc2_star(level, th) / b.I1**2
-            out.append(Branch(np.cos(th)[::-1], c2[::-1], h[::-1], (u2 > 0)[::-1]))
+            out.append(Branch(np.cos(th)[::-1], c2[::-1], h[::-1], (u2 > 0)[::-1], th[::-1]))
     return out
 
 
 def _critical(level: LevelSet, theta: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Critical points of ``U`` on ``level`` in order of increasing ``gamma3``: ``gamma3``, ``U``
-    and ``U''_theta`` there (sign changes of ``dU`` on ``theta``, refined by Brent's method)."""
+    """Critical points of ``U`` on ``level`` in order of decreasing signed ``theta`` (increasing
+    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there (sign changes of
+    ``dU`` on ``theta``, refined by Brent's method)."""
     with np.errstate(over="ignore", invalid="ignore"):
         d = level.dU(theta)
     sign = np.sign(d)
@@ -249,52 +272,97 @@ def _critical(level: LevelSet, theta: FloatArray) -> tuple[FloatArray, FloatArra
         if np.isfinite(d[k]) and np.isfinite(d[k + 1]):
             roots.append(brentq(lambda x: float(level.dU(x)), theta[k], theta[k + 1],
                                 xtol=1e-15, rtol=4 * np.finfo(float).eps))  # fmt: skip
-    th = np.array(sorted(roots, reverse=True))  # increasing gamma3
-    return np.cos(th), level.U(th), level.d2U(th) if th.size else th
+    th = np.array(sorted(roots, reverse=True))  # increasing gamma3 on (0, pi)
+    return th, level.U(th), level.d2U(th) if th.size else th
 
 
-def _orbits_at(U: FloatArray, centre: NDArray[np.bool_], h: float) -> tuple[tuple[int, ...], ...]:
-    """The periodic orbits of the level ``h`` from the critical points (in order of increasing
-    ``gamma3``, ``U`` there, which are centres): each orbit as the indices of the centres it
-    encloses. Exact: ``U`` is monotone between critical points and ``+inf`` at both poles, so
-    the intervals of ``{U < h}`` are separated by the saddles with ``U >= h``."""
+#: Marks an orbit (a tuple of centre indices) that passes through the pole.
+THROUGH_POLE = -1
+#: The pole's energy among the cuts of a column's h axis (pole levels).
+POLE_CUT = -2
+
+
+def _orbits_at(
+    U: FloatArray,
+    centre: NDArray[np.bool_],
+    h: float,
+    theta: FloatArray | None = None,
+    pole: tuple[float, float] | None = None,
+) -> tuple[tuple[int, ...], ...]:
+    """The periodic orbits of the level ``h`` from the critical points (in order of decreasing
+    ``theta``, ``U`` there, which are centres): each orbit as the indices of the centres it
+    encloses, followed by :data:`THROUGH_POLE` when it passes through ``pole`` = ``(theta_p,
+    U(theta_p))`` (a pole level; ``theta`` the critical points' angles). Exact: ``U`` is monotone
+    between critical points and ``+inf`` at both ends of the domain, so the intervals of
+    ``{U < h}`` are separated by the saddles with ``U >= h``."""
     orbits: list[tuple[int, ...]] = []
     group: list[int] = []
+    upper = math.inf  # theta of the saddle that bounds the current group from above
+
+    def close(lower: float) -> None:
+        if not group:
+            return
+        through = pole is not None and pole[1] < h and lower < pole[0] < upper
+        orbits.append((*group, THROUGH_POLE) if through else tuple(group))
+
     for k in range(len(U)):
         if not centre[k] and U[k] >= h:
-            if group:
-                orbits.append(tuple(group))
+            close(float(theta[k]) if theta is not None else -math.inf)
             group = []
+            upper = float(theta[k]) if theta is not None else math.inf
         elif centre[k] and U[k] < h:
             group.append(k)
-    if group:
-        orbits.append(tuple(group))
+    close(-math.inf)
     return tuple(orbits)
 
 
-def region_signature(level: LevelSet, h: float) -> tuple[int, ...]:
+def _centres(orbit: Sequence[int]) -> list[int]:
+    return [k for k in orbit if k != THROUGH_POLE]
+
+
+def _pole(level: LevelSet) -> tuple[float, float] | None:
+    """``(theta, U)`` of the pole an orbit of a pole level can pass, else ``None``."""
+    t = level.pole_theta
+    return None if t is None else (t, float(level.U(t)))
+
+
+def region_orbits(level: LevelSet, h: float) -> list[tuple[int, bool]]:
     """What the level ``h`` of ``level`` holds: for each periodic orbit (each interval of
-    ``{U < h}``, in order of increasing ``gamma3``) the number of centres (minima of ``U``)
-    inside it; ``()``: no motion (``h <= min U``). Not for pole levels."""
-    if level.pole is not None:
-        raise LevelSetError(f"{level.describe()} is a pole level: not classified")
-    _, U, u2 = _critical(level, _classify_grid())
-    return tuple(len(o) for o in _orbits_at(U, u2 > 0, h))
+    ``{U < h}``, in order of increasing ``gamma3``, or of decreasing signed ``theta`` on a pole
+    level) the number of centres (minima of ``U``) inside it and whether it passes through the
+    pole; ``[]``: no motion (``h <= min U``)."""
+    _base_level(level.body, level.M3, level.C1)  # refuses the level without spin
+    theta, U, u2 = _critical(level, _classify_grid(level))
+    return [(len(_centres(o)), THROUGH_POLE in o)
+            for o in _orbits_at(U, u2 > 0, h, theta, _pole(level))]  # fmt: skip
 
 
-def _classify_grid() -> FloatArray:
-    return _interval_grid(0.0, math.pi, CLASSIFY_POINTS)
+def region_signature(level: LevelSet, h: float) -> tuple[int, ...]:
+    """The number of centres inside each orbit of the level ``h`` (:func:`region_orbits`)."""
+    return tuple(n for n, _ in region_orbits(level, h))
 
 
-def describe_signature(signature: Sequence[int]) -> str:
+def _classify_grid(level: LevelSet | None = None) -> FloatArray:
+    lo, hi = (0.0, math.pi) if level is None else level.theta_domain
+    return _interval_grid(lo, hi, int(CLASSIFY_POINTS * (hi - lo) / math.pi))
+
+
+def describe_signature(signature: Sequence[int], through_pole: Sequence[bool] = ()) -> str:
     """Words for a :func:`region_signature`: ``"1 orbit around 1 centre"``, ``"2 orbits around
-    1 + 1 centres"``, ``"no motion"``."""
+    1 + 1 centres"``, ``"no motion"``; with ``through_pole``, which orbits pass the pole."""
     if not signature:
         return "no motion"
     n = len(signature)
     centres = " + ".join(str(c) for c in signature)
     plural = "s" if n > 1 or signature[0] != 1 else ""
-    return f"{n} orbit{'s' if n > 1 else ''} around {centres} centre{plural}"
+    words = f"{n} orbit{'s' if n > 1 else ''} around {centres} centre{plural}"
+    passing = [k for k, p in enumerate(through_pole) if p]
+    if passing and n == 1:
+        words += ", through the pole"
+    elif passing:
+        which = " and ".join(f"orbit {k + 1}" for k in passing)
+        words += f" ({which} through the pole)"
+    return words
 
 
 @dataclass(frozen=True)
@@ -315,6 +383,8 @@ class Region:
         column.
     centre_gamma3 : tuple of tuple of float
         At the representative level: ``gamma3`` of the centres inside each orbit.
+    through_pole : tuple of bool
+        Whether each orbit passes through the pole (pole levels ``C1 = +-M3`` only).
     C2_range, h_range : tuple of float
         The extent of the region on the grid.
     cells : int
@@ -327,6 +397,7 @@ class Region:
     C2: float
     h: float
     centre_gamma3: tuple[tuple[float, ...], ...]
+    through_pole: tuple[bool, ...]
     C2_range: tuple[float, float]
     h_range: tuple[float, float]
     cells: int
@@ -336,6 +407,7 @@ class Region:
             "name": self.name, "label": self.label, "orbits": len(self.signature),
             "centres_per_orbit": list(self.signature), "C2": self.C2, "h": self.h,
             "centre_gamma3": [list(g) for g in self.centre_gamma3],
+            "through_pole": list(self.through_pole),
             "C2_range": list(self.C2_range), "h_range": list(self.h_range), "cells": self.cells,
         }  # fmt: skip
 
@@ -358,6 +430,9 @@ class BifurcationDiagram:
         Index into ``regions`` of each grid cell, for drawing (-1: no motion).
     min_U : ndarray, shape (nc,)
         ``min U`` over ``gamma3`` at each ``C2`` of the grid (below it: no motion).
+    pole_energy : ndarray, shape (nc,)
+        On a pole level, ``U`` at the pole for each ``C2`` of the grid: above it the orbits pass
+        through the pole (NaN off the pole levels).
     """
 
     body: SphericalTop
@@ -370,6 +445,7 @@ class BifurcationDiagram:
     h_grid: FloatArray
     region_index: NDArray[np.int64]
     min_U: FloatArray
+    pole_energy: FloatArray
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary: the folds, the regions and the grid's extent."""
@@ -451,30 +527,37 @@ def bifurcation_diagram(
     if not (math.isfinite(c2_lo) and math.isfinite(c2_hi) and c2_lo < c2_hi):
         raise LevelSetError(f"C2 range ({c2_lo:g}, {c2_hi:g}) must be finite and increasing")
     C2_grid = np.linspace(c2_lo, c2_hi, nc)
-    theta = _classify_grid()
+    theta = _classify_grid(level)
     # per column: the critical values cut the h axis into intervals, each with one set of
     # orbits; a node is (column, lo, hi, orbits, its bounding critical points' indices, count)
     nodes: list[tuple[int, float, float, tuple[tuple[int, ...], ...], tuple[int, int, int]]] = []
     columns: list[list[int]] = []
     gammas: list[FloatArray] = []
     min_U = np.empty(nc)
+    pole_energy = np.full(nc, np.nan)
     for j, c2 in enumerate(C2_grid):
         lv = LevelSet(body, level.M3, level.C1, float(c2))
-        g3, U, u2 = _critical(lv, theta)
-        gammas.append(g3)
+        th, U, u2 = _critical(lv, theta)
+        gammas.append(np.cos(th))
+        pole = _pole(lv)
         centre = u2 > 0
         min_U[j] = float(np.min(U[centre])) if centre.any() else math.nan
-        order = [int(k) for k in np.argsort(U, kind="stable")]
+        # the h axis is cut at the critical values and, on a pole level, at the pole's energy
+        # (above it orbits pass through the pole); POLE_CUT stands for the pole in the ids
+        cut_values = [(float(u), k) for k, u in enumerate(U)]
+        if pole is not None:
+            cut_values.append((pole[1], POLE_CUT))
+            pole_energy[j] = pole[1]
+        cut_values.sort()
         column = []
-        for pos, k in enumerate(order):
-            lo = float(U[k])
-            upper = order[pos + 1] if pos + 1 < len(order) else -1
-            hi = float(U[upper]) if upper >= 0 else math.inf
+        for pos, (lo, k) in enumerate(cut_values):
+            upper = cut_values[pos + 1][1] if pos + 1 < len(cut_values) else -1
+            hi = cut_values[pos + 1][0] if pos + 1 < len(cut_values) else math.inf
             if not hi > lo:
                 continue
             mid = 0.5 * (lo + hi) if math.isfinite(hi) else lo + 1.0 + abs(lo)
             column.append(len(nodes))
-            nodes.append((j, lo, hi, _orbits_at(U, centre, mid), (k, upper, len(U))))
+            nodes.append((j, lo, hi, _orbits_at(U, centre, mid, th, pole), (k, upper, len(U))))
         columns.append(column)
     if h_range is None:
         h_range = _default_h_range(branches, (c2_lo, c2_hi), float(np.nanmin(min_U)))
@@ -500,7 +583,7 @@ def bifurcation_diagram(
             # neither)
             return o1 == o2 and (id1[0] == id2[0] or id1[1] == id2[1])
         # a fold between them: the same kind of orbits, overlapping in h
-        return [len(o) for o in o1] == [len(o) for o in o2] and lo1 < hi2 and lo2 < hi1
+        return _kinds(o1) == _kinds(o2) and lo1 < hi2 and lo2 < hi1
 
     for j in range(nc - 1):
         for a in columns[j]:
@@ -520,7 +603,7 @@ def bifurcation_diagram(
         lo_c, hi_c = max(lo, h_lo), min(hi, h_hi)
         los = [max(nodes[b][1], h_lo) for b in group]
         his = [min(nodes[b][2], h_hi) for b in group]
-        where = tuple(tuple(float(gammas[j][k]) for k in orbit) for orbit in orbits)
+        where = tuple(tuple(float(gammas[j][k]) for k in _centres(orbit)) for orbit in orbits)
         reps.append((float(C2_grid[j]), 0.5 * (lo_c + hi_c), orbits, group, min(los), max(his),
                      where))  # fmt: skip
     reps.sort(key=lambda r: (r[0], r[1]))
@@ -531,15 +614,20 @@ def bifurcation_diagram(
         for a in group:
             j, lo_a, hi_a, _, _ = nodes[a]
             region_index[(h_grid > lo_a) & (h_grid <= hi_a), j] = n_reg
-        sig = tuple(len(o) for o in orbits)
+        sig = tuple(len(_centres(o)) for o in orbits)
+        passing = tuple(THROUGH_POLE in o for o in orbits)
         regions.append(Region(
-            name=_region_name(n_reg), signature=sig, label=describe_signature(sig),
-            C2=c2, h=h, centre_gamma3=where,
+            name=_region_name(n_reg), signature=sig, label=describe_signature(sig, passing),
+            C2=c2, h=h, centre_gamma3=where, through_pole=passing,
             C2_range=(float(C2_grid[min(cols)]), float(C2_grid[max(cols)])),
             h_range=(lo, hi), cells=len(group),
         ))  # fmt: skip
     return BifurcationDiagram(body, float(level.M3), float(level.C1), branches, fs, regions,
-                              C2_grid, h_grid, region_index, min_U)  # fmt: skip
+                              C2_grid, h_grid, region_index, min_U, pole_energy)  # fmt: skip
+
+
+def _kinds(orbits: tuple[tuple[int, ...], ...]) -> list[tuple[int, bool]]:
+    return [(len(_centres(o)), THROUGH_POLE in o) for o in orbits]
 
 
 def _region_name(k: int) -> str:
