@@ -93,10 +93,12 @@ def small_map():
 def test_resonance_points_have_integer_rotation_numbers(small_map):
     rmap, _ = small_map
     assert rmap.resonances
-    for r in rmap.resonances[:5]:
+    assert any(r["q"] == 1 for r in rmap.resonances)
+    for r in rmap.resonances[:8]:
         level = LevelSet(PAPER, 1.0, 0.5, r["C2"])
         n = rot.rotation_numbers(level, r["h"])[r["orbit"]]
-        assert n == pytest.approx(r["N"], abs=1e-9)
+        assert n == pytest.approx(r["p"] / r["q"], abs=1e-9)
+        assert r["N"] == r["p"] / r["q"] and r["q"] <= rot.CURVE_DENOMINATOR
 
 
 def _full_run(example, periods, samples):

@@ -81,7 +81,8 @@ def rotation(
     lo, hi = summary["N_range"]
     console.print(f"rotation number N over C2 in [{c2w[0]:.5g}, {c2w[1]:.5g}], h in "
                   f"[{hw[0]:.5g}, {hw[1]:.5g}]: N from {lo:.6g} to {hi:.6g}; "
-                  f"{len(rmap.resonances)} points with N an integer")  # fmt: skip
+                  f"{sum(r['q'] == 1 for r in rmap.resonances)} points with N an integer, "
+                  f"{sum(r['q'] > 1 for r in rmap.resonances)} with N = p/2 or p/3")  # fmt: skip
     for name, ex in examples.items():
         frac = "" if ex["q"] in (None, 1) else f" = {ex['p']}/{ex['q']}"
         console.print(f"{name}: N = {ex['N']:.6g}{frac} at C2 = {ex['C2']:.6g}, h = {ex['h']:.6g}")

@@ -50,10 +50,12 @@ def rotation_figure(
     cbar.set_label("|N - nearest integer|, first orbit", fontsize=8)
     for br in diagram.branches:
         ax.plot(br.C2, br.h, color="w", lw=0.9, alpha=0.8)
-    res = [r for r in rmap.resonances if r["orbit"] == 0]
-    if res:
-        ax.plot([r["C2"] for r in res], [r["h"] for r in res], ".", color="cyan", ms=3,
-                label="N integer (drift)")  # fmt: skip
+    for q, colour, what in ((1, "cyan", "N integer (drift)"), (2, "#7fff00", "N = k + 1/2"),
+                            (3, "#ffd700", "N = p/3")):  # fmt: skip
+        res = [r for r in rmap.resonances if r["orbit"] == 0 and r["q"] == q]
+        if res:
+            ax.plot([r["C2"] for r in res], [r["h"] for r in res], ".", color=colour, ms=3,
+                    label=what)  # fmt: skip
     for name, ex in examples.items():
         ax.plot(ex["C2"], ex["h"], MARKERS[name], color="w", mec="k", ms=7, label=name)
     ax.set_xlim(rmap.C2_grid[0], rmap.C2_grid[-1])

@@ -54,6 +54,8 @@ FloatArray = NDArray[np.float64]
 RESONANCE_TOLERANCE = 1e-9
 #: Largest denominator of a rotation number classified as closed.
 MAX_DENOMINATOR = 12
+#: Resonance curves traced on the map: ``N = p/q`` with ``q`` up to this (1: drifting).
+CURVE_DENOMINATOR = 3
 
 
 def rotation_number(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, float]:
@@ -113,8 +115,9 @@ class RotationMap:
         encloses; -1 where there is no orbit. Along a column ``N`` is continuous within a
         family.
     resonances : list of dict
-        Points ``{"N", "C2", "h", "orbit"}`` of the curves where ``N`` is an integer, found by
-        Brent's method along each column between grid points of the same orbit family.
+        Points ``{"N", "p", "q", "C2", "h", "orbit"}`` of the resonance curves ``N = p/q`` with
+        ``q <= CURVE_DENOMINATOR`` (``q = 1``: drifting; else closed after ``q`` periods), found
+        by Brent's method along each column between grid points of the same orbit family.
     """
 
     M3: float
@@ -144,6 +147,17 @@ def _family_code(theta_c: FloatArray, centre: NDArray[np.bool_], orbit: Orbit) -
         if c and orbit.theta_min <= t <= orbit.theta_max:
             code += 1 << (n + 8)
     return code
+
+
+def _fractions_between(a: float, b: float, max_q: int) -> list[Fraction]:
+    """Every ``p/q`` (lowest terms, ``q <= max_q``) strictly between ``a`` and ``b``."""
+    lo, hi = min(a, b), max(a, b)
+    out = set()
+    for q in range(1, max_q + 1):
+        for p in range(math.floor(lo * q) + 1, math.ceil(hi * q)):
+            if lo < p / q < hi:
+                out.add(Fraction(p, q))
+    return sorted(out)
 
 
 def _offset(h: float, level: LevelSet, k: int, count: int, target: float) -> float:
@@ -214,16 +228,16 @@ def rotation_map(
                 a, b = N[i, j, k], N[i + 1, j, k]
                 if family[i, j, k] != family[i + 1, j, k]:
                     continue  # another family: N need not be continuous between
-                for m in range(math.ceil(min(a, b)), math.floor(max(a, b)) + 1):
-                    if not min(a, b) < m < max(a, b):
-                        continue
+                for frac in _fractions_between(float(a), float(b), CURVE_DENOMINATOR):
                     bracket = (float(h_grid[i]), float(h_grid[i + 1]))
-                    args = (level, k, int(counts[i]), float(m))
+                    args = (level, k, int(counts[i]), float(frac))
                     try:
                         h_res = brentq(_offset, *bracket, args=args, xtol=1e-12)
                     except ValueError:
                         continue
-                    resonances.append({"N": m, "C2": float(c2), "h": float(h_res), "orbit": k})
+                    resonances.append({"N": float(frac), "p": frac.numerator,
+                                       "q": frac.denominator, "C2": float(c2),
+                                       "h": float(h_res), "orbit": k})  # fmt: skip
         if progress is not None:
             progress(j + 1, nc)
     return RotationMap(float(M3), float(C1), C2_grid, h_grid, N, family, resonances)
@@ -278,10 +292,10 @@ def class_examples(body: SphericalTop, rmap: RotationMap) -> dict[str, dict[str,
     if not np.isfinite(n0).any():
         return out
     if rmap.resonances:
-        r = next((r for r in rmap.resonances if r["orbit"] == 0), None)
+        r = next((r for r in rmap.resonances if r["orbit"] == 0 and r["q"] == 1), None)
         if r is not None:
             out["drifting"] = {"C2": r["C2"], "h": r["h"], "orbit": 0, "N": float(r["N"]),
-                               "p": int(r["N"]), "q": 1}  # fmt: skip
+                               "p": r["p"], "q": 1}  # fmt: skip
     best: Fraction | None = None
     nh, nc = n0.shape
     for j in range(nc):
