@@ -68,6 +68,8 @@ STATUS = {
     3: "level too large",
 }
 SUFFIXES = (".nc", ".zarr")
+#: Largest chunk along each dimension of a Zarr store.
+ZARR_CHUNK = 64
 MAX_SPEC_BYTES = 1_000_000
 
 
@@ -373,9 +375,11 @@ def _write(ds: xr.Dataset, output: Path) -> None:
     tmp = output.with_name(f".{output.name}.tmp{os.getpid()}")
     shutil.rmtree(tmp, ignore_errors=True)
     try:
+        # stored in chunks of at most ZARR_CHUNK along each dimension (dask arrays)
+        chunked = ds.chunk({dim: min(int(n), ZARR_CHUNK) for dim, n in ds.sizes.items()})
         with warnings.catch_warnings():  # zarr 3: consolidated metadata is an extension
             warnings.filterwarnings("ignore", message=".*[Cc]onsolidated metadata.*")
-            ds.to_zarr(tmp, mode="w")
+            chunked.to_zarr(tmp, mode="w")
         old = output.with_name(f".{output.name}.old{os.getpid()}")
         if output.exists():
             os.replace(output, old)
