@@ -179,3 +179,21 @@ def test_cli_atlas_errors(capsys, tmp_path, extra, axes, message):
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and message in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
+
+
+def test_a_folder_that_is_not_a_zarr_store_is_not_replaced(tmp_path):
+    (tmp_path / "a.zarr").mkdir()
+    (tmp_path / "a.zarr" / "precious.txt").write_text("keep me")
+    spec = atlas_spec_from_dict(spec_dict({"C2": [0.0]}))
+    with pytest.raises(AtlasError, match="not a Zarr store"):
+        atlas(spec, tmp_path / "a.zarr")
+    assert (tmp_path / "a.zarr" / "precious.txt").read_text() == "keep me"
+
+
+def test_too_many_local_workers_are_refused(tmp_path):
+    import os
+
+    spec = atlas_spec_from_dict(spec_dict({"C2": [0.0]}))
+    with pytest.raises(AtlasError, match="per core"):
+        atlas(spec, tmp_path / "a.nc", workers=100 * (os.cpu_count() or 1))
+    assert list(tmp_path.iterdir()) == []

@@ -68,6 +68,8 @@ STATUS = {
     3: "level too large",
 }
 SUFFIXES = (".nc", ".zarr")
+#: Most worker processes per core of the embedded local cluster.
+MAX_WORKERS_PER_CORE = 4
 #: Largest chunk along each dimension of a Zarr store.
 ZARR_CHUNK = 64
 MAX_SPEC_BYTES = 1_000_000
@@ -301,11 +303,13 @@ def _client(client: Client | None, workers: int | None, scheduler: str | None) -
     n = workers if workers is not None else (os.cpu_count() or 1)
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                            dashboard_address=None, silence_logs=50)  # fmt: skip
-    local = Client(cluster)
     try:
-        yield local
+        local = Client(cluster)
+        try:
+            yield local
+        finally:
+            local.close()
     finally:
-        local.close()
         cluster.close()
 
 
@@ -382,9 +386,15 @@ def _write(ds: xr.Dataset, output: Path) -> None:
             chunked.to_zarr(tmp, mode="w")
         old = output.with_name(f".{output.name}.old{os.getpid()}")
         if output.exists():
-            os.replace(output, old)
-        os.replace(tmp, output)
-        shutil.rmtree(old, ignore_errors=True)
+            os.replace(output, old)  # a folder cannot be renamed onto a folder
+            try:
+                os.replace(tmp, output)
+            except OSError:
+                os.replace(old, output)  # put the previous store back
+                raise
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, output)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
@@ -394,6 +404,9 @@ def check_atlas_output(output: str | os.PathLike[str]) -> Path:
     exist and is replaced)."""
     path = Path(output)
     if path.suffix.lower() == ".zarr" and path.is_dir():
+        if not any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs")):
+            raise AtlasError(f"cannot write {str(path)!r}: a folder that is not a Zarr store "
+                             "is in the way")  # fmt: skip
         return path
     try:
         return check_output_path(path, SUFFIXES)
@@ -442,6 +455,11 @@ def atlas(
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):  # fmt: skip
         raise AtlasError(f"workers = {short_repr(workers)} must be an integer >= 1")
+    cores = os.cpu_count() or 1
+    if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
+        raise AtlasError(f"workers = {workers} is more than {MAX_WORKERS_PER_CORE} per core "
+                         f"({cores} cores) for the local cluster; use a scheduler to go "
+                         "wide")  # fmt: skip
     out_path = None if output is None else check_atlas_output(output)
     cells = spec.cells()
     names = tuple(spec.axes)
@@ -487,21 +505,45 @@ def _compute(
         progress(finished, spec.size)
     todo = [k for k in range(len(starts)) if k not in done]
     if todo:
-        from distributed import as_completed
-
         with _client(client, workers, scheduler) as c:
             futures = {c.submit(classify_cells, spec.fixed, names,
                                 cells[starts[k] : starts[k] + chunk], pure=False): k
                        for k in todo}  # fmt: skip
-            for fut in as_completed(futures):
-                k = futures[fut]
-                result = fut.result()
-                done[k] = result
-                if folder is not None:
-                    _save_chunk(folder, k, result)
-                finished += len(result["status"])
-                if progress is not None:
-                    progress(finished, spec.size)
+            try:
+                _collect(futures, done, folder, spec.size, finished, progress)
+            except BaseException:
+                c.cancel(list(futures))  # stop what is still queued before the cluster goes
+                raise
+
+
+def _collect(
+    futures: dict[Any, int],
+    done: dict[int, dict[str, np.ndarray]],
+    folder: Path | None,
+    total: int,
+    finished: int,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Collect the chunks as they finish, saving each at once. A task that failed on a worker
+    (a lost worker, an error) is reported as one :class:`AtlasError`."""
+    from distributed import as_completed
+
+    for fut in as_completed(futures):
+        k = futures[fut]
+        try:
+            result = fut.result()
+        except RollingTopError:
+            raise
+        except Exception as exc:
+            raise AtlasError(f"a Dask task failed ({type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''}); the chunks "
+                             "finished so far are kept: run again to resume") from None  # fmt: skip
+        done[k] = result
+        if folder is not None:
+            _save_chunk(folder, k, result)
+        finished += len(result["status"])
+        if progress is not None:
+            progress(finished, total)
 
 
 def classify_in_process(spec: AtlasSpec) -> xr.Dataset:

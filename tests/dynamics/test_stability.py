@@ -174,3 +174,13 @@ def test_readme_states_the_computed_thresholds():
     expected = (f"{rates['meridian']:.2f} under the paper's constraint, {rates['rough']:.2f} "
                 f"rolling without slipping, {rates['smooth']:.2f} on a smooth plane")  # fmt: skip
     assert expected in text
+
+
+def test_threshold_does_not_depend_on_the_units():
+    """g = 1e-10: the eigenvalues are tiny, the threshold still matches the closed form."""
+    from dataclasses import replace
+
+    b = replace(PAPER, g=1e-10)
+    for model in ("smooth", "rough", "meridian"):
+        (south, _) = vertical_spins(b, model)
+        assert south.omega3_critical == pytest.approx(south.omega3_closed_form, rel=1e-6)

@@ -242,3 +242,33 @@ def test_cli_no_spin_level_is_one_line(capsys, tmp_path):
     path.write_text(scenario_text(initial=None, level="M3 = 0.0\nC1 = 0.0"))
     code, out, err = run_cli(capsys, "bifurcation", str(path))
     assert code == 2 and "without spin" in err and len(err.strip().splitlines()) == 1
+
+
+def test_near_pole_level_keeps_the_steady_motion_in_the_wall():
+    """C1 = M3 - 1e-9 (above the pole tolerance): a centre sits in the thin wall next to the
+    pole; the classification sees it as steady_motions does (review finding)."""
+    level = LevelSet(PAPER, 1.0, 1.0 - 1e-9, -0.3)
+    motions = steady_motions(level)
+    assert len(motions) == 3
+    assert bf.region_orbits(level, 2.0) == [(2, False)]
+    assert bf._critical(level, None)[0].size == 3
+
+
+def test_centre_of_mass_at_the_centre_has_a_family_of_steady_motions():
+    """a3 = 0: gamma3 = C1/M3 is a steady motion at every C2; the count includes it and the
+    curve that meets it there is a pitchfork, not a fold."""
+    from dataclasses import replace
+
+    body = replace(PAPER, a3=0.0)
+    assert bf.folds(body, 1.0, 0.5) == []
+    m = bf.steady_count_map(body, 1.0, C1_range=(0.4, 0.6), C2_range=(-1.6, -0.5),
+                            resolution=(3, 4))  # fmt: skip
+    for k, c1 in enumerate(m.C1_grid):
+        for i, c2 in enumerate(m.C2_grid):
+            assert m.count[i, k] == len(steady_motions(LevelSet(body, 1.0, float(c1), float(c2))))
+    d = bf.bifurcation_diagram(body, 1.0, 0.5)
+    assert d.C2_grid[0] < -1.1258 < d.C2_grid[-1]  # the pitchfork is in the default window
+    family = [br for br in d.branches if np.all(br.gamma3 == br.gamma3[0])]
+    assert len(family) == 1 and family[0].gamma3[0] == pytest.approx(0.5, abs=1e-15)
+    for r in d.regions:
+        assert bf.region_signature(LevelSet(body, 1.0, 0.5, r.C2), r.h) == r.signature

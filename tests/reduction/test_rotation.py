@@ -146,3 +146,10 @@ def test_cli_rotation_json(capsys):
 def test_cli_rotation_bad_resolution(capsys):
     code, out, err = run_cli(capsys, "rotation", str(EXAMPLES / "fig5.toml"), "--resolution", "1")
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+
+
+def test_cli_rotation_empty_window_is_one_line(capsys):
+    code, out, err = run_cli(capsys, "rotation", str(EXAMPLES / "fig5.toml"), "--h-range=-100,-99",
+                             "--resolution", "3")  # fmt: skip
+    assert code == 2 and out == "" and "no periodic orbit" in err
+    assert len(err.strip().splitlines()) == 1

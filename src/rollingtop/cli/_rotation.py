@@ -62,6 +62,10 @@ def rotation(
     with _output.counting("rotation numbers", resolution) as progress:
         rmap = rotation_map(sc.body, M3, C1, C2_range=c2w, h_range=hw,
                             resolution=(resolution, resolution), progress=progress)  # fmt: skip
+    if rmap.to_dict()["N_range"] is None:
+        raise BadInput(f"no periodic orbit in the window C2 in [{c2w[0]:.6g}, {c2w[1]:.6g}], "
+                       f"h in [{hw[0]:.6g}, {hw[1]:.6g}]: widen --h-range or "
+                       "--c2-range")  # fmt: skip
     examples = class_examples(sc.body, rmap)
     summary: dict[str, Any] = {**rmap.to_dict(), "classes": examples}
     if C2 is not None:

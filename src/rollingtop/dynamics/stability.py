@@ -143,7 +143,9 @@ def vertical_spin_eigenvalues(
 
 
 def _unstable(eigenvalues: ComplexArray) -> bool:
-    size = max(1.0, float(np.max(np.abs(eigenvalues))))
+    """A real part above :data:`UNSTABLE_TOLERANCE` of the eigenvalues' size (no absolute
+    floor: the answer does not depend on the units)."""
+    size = float(np.max(np.abs(eigenvalues)))
     return bool(np.max(eigenvalues.real) > UNSTABLE_TOLERANCE * size)
 
 

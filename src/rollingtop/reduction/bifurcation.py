@@ -14,7 +14,10 @@ motion of the level ``C2`` exactly when
 
 In ``gamma3``, ``dP/dgamma3 = (M3 gamma3 - C1)(R + a3 gamma3) / s^3`` (``s = sin theta``): ``C2*``
 has a pole at ``gamma3 = C1/M3`` (and at ``gamma3 = -R/a3`` for a centre of mass outside the
-sphere), where ``U0'`` stays ``-m g a3 s != 0``; between the poles it is smooth. The critical
+sphere), where ``U0'`` stays ``-m g a3 s != 0``; between the poles it is smooth. With the centre
+of mass at the centre (``a3 = 0``) ``U0'`` vanishes there too: the pole is removable, and
+``gamma3 = C1/M3`` is a steady motion for every ``C2`` -- a family drawn as a curve of its own,
+which the other curve crosses (a pitchfork there, not a fold). The critical
 values form the curves ``theta -> (C2*(theta), h*(theta))``, ``h* = U(theta; C2*(theta))``, in the
 plane ``(C2, h)``. Along a curve ``U'' = -m P' C2*' / I1^2``: the critical point is a centre where
 ``P' C2*' < 0``, a saddle where ``> 0``, and the two meet at the **folds**, the extrema of ``C2*``
@@ -46,6 +49,7 @@ from scipy.optimize import brentq
 from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.steady import critical_points
 
 __all__ = [
     "BifurcationDiagram",
@@ -67,6 +71,10 @@ FloatArray = NDArray[np.float64]
 BRANCH_POINTS = 4001
 #: Points of ``theta`` in ``(0, pi)`` on which ``U`` is sampled to classify a level.
 CLASSIFY_POINTS = 1201
+#: Extrema of ``C2*`` this close to the family of ``a3 = 0`` are where the curve meets it.
+FAMILY_GAP = 1e-4
+#: Critical values closer than this (relative) are one value: no region between them.
+EQUAL_VALUES = 1e-9
 #: Step of the complex-step derivative (exact to round-off for analytic functions).
 _COMPLEX_STEP = 1e-30
 
@@ -130,6 +138,16 @@ def critical_energy(body: SphericalTop, M3: float, C1: float, gamma3: float | Fl
         return _energy_on_curve(level, theta, _c2_star(level, theta))
 
 
+def _family(level: LevelSet) -> float | None:
+    """With the centre of mass at the centre (``a3 = 0``) ``U0'`` and ``P'`` both vanish at
+    ``gamma3 = C1/M3``: that ``theta`` is a steady motion for every ``C2`` (a family, drawn as a
+    curve of its own; ``C2*`` is regular there). ``None`` otherwise."""
+    if level.body.a3 != 0.0 or level.pole is not None or level.M3 == 0.0:
+        return None
+    c = level.C1 / level.M3
+    return math.acos(c) if abs(c) < 1.0 else None
+
+
 def _dc2_star(level: LevelSet, theta: FloatArray) -> FloatArray:
     """``dC2*/dtheta`` by the complex step (exact to round-off)."""
     z = np.asarray(theta, dtype=float) + 1j * _COMPLEX_STEP
@@ -142,8 +160,8 @@ def _cuts(level: LevelSet) -> list[float]:
     pole level, where ``C1/M3 = +-1``) and ``gamma3 = -R/a3``, if in ``(-1, 1)``."""
     b = level.body
     values = []
-    if level.pole is None and level.M3 != 0.0 and abs(level.C1 / level.M3) < 1.0:
-        values.append(level.C1 / level.M3)
+    if level.pole is None and level.M3 != 0.0 and abs(level.C1 / level.M3) < 1.0 and b.a3 != 0.0:
+        values.append(level.C1 / level.M3)  # with a3 = 0 the pole is removable (_family)
     if b.a3 != 0.0 and abs(b.R / b.a3) < 1.0:
         values.append(-b.R / b.a3)
     lo, hi = level.theta_domain
@@ -204,6 +222,7 @@ def folds(body: SphericalTop, M3: float, C1: float) -> list[Fold]:
     than the grid's spacing would be missed.
     """
     level = _base_level(body, M3, C1)
+    t0 = _family(level)
     found = []
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for a, b in _intervals(level):
@@ -215,6 +234,8 @@ def folds(body: SphericalTop, M3: float, C1: float) -> list[Fold]:
                     continue
                 t = brentq(lambda x: float(_dc2_star(level, np.array(x))), th[k], th[k + 1],
                            xtol=1e-15, rtol=4 * np.finfo(float).eps)  # fmt: skip
+                if t0 is not None and abs(t - t0) < FAMILY_GAP:
+                    continue  # where the curve meets the family of a3 = 0: a pitchfork
                 c2 = float(_c2_star(level, t))
                 h = float(_energy_on_curve(level, np.array(t), np.array(c2)))
                 # C2* has a maximum in theta where its derivative goes from + to -; in gamma3
@@ -260,19 +281,35 @@ def _branches(level: LevelSet, n: int = BRANCH_POINTS) -> list[Branch]:
     return out
 
 
+def _pitchfork_c2(level: LevelSet, t0: float) -> float:
+    """The ``C2`` at which the family ``theta = t0`` (``a3 = 0``) changes type:
+    ``U''(t0; C2) = U0''(t0) + m C2 P''(t0) / I1^2 = 0``."""
+    b = level.body
+    _, _, _, dq2 = level._q(np.array([t0 + 1j * _COMPLEX_STEP]))
+    p2 = float(np.imag(dq2[0])) / _COMPLEX_STEP
+    return -float(level.d2U(t0)) * b.I1**2 / (b.m * p2)
+
+
+def _family_branch(level: LevelSet, t0: float, window: tuple[float, float]) -> Branch:
+    """The curve of the family ``theta = t0`` (``a3 = 0``) over the ``C2`` window: ``h = U(t0;
+    C2)``, a centre where ``U''(t0; C2) = U0''(t0) + m C2 P''(t0) / I1^2 > 0``."""
+    b = level.body
+    c2 = np.linspace(window[0], window[1], 801)
+    th = np.full_like(c2, t0)
+    z = np.array([t0 + 1j * _COMPLEX_STEP])
+    _, _, _, dq2 = level._q(z)
+    p2 = float(np.imag(dq2[0])) / _COMPLEX_STEP
+    u2 = float(level.d2U(t0)) + b.m * c2 * p2 / b.I1**2
+    return Branch(np.cos(th), c2, _energy_on_curve(level, th, c2), u2 > 0, th)
+
+
 def _critical(level: LevelSet, theta: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Critical points of ``U`` on ``level`` in order of decreasing signed ``theta`` (increasing
-    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there (sign changes of
-    ``dU`` on ``theta``, refined by Brent's method)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        d = level.dU(theta)
-    sign = np.sign(d)
-    roots = []
-    for k in np.flatnonzero(sign[:-1] * sign[1:] < 0):
-        if np.isfinite(d[k]) and np.isfinite(d[k + 1]):
-            roots.append(brentq(lambda x: float(level.dU(x)), theta[k], theta[k + 1],
-                                xtol=1e-15, rtol=4 * np.finfo(float).eps))  # fmt: skip
-    th = np.array(sorted(roots, reverse=True))  # increasing gamma3 on (0, pi)
+    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there
+    (:func:`rollingtop.reduction.steady.critical_points`, whose grid also resolves the thin wall
+    next to a pole on a level near a pole level; ``theta`` is not used)."""
+    del theta  # the search is steady.critical_points': its grid resolves the walls at a pole
+    th = np.sort(critical_points(level))[::-1].copy()  # increasing gamma3 on (0, pi)
     return th, level.U(th), level.d2U(th) if th.size else th
 
 
@@ -523,10 +560,16 @@ def bifurcation_diagram(
         raise LevelSetError(f"resolution = {resolution} must be at least (3, 3)")
     fs = folds(body, M3, C1)
     branches = _branches(level)
-    c2_lo, c2_hi = C2_range if C2_range is not None else _default_c2_range(level, fs)
+    marks = list(fs)
+    t0 = _family(level)
+    if t0 is not None:  # a3 = 0: the pitchfork where the family changes type belongs in view
+        marks.append(Fold(_pitchfork_c2(level, t0), math.cos(t0), math.nan, "pitchfork", t0))
+    c2_lo, c2_hi = C2_range if C2_range is not None else _default_c2_range(level, marks)
     if not (math.isfinite(c2_lo) and math.isfinite(c2_hi) and c2_lo < c2_hi):
         raise LevelSetError(f"C2 range ({c2_lo:g}, {c2_hi:g}) must be finite and increasing")
     C2_grid = np.linspace(c2_lo, c2_hi, nc)
+    if t0 is not None:
+        branches.append(_family_branch(level, t0, (c2_lo, c2_hi)))
     theta = _classify_grid(level)
     # per column: the critical values cut the h axis into intervals, each with one set of
     # orbits; a node is (column, lo, hi, orbits, its bounding critical points' indices, count)
@@ -553,8 +596,8 @@ def bifurcation_diagram(
         for pos, (lo, k) in enumerate(cut_values):
             upper = cut_values[pos + 1][1] if pos + 1 < len(cut_values) else -1
             hi = cut_values[pos + 1][0] if pos + 1 < len(cut_values) else math.inf
-            if not hi > lo:
-                continue
+            if math.isfinite(hi) and not hi - lo > EQUAL_VALUES * max(1.0, abs(lo), abs(hi)):
+                continue  # equal critical values (a symmetric body's twin wells), to round-off
             mid = 0.5 * (lo + hi) if math.isfinite(hi) else lo + 1.0 + abs(lo)
             column.append(len(nodes))
             nodes.append((j, lo, hi, _orbits_at(U, centre, mid, th, pole), (k, upper, len(U))))
@@ -644,8 +687,8 @@ class SteadyCountMap:
     M3 : float
     C1_grid, C2_grid : ndarray, shapes (n1,), (n2,)
     count : ndarray of int, shape (n2, n1)
-        Number of critical points of ``U`` in ``(-1, 1)`` (-1 on the pole lines
-        ``C1 = +-M3``, which are not classified).
+        Number of critical points of ``U`` (on a pole line ``C1 = +-M3``, in the signed angle's
+        domain; -1 for the level without spin, ``M3 = C1 = 0``, which is not classified).
     fold_C1, fold_C2 : ndarray, shape (k,)
         Points of the fold curves: every fold of every ``C1`` of the grid.
     """
@@ -685,6 +728,8 @@ def steady_count_map(
     poles of ``C2*`` (:data:`BRANCH_POINTS` points each).
     """
     n1, n2 = (int(x) for x in resolution)
+    if n1 < 2 or n2 < 2:
+        raise LevelSetError(f"resolution = {resolution} must be at least (2, 2)")
     C1_grid = np.linspace(*C1_range, n1)
     C2_grid = np.linspace(*C2_range, n2)
     count = np.full((n2, n1), -1, dtype=np.int64)
@@ -695,7 +740,8 @@ def steady_count_map(
             level = _base_level(body, M3, float(c1))
         except LevelSetError:
             continue  # a pole line
-        total = np.zeros(n2, dtype=np.int64)
+        # the family gamma3 = C1/M3 of a body with a3 = 0 is a steady motion at every C2
+        total = np.full(n2, 0 if _family(level) is None else 1, dtype=np.int64)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             for a, e in _intervals(level):
                 c2s = _c2_star(level, _interval_grid(a, e, BRANCH_POINTS))

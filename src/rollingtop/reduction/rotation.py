@@ -201,6 +201,9 @@ def rotation_map(
         ``progress(done, total)`` after each column of ``C2``.
     """
     nc, nh = (int(x) for x in resolution)
+    if nc < 2 or nh < 2 or max_orbits < 1:
+        raise LevelSetError(f"resolution = {resolution} must be at least (2, 2) and max_orbits "
+                            f"= {max_orbits} at least 1")  # fmt: skip
     C2_grid = np.linspace(*C2_range, nc)
     h_grid = np.linspace(*h_range, nh)
     N = np.full((nh, nc, max_orbits), np.nan)
