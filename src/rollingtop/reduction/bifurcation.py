@@ -49,7 +49,6 @@ from scipy.optimize import brentq
 from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction.level import LevelSet, LevelSetError
-from rollingtop.reduction.steady import critical_points
 
 __all__ = [
     "BifurcationDiagram",
@@ -305,12 +304,36 @@ def _family_branch(level: LevelSet, t0: float, window: tuple[float, float]) -> B
 
 def _critical(level: LevelSet, theta: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Critical points of ``U`` on ``level`` in order of decreasing signed ``theta`` (increasing
-    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there
-    (:func:`rollingtop.reduction.steady.critical_points`, whose grid also resolves the thin wall
-    next to a pole on a level near a pole level; ``theta`` is not used)."""
-    del theta  # the search is steady.critical_points': its grid resolves the walls at a pole
-    th = np.sort(critical_points(level))[::-1].copy()  # increasing gamma3 on (0, pi)
+    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there. Sign changes of
+    ``dU`` on a grid that also resolves the thin wall next to a pole on a level near a pole
+    level (:func:`_critical_grid`), each refined by Brent's method; ``theta`` is not used."""
+    del theta  # the grid is the level's own (_critical_grid)
+    grid = _critical_grid(level)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        d = level.dU(grid)
+    sign = np.sign(d)
+    roots = []
+    for k in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (sign[:-1] * sign[1:] < 0)):
+        roots.append(brentq(level.dU, grid[k], grid[k + 1], xtol=1e-15, rtol=8.9e-16,
+                            maxiter=200))  # fmt: skip
+    th = np.array(sorted(roots, reverse=True))  # increasing gamma3 on (0, pi)
     return th, level.U(th), level.d2U(th) if th.size else th
+
+
+#: Points at geometrically shrinking distances from each end of the theta domain (1e-18 to
+#: 1e-3 of its length): near a pole level the wall of ``U``, and a steady motion in it, can sit
+#: as close to the pole as ``|C1 -+ M3|`` (as in ``steady.critical_points``).
+WALL_POINTS = 301
+
+
+def _critical_grid(level: LevelSet) -> FloatArray:
+    lo, hi = level.theta_domain
+    grid = _classify_grid(level)
+    if level.pole is None:
+        d = (hi - lo) * np.logspace(-18.0, -3.0, WALL_POINTS)
+        grid = np.unique(np.concatenate([grid, lo + d, hi - d]))
+    out: FloatArray = grid[(grid > lo) & (grid < hi)]
+    return out
 
 
 #: Marks an orbit (a tuple of centre indices) that passes through the pole.
