@@ -273,7 +273,12 @@ def nudge(draw, doc: dict) -> None:
         doc["initial"]["omega"] = draw(st.lists(st.floats(-4, 4), min_size=3, max_size=3))
     elif what == "body" and "body" in doc:
         key = draw(st.sampled_from(["R", "m", "g", "a3", "I1", "I3", "I2"]))
-        doc["body"][key] = doc["body"].get(key, 0.3) * draw(st.floats(0.2, 3.0))
+        old = doc["body"].get(key, 0.3)
+        # an earlier hostile mutation may have left a non-number (a list, a huge integer) here
+        # (found by a fresh run): scale a plausible value instead
+        if isinstance(old, bool) or not isinstance(old, int | float) or abs(old) > 1e300:
+            old = 0.3
+        doc["body"][key] = float(old) * draw(st.floats(0.2, 3.0))
     elif what == "integration":
         key, values = draw(st.sampled_from([
             ("t_end", st.floats(1e-4, 0.05)), ("samples", st.integers(2, 60)),
