@@ -153,3 +153,16 @@ def test_cli_rotation_empty_window_is_one_line(capsys):
                              "--resolution", "3")  # fmt: skip
     assert code == 2 and out == "" and "no periodic orbit" in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_rotation_map_on_a_pole_level():
+    """C1 = M3: orbits above the pole's energy pass through the pole; N is defined there too and
+    the map holds what rotation_numbers gives."""
+    rmap = rot.rotation_map(PAPER, 1.0, 1.0, C2_range=(-0.5, 0.5), h_range=(0.2, 1.5),
+                            resolution=(5, 5))  # fmt: skip
+    n0 = rmap.N[:, :, 0]
+    assert np.isfinite(n0).sum() >= 10
+    i, j = np.argwhere(np.isfinite(n0))[-1]
+    level = LevelSet(PAPER, 1.0, 1.0, float(rmap.C2_grid[j]))
+    assert rot.rotation_numbers(level, float(rmap.h_grid[i]))[0] == n0[i, j]
+    assert any(o.pole_passage for o in orbits(level, float(rmap.h_grid[i])))

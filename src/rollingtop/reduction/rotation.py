@@ -211,8 +211,9 @@ def rotation_map(
     resonances: list[dict[str, Any]] = []
     for j, c2 in enumerate(C2_grid):
         level = LevelSet(body, M3, C1, float(c2))
-        if level.pole is not None:
-            raise LevelSetError(f"{level.describe()} is a pole level: not mapped")
+        if level.pole == "both":
+            raise LevelSetError(f"{level.describe()}: without spin the axis does not precess "
+                                "(N = 0); no map")  # fmt: skip
         theta_c = critical_points(level)
         centre = level.d2U(theta_c) > 0 if theta_c.size else np.zeros(0, dtype=bool)
         for i, h in enumerate(h_grid):
