@@ -407,6 +407,19 @@ def test_fuzz_reduction_commands(data, command):
         assert listing(folder) == ["s.toml"]
 
 
+@pytest.mark.slow
+@fuzz(30)
+@given(data=scenario_bytes(), command=st.sampled_from(["bifurcation", "stability"]))
+def test_fuzz_classification_commands(data, command):
+    """The classification commands (issue 14) on hostile scenarios: one line or a result."""
+    with workdir() as folder:
+        scenario = folder / "s.toml"
+        scenario.write_bytes(data)
+        code, out, err = invoke([command, str(scenario), "--json"])
+        check_contract(code, out, err, as_json=True)
+        assert listing(folder) == ["s.toml"]
+
+
 # Huge and tiny finite values included: a level too large for double precision is refused in
 # one line (LevelSet), one whose walls are too thin near theta = pi too (orbits)
 hostile_level_numbers = st.sampled_from([0.0, 1.0, -1.0, 1e-12, -1e-300, 1e-150, 1e150, 1e300,
