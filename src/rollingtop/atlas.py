@@ -235,7 +235,7 @@ def classify_cells(
         is not classified, see :data:`STATUS`); ``rotation_centre`` and ``centre_gamma3``,
         shape (k, :data:`MAX_CENTRES`), NaN-padded, the centres in order of ``gamma3``.
     """
-    from rollingtop.reduction.bifurcation import _classify_grid, _critical
+    from rollingtop.reduction.bifurcation import _critical
     from rollingtop.reduction.level import LevelSet, LevelSetError
     from rollingtop.reduction.rotation import centre_rotation_number
     from rollingtop.reduction.steady import steady_motion
@@ -244,7 +244,6 @@ def classify_cells(
     out = {name: np.full(k, -1, dtype=np.int16) for name in FIELDS}
     out["rotation_centre"] = np.full((k, MAX_CENTRES), np.nan)
     out["centre_gamma3"] = np.full((k, MAX_CENTRES), np.nan)
-    theta = _classify_grid()  # (0, pi): pole levels are not classified here (status 2)
     for n in range(k):
         p = dict(fixed)
         p.update(zip(names, (float(x) for x in values[n]), strict=True))
@@ -261,7 +260,7 @@ def classify_cells(
         if level.pole is not None:
             out["status"][n] = 2
             continue
-        th, _, u2 = _critical(level, theta)
+        th, _, u2 = _critical(level)
         g3 = np.cos(th)
         out["status"][n] = 0
         out["n_steady"][n] = len(g3)

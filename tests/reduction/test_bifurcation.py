@@ -251,7 +251,7 @@ def test_near_pole_level_keeps_the_steady_motion_in_the_wall():
     motions = steady_motions(level)
     assert len(motions) == 3
     assert bf.region_orbits(level, 2.0) == [(2, False)]
-    assert bf._critical(level, None)[0].size == 3
+    assert bf._critical(level)[0].size == 3
 
 
 def test_centre_of_mass_at_the_centre_has_a_family_of_steady_motions():

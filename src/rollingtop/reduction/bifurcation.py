@@ -302,12 +302,11 @@ def _family_branch(level: LevelSet, t0: float, window: tuple[float, float]) -> B
     return Branch(np.cos(th), c2, _energy_on_curve(level, th, c2), u2 > 0, th)
 
 
-def _critical(level: LevelSet, theta: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+def _critical(level: LevelSet) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Critical points of ``U`` on ``level`` in order of decreasing signed ``theta`` (increasing
     ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there. Sign changes of
     ``dU`` on a grid that also resolves the thin wall next to a pole on a level near a pole
-    level (:func:`_critical_grid`), each refined by Brent's method; ``theta`` is not used."""
-    del theta  # the grid is the level's own (_critical_grid)
+    level (:func:`_critical_grid`), each refined by Brent's method."""
     grid = _critical_grid(level)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         d = level.dU(grid)
@@ -392,7 +391,7 @@ def region_orbits(level: LevelSet, h: float) -> list[tuple[int, bool]]:
     level) the number of centres (minima of ``U``) inside it and whether it passes through the
     pole; ``[]``: no motion (``h <= min U``)."""
     _base_level(level.body, level.M3, level.C1)  # refuses the level without spin
-    theta, U, u2 = _critical(level, _classify_grid(level))
+    theta, U, u2 = _critical(level)
     return [(len(_centres(o)), THROUGH_POLE in o)
             for o in _orbits_at(U, u2 > 0, h, theta, _pole(level))]  # fmt: skip
 
@@ -593,7 +592,6 @@ def bifurcation_diagram(
     C2_grid = np.linspace(c2_lo, c2_hi, nc)
     if t0 is not None:
         branches.append(_family_branch(level, t0, (c2_lo, c2_hi)))
-    theta = _classify_grid(level)
     # per column: the critical values cut the h axis into intervals, each with one set of
     # orbits; a node is (column, lo, hi, orbits, its bounding critical points' indices, count)
     nodes: list[tuple[int, float, float, tuple[tuple[int, ...], ...], tuple[int, int, int]]] = []
@@ -603,7 +601,7 @@ def bifurcation_diagram(
     pole_energy = np.full(nc, np.nan)
     for j, c2 in enumerate(C2_grid):
         lv = LevelSet(body, level.M3, level.C1, float(c2))
-        th, U, u2 = _critical(lv, theta)
+        th, U, u2 = _critical(lv)
         gammas.append(np.cos(th))
         pole = _pole(lv)
         centre = u2 > 0
