@@ -124,7 +124,7 @@ def machine() -> dict:
     import numba
     import scipy
 
-    cpu = platform.processor()
+    cpu = platform.processor() or platform.machine()
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):

@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from run_benchmarks import ROOT, median_time  # noqa: E402
+from run_benchmarks import ROOT, machine, median_time  # noqa: E402
 
 BENCH = ROOT / "benchmarks"
 PAPER = ROOT / "examples" / "paper.toml"
@@ -110,18 +110,8 @@ def _save(fig, path: Path | None) -> str | None:
 
 
 def _machine_line() -> str:
-    import os
-    import platform
-
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores"
+    m = machine()
+    return f"{m['cpu']}, {m['cores']} cores"
 
 
 # ----------------------------------------------------------------------------------------------

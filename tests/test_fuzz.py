@@ -399,6 +399,11 @@ def test_fuzz_simulate_scenarios(data, output):
 @fuzz(40)
 @given(data=scenario_bytes(), command=st.sampled_from(["equilibria", "orbits"]))
 def test_fuzz_reduction_commands(data, command):
+    run_scenario_command(data, command)
+
+
+def run_scenario_command(data: bytes, command: str) -> None:
+    """``rollingtop COMMAND s.toml --json`` on ``data``: the contract, and no file written."""
     with workdir() as folder:
         scenario = folder / "s.toml"
         scenario.write_bytes(data)
@@ -412,12 +417,7 @@ def test_fuzz_reduction_commands(data, command):
 @given(data=scenario_bytes(), command=st.sampled_from(["bifurcation", "stability"]))
 def test_fuzz_classification_commands(data, command):
     """The classification commands (issue 14) on hostile scenarios: one line or a result."""
-    with workdir() as folder:
-        scenario = folder / "s.toml"
-        scenario.write_bytes(data)
-        code, out, err = invoke([command, str(scenario), "--json"])
-        check_contract(code, out, err, as_json=True)
-        assert listing(folder) == ["s.toml"]
+    run_scenario_command(data, command)
 
 
 # Huge and tiny finite values included: a level too large for double precision is refused in

@@ -32,7 +32,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
 from rollingtop.reduction.level import LevelSet, LevelSetError
-from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits, period
+from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits
+from rollingtop.reduction.rotation import rotation_number
 
 __all__ = ["PeriodMap", "period_map", "reconstruct", "RESONANCE_TOLERANCE", "NEAR_RESONANT"]
 
@@ -203,9 +204,8 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
         path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=w_tau0)
     else:
         exact_level, exact_orbit = canonical_orbit(level, h, orbit)  # near north: its mirror
-        peaks = [t for t in (exact_level.pole_theta,) if t is not None]
-        dpsi, dpsi_err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max,
-                                peaks=peaks, weight=exact_level.psi_dot)  # fmt: skip
+        turns, turns_err = rotation_number(level, h, orbit)  # the same quadrature of psi'
+        dpsi, dpsi_err = 2 * math.pi * turns, 2 * math.pi * turns_err
         theta0 = start_theta(orbit)
         if exact_level is level:
             path = reconstruct(level, [0.0, T], theta0=theta0, w_tau0=0.0)

@@ -7,8 +7,9 @@ the body frame ``(v, w, gamma)`` is then constant, and for a model whose equatio
 the vertical these nine variables obey a closed system (they do not involve the frame's other
 vectors or the position). Its linearisation on the constraint manifold -- ``|gamma| = 1`` and the
 model's velocity constraints ``J(gamma) (v, w) = 0`` -- decides linear stability: the Jacobian of
-the right-hand side (central differences of the compiled kernel) restricted to the null space of
-the constraints' Jacobian, whose eigenvalues are purely imaginary or zero for a stable spin.
+the right-hand side (central differences of the compiled kernel, :mod:`rollingtop._numdiff`)
+restricted to the null space of the constraints' Jacobian, whose eigenvalues are purely
+imaginary or zero for a stable spin.
 
 A model whose constraint is singular at the vertical supplies its own eigenvalues
 (:attr:`~rollingtop.contact.ContactModel.vertical_eigenvalues`: the meridian model, through the
@@ -27,6 +28,7 @@ import numpy as np
 
 from rollingtop._errors import RollingTopError
 from rollingtop._jit import call
+from rollingtop._numdiff import central_jacobian
 from rollingtop._types import ComplexArray, FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
@@ -35,8 +37,6 @@ from rollingtop.dynamics._layout import N_STATE
 
 __all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]
 
-#: Relative step of the central differences of the Jacobian.
-DIFF_STEP = 1e-6
 #: A spin counts as unstable when an eigenvalue's real part exceeds this, relative to the
 #: eigenvalues' size (the differences' error is ~1e-10 of it).
 UNSTABLE_TOLERANCE = 1e-6
@@ -67,17 +67,6 @@ def _state(x: FloatArray) -> FloatArray:
     return y
 
 
-def _jacobian(fun: Any, x: FloatArray) -> FloatArray:
-    f0 = fun(x)
-    D = np.zeros((len(f0), len(x)))
-    for i in range(len(x)):
-        h = DIFF_STEP * max(1.0, abs(x[i]))
-        e = np.zeros(len(x))
-        e[i] = h
-        D[:, i] = (fun(x + e) - fun(x - e)) / (2.0 * h)
-    return D
-
-
 def _generic_eigenvalues(
     model: ContactModel, body: SphericalTop, omega3: float, pole: int
 ) -> ComplexArray:
@@ -98,11 +87,11 @@ def _generic_eigenvalues(
         nc = call(_kernel.constraint_rows, code, p, _state(x), J, bias, dirs)
         return np.concatenate([[x[6:9] @ x[6:9] - 1.0], J[:nc] @ x[0:6]])
 
-    G = _jacobian(constraints, x0)
+    G = central_jacobian(constraints, x0)
     _, sv, vt = np.linalg.svd(G)
     rank = int(np.sum(sv > 1e-9 * sv[0]))
     T = vt[rank:].T  # orthonormal basis of the tangent space of the constraint manifold
-    A = T.T @ _jacobian(rhs, x0) @ T
+    A = T.T @ central_jacobian(rhs, x0) @ T
     out: ComplexArray = np.linalg.eigvals(A).astype(complex)
     return out
 

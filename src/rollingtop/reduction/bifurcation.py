@@ -49,6 +49,7 @@ from scipy.optimize import brentq
 from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.steady import critical_points
 
 __all__ = [
     "BifurcationDiagram",
@@ -68,7 +69,8 @@ FloatArray = NDArray[np.float64]
 
 #: Points of ``theta`` per interval between poles of ``C2*`` (clustered towards the ends).
 BRANCH_POINTS = 4001
-#: Points of ``theta`` in ``(0, pi)`` on which ``U`` is sampled to classify a level.
+#: Points of ``theta`` per ``pi`` of the domain on which ``dU`` is sampled to find a level's
+#: critical points (:func:`rollingtop.reduction.steady.critical_points`).
 CLASSIFY_POINTS = 1201
 #: Extrema of ``C2*`` this close to the family of ``a3 = 0`` are where the curve meets it.
 FAMILY_GAP = 1e-4
@@ -280,59 +282,39 @@ def _branches(level: LevelSet, n: int = BRANCH_POINTS) -> list[Branch]:
     return out
 
 
-def _pitchfork_c2(level: LevelSet, t0: float) -> float:
-    """The ``C2`` at which the family ``theta = t0`` (``a3 = 0``) changes type:
-    ``U''(t0; C2) = U0''(t0) + m C2 P''(t0) / I1^2 = 0``."""
+def _family_curvature(level: LevelSet, t0: float) -> tuple[float, float]:
+    """``U0''(t0)`` and ``m P''(t0) / I1^2``: on the family ``theta = t0`` (``a3 = 0``)
+    ``U''(t0; C2) = U0''(t0) + C2 m P''(t0) / I1^2`` (``P''`` by the complex step)."""
     b = level.body
     _, _, _, dq2 = level._q(np.array([t0 + 1j * _COMPLEX_STEP]))
     p2 = float(np.imag(dq2[0])) / _COMPLEX_STEP
-    return -float(level.d2U(t0)) * b.I1**2 / (b.m * p2)
+    return float(level.d2U(t0)), b.m * p2 / b.I1**2
+
+
+def _pitchfork_c2(level: LevelSet, t0: float) -> float:
+    """The ``C2`` at which the family ``theta = t0`` (``a3 = 0``) changes type, ``U'' = 0``."""
+    u0, slope = _family_curvature(level, t0)
+    return -u0 / slope
 
 
 def _family_branch(level: LevelSet, t0: float, window: tuple[float, float]) -> Branch:
     """The curve of the family ``theta = t0`` (``a3 = 0``) over the ``C2`` window: ``h = U(t0;
-    C2)``, a centre where ``U''(t0; C2) = U0''(t0) + m C2 P''(t0) / I1^2 > 0``."""
-    b = level.body
+    C2)``, a centre where ``U''(t0; C2) > 0``."""
     c2 = np.linspace(window[0], window[1], 801)
     th = np.full_like(c2, t0)
-    z = np.array([t0 + 1j * _COMPLEX_STEP])
-    _, _, _, dq2 = level._q(z)
-    p2 = float(np.imag(dq2[0])) / _COMPLEX_STEP
-    u2 = float(level.d2U(t0)) + b.m * c2 * p2 / b.I1**2
-    return Branch(np.cos(th), c2, _energy_on_curve(level, th, c2), u2 > 0, th)
+    u0, slope = _family_curvature(level, t0)
+    return Branch(np.cos(th), c2, _energy_on_curve(level, th, c2), u0 + slope * c2 > 0, th)
 
 
 def _critical(level: LevelSet) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Critical points of ``U`` on ``level`` in order of decreasing signed ``theta`` (increasing
-    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there. Sign changes of
-    ``dU`` on a grid that also resolves the thin wall next to a pole on a level near a pole
-    level (:func:`_critical_grid`), each refined by Brent's method."""
-    grid = _critical_grid(level)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        d = level.dU(grid)
-    sign = np.sign(d)
-    roots = []
-    for k in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (sign[:-1] * sign[1:] < 0)):
-        roots.append(brentq(level.dU, grid[k], grid[k + 1], xtol=1e-15, rtol=8.9e-16,
-                            maxiter=200))  # fmt: skip
-    th = np.array(sorted(roots, reverse=True))  # increasing gamma3 on (0, pi)
+    ``gamma3`` off a pole level): ``theta``, ``U`` and ``U''_theta`` there
+    (:func:`rollingtop.reduction.steady.critical_points` on :data:`CLASSIFY_POINTS` points, with
+    its points at the thin wall next to a pole on a level near a pole level)."""
+    lo, hi = level.theta_domain  # CLASSIFY_POINTS per pi of the domain (a pole level has 2 pi)
+    points = int(CLASSIFY_POINTS * (hi - lo) / math.pi)
+    th = critical_points(level, points)[::-1].copy()  # increasing gamma3 on (0, pi)
     return th, level.U(th), level.d2U(th) if th.size else th
-
-
-#: Points at geometrically shrinking distances from each end of the theta domain (1e-18 to
-#: 1e-3 of its length): near a pole level the wall of ``U``, and a steady motion in it, can sit
-#: as close to the pole as ``|C1 -+ M3|`` (as in ``steady.critical_points``).
-WALL_POINTS = 301
-
-
-def _critical_grid(level: LevelSet) -> FloatArray:
-    lo, hi = level.theta_domain
-    grid = _classify_grid(level)
-    if level.pole is None:
-        d = (hi - lo) * np.logspace(-18.0, -3.0, WALL_POINTS)
-        grid = np.unique(np.concatenate([grid, lo + d, hi - d]))
-    out: FloatArray = grid[(grid > lo) & (grid < hi)]
-    return out
 
 
 #: Marks an orbit (a tuple of centre indices) that passes through the pole.
@@ -399,11 +381,6 @@ def region_orbits(level: LevelSet, h: float) -> list[tuple[int, bool]]:
 def region_signature(level: LevelSet, h: float) -> tuple[int, ...]:
     """The number of centres inside each orbit of the level ``h`` (:func:`region_orbits`)."""
     return tuple(n for n, _ in region_orbits(level, h))
-
-
-def _classify_grid(level: LevelSet | None = None) -> FloatArray:
-    lo, hi = (0.0, math.pi) if level is None else level.theta_domain
-    return _interval_grid(lo, hi, int(CLASSIFY_POINTS * (hi - lo) / math.pi))
 
 
 def describe_signature(signature: Sequence[int], through_pole: Sequence[bool] = ()) -> str:

@@ -22,7 +22,7 @@ the resonance curves accumulate at the separatrix.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -165,6 +165,34 @@ def _offset(h: float, level: LevelSet, k: int, count: int, target: float) -> flo
     return _family_n(level, h, k, count) - target
 
 
+def _family_steps(
+    N: FloatArray, family: NDArray[np.int64], j: int
+) -> Iterator[tuple[int, int, int]]:
+    """``(i, k, count)`` for the neighbouring grid levels ``i, i + 1`` of column ``j`` that hold
+    the same number ``count`` of orbits and where orbit ``k`` is of one family at both: there
+    ``N`` is continuous between them."""
+    counts = np.sum(np.isfinite(N[:, j, :]), axis=1)
+    for i in range(N.shape[0] - 1):
+        if counts[i] != counts[i + 1] or counts[i] == 0:
+            continue
+        for k in range(int(counts[i])):
+            if family[i, j, k] == family[i + 1, j, k]:
+                yield i, k, int(counts[i])
+
+
+def _solve_level(
+    level: LevelSet, bracket: tuple[float, float], k: int, count: int, target: float,
+    xtol: float,
+) -> float | None:  # fmt: skip
+    """The ``h`` in ``bracket`` where orbit ``k`` of ``count`` has ``N = target`` (Brent's
+    method), or ``None`` where ``N - target`` does not change sign."""
+    try:
+        h: float = brentq(_offset, *bracket, args=(level, k, count, target), xtol=xtol)
+    except ValueError:
+        return None
+    return h
+
+
 def _family_n(level: LevelSet, h: float, k: int, count: int) -> float:
     """``N`` of the ``k``-th of ``count`` periodic orbits at ``h`` (NaN if the count differs)."""
     periodic = [o for o in orbits(level, h) if o.kind == "periodic"]
@@ -224,21 +252,12 @@ def rotation_map(
             for k, o in enumerate(found[:max_orbits]):
                 N[i, j, k] = rotation_number(level, float(h), o)[0]
                 family[i, j, k] = _family_code(theta_c, centre, o)
-        counts = np.sum(np.isfinite(N[:, j, :]), axis=1)
-        for i in range(nh - 1):
-            if counts[i] != counts[i + 1] or counts[i] == 0:
-                continue
-            for k in range(int(counts[i])):
-                a, b = N[i, j, k], N[i + 1, j, k]
-                if family[i, j, k] != family[i + 1, j, k]:
-                    continue  # another family: N need not be continuous between
-                for frac in _fractions_between(float(a), float(b), CURVE_DENOMINATOR):
-                    bracket = (float(h_grid[i]), float(h_grid[i + 1]))
-                    args = (level, k, int(counts[i]), float(frac))
-                    try:
-                        h_res = brentq(_offset, *bracket, args=args, xtol=1e-12)
-                    except ValueError:
-                        continue
+        for i, k, count in _family_steps(N, family, j):
+            bracket = (float(h_grid[i]), float(h_grid[i + 1]))
+            for frac in _fractions_between(float(N[i, j, k]), float(N[i + 1, j, k]),
+                                           CURVE_DENOMINATOR):  # fmt: skip
+                h_res = _solve_level(level, bracket, k, count, float(frac), 1e-12)
+                if h_res is not None:
                     resonances.append({"N": float(frac), "p": frac.numerator,
                                        "q": frac.denominator, "C2": float(c2),
                                        "h": float(h_res), "orbit": k})  # fmt: skip
@@ -252,22 +271,16 @@ def _crossing(
 ) -> tuple[float, float] | None:
     """A level ``(C2, h)`` of the map where orbit ``k`` has ``N = target`` exactly (Brent's
     method between neighbouring grid points of one family), or ``None``."""
-    nh, nc, _ = rmap.N.shape
-    for j in range(nc):
+    for j in range(rmap.N.shape[1]):
         level = LevelSet(body, rmap.M3, rmap.C1, float(rmap.C2_grid[j]))
-        counts = np.sum(np.isfinite(rmap.N[:, j, :]), axis=1)
-        for i in range(nh - 1):
-            a, b = rmap.N[i, j, k], rmap.N[i + 1, j, k]
-            if counts[i] != counts[i + 1] or not (min(a, b) < target < max(a, b)):
+        for i, kk, count in _family_steps(rmap.N, rmap.family, j):
+            a, b = rmap.N[i, j, kk], rmap.N[i + 1, j, kk]
+            if kk != k or not (min(a, b) < target < max(a, b)):
                 continue
-            if rmap.family[i, j, k] != rmap.family[i + 1, j, k]:
-                continue
-            try:
-                h = brentq(_offset, float(rmap.h_grid[i]), float(rmap.h_grid[i + 1]),
-                           args=(level, k, int(counts[i]), target), xtol=1e-13)  # fmt: skip
-            except ValueError:
-                continue
-            return float(rmap.C2_grid[j]), float(h)
+            bracket = (float(rmap.h_grid[i]), float(rmap.h_grid[i + 1]))
+            h = _solve_level(level, bracket, k, count, target, 1e-13)
+            if h is not None:
+                return float(rmap.C2_grid[j]), h
     return None
 
 
@@ -275,7 +288,7 @@ def _simplest_fraction(a: float, b: float, max_q: int = 200) -> Fraction | None:
     """The fraction with the smallest denominator ``2 <= q <= max_q`` strictly inside ``(a, b)``
     (integers excluded: they are the drifting class)."""
     lo, hi = min(a, b), max(a, b)
-    for q in range(2, max_q + 1):
+    for q in range(2, max_q + 1):  # the first q with a fraction inside: stop there
         p = math.floor(lo * q) + 1
         while p / q < hi:
             if math.gcd(p, q) == 1:
@@ -301,14 +314,11 @@ def class_examples(body: SphericalTop, rmap: RotationMap) -> dict[str, dict[str,
             out["drifting"] = {"C2": r["C2"], "h": r["h"], "orbit": 0, "N": float(r["N"]),
                                "p": r["p"], "q": 1}  # fmt: skip
     best: Fraction | None = None
-    nh, nc = n0.shape
-    for j in range(nc):
-        for i in range(nh - 1):
-            a, b = n0[i, j], n0[i + 1, j]
-            same = rmap.family[i, j, 0] == rmap.family[i + 1, j, 0] >= 0
-            if not (same and np.isfinite(a) and np.isfinite(b)):
+    for j in range(n0.shape[1]):
+        for i, k, _ in _family_steps(rmap.N, rmap.family, j):
+            if k != 0:
                 continue
-            frac = _simplest_fraction(float(a), float(b))
+            frac = _simplest_fraction(float(n0[i, j]), float(n0[i + 1, j]))
             if frac is not None and (best is None or frac.denominator < best.denominator):
                 best = frac
     if best is not None:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from rollingtop._json import json_ready
+from rollingtop._numdiff import DIFF_STEP, central_jacobian
 from rollingtop.reduction.level import LevelSet
 
 __all__ = ["SteadyMotion", "steady_motions", "critical_points"]
@@ -84,10 +85,10 @@ class SteadyMotion:
         return json_ready(asdict(self))
 
 
-def _grid(level: LevelSet) -> NDArray[np.float64]:
+def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
     lo, hi = level.theta_domain
     # Chebyshev-like spacing clusters points near the barriers, where U varies fastest.
-    x = np.cos(np.linspace(math.pi, 0.0, GRID_POINTS))
+    x = np.cos(np.linspace(math.pi, 0.0, points))
     grid = lo + (hi - lo) * (x + 1) / 2
     if level.pole is None:
         # near a pole level the wall of U, and a steady motion beside it, can sit as close to
@@ -97,14 +98,16 @@ def _grid(level: LevelSet) -> NDArray[np.float64]:
     return grid
 
 
-def critical_points(level: LevelSet) -> NDArray[np.float64]:
+def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
     """All zeros of ``dU/dtheta`` inside the theta domain, increasing.
 
-    Sign changes of ``dU/dtheta`` on a fine grid (clustered at the ends), each refined by Brent's
-    method to machine precision; a zero of even multiplicity that does not change sign is found
-    when the grid lands on it exactly only.
+    Sign changes of ``dU/dtheta`` on a grid of ``points`` points (clustered at the ends, plus
+    points at the walls next to the poles), each refined by Brent's method to machine
+    precision; a zero of even multiplicity that does not change sign is found when the grid
+    lands on it exactly only. Fewer points serve the classification of many levels
+    (:mod:`rollingtop.reduction.bifurcation`).
     """
-    grid = _grid(level)[1:-1]
+    grid = _grid(level, points)[1:-1]
     with np.errstate(all="ignore"):
         d = level.dU(grid)
     roots = []
@@ -123,8 +126,6 @@ def _scale(level: LevelSet, theta: float) -> float:
     return max(abs(float(level.U(theta))), abs(float(level.d2U(theta))), 1e-300)
 
 
-#: Relative step of the central differences in :func:`linearised_eigenvalues`.
-DIFF_STEP = 1e-6
 #: Real parts below this times the eigenvalues' size count as zero.
 STABLE_TOLERANCE = 1e-6
 
@@ -144,15 +145,10 @@ def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex
 
     theta = math.acos(gamma3)
     x0 = np.array([gamma3, float(level.v_tau(theta)), float(level.w_n(theta)), 0.0])
-    D = np.zeros((4, 4))
-    for i in range(4):
-        h = DIFF_STEP * max(1.0, abs(x0[i]))
-        if i == 0:  # stay inside (-1, 1): near a pole the step shrinks with the distance to it
-            h = min(h, 0.25 * (1.0 - abs(gamma3)))
-        e = np.zeros(4)
-        e[i] = h
-        D[:, i] = (reduced_rhs(level.body, level.M3, x0 + e)
-                   - reduced_rhs(level.body, level.M3, x0 - e)) / (2 * h)  # fmt: skip
+    steps = DIFF_STEP * np.maximum(1.0, np.abs(x0))
+    # stay inside (-1, 1): near a pole the step in gamma3 shrinks with the distance to it
+    steps[0] = min(steps[0], 0.25 * (1.0 - abs(gamma3)))
+    D = central_jacobian(lambda x: reduced_rhs(level.body, level.M3, x), x0, steps)
     if not np.all(np.isfinite(D)):  # a steady motion at round-off distance from a pole
         return np.full(4, complex(math.nan, math.nan))
     out: NDArray[np.complex128] = np.linalg.eigvals(D).astype(complex)
