@@ -17,7 +17,12 @@ PAPER_BODY = dict(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5)
 #: Initial conditions of examples/paper.toml, with each model's free velocity.
 GAMMA0 = (0.0, 0.6, 0.8)
 OMEGA0 = (0.7, -0.3, 2.0)
-FREE = {"meridian": {"v_tau": 0.25}, "smooth": {"v_horizontal": (0.3, -0.2)}, "rough": {}}
+FREE = {
+    "meridian": {"v_tau": 0.25},
+    "smooth": {"v_horizontal": (0.3, -0.2)},
+    "rough": {},
+    "parallel": {"v_nu": 0.25},
+}
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:

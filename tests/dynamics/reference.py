@@ -24,6 +24,14 @@ def directions(model, alpha, beta, gamma, w):
         p = E3 - g3 * gamma
         pdot = -g3dot * gamma - g3 * gdot
         dirs.append((p / s, pdot / s - p * sdot / s**2))
+    elif model == "parallel":
+        # no slip across the axis: tau = e3 x gamma / s (the companion paper), away from the pole
+        g3, g3dot = gamma[2], gdot[2]
+        s = np.sqrt(1.0 - g3**2)
+        sdot = -g3 * g3dot / s
+        p = np.cross(E3, gamma)
+        pdot = np.cross(E3, gdot)
+        dirs.append((p / s, pdot / s - p * sdot / s**2))
     elif model == "rough":
         # vp = 0 as f1 plus (vp, alpha) = (vp, beta) = 0 (docs/model.md; the package uses body axes)
         dirs += [(alpha, np.cross(alpha, w)), (beta, np.cross(beta, w))]

@@ -58,8 +58,11 @@ class Kernel:
 
     @property
     def carries_direction(self) -> bool:
-        """Whether the state's ``psi_nu`` is a carried constraint direction (a variant)."""
-        return self.variant is not None
+        """Whether the state's ``psi_nu`` is a carried constraint direction: a variant, or the
+        own kernel of a model that always carries it (:attr:`ContactModel.carries_direction`)."""
+        from rollingtop.contact import get_model
+
+        return self.variant is not None or get_model(self.model).carries_direction
 
 
 @dataclass(frozen=True)
@@ -127,6 +130,11 @@ class ContactModel:
         linearisation at the vertical spin, for a model whose equations are singular at the
         vertical (the meridian model: its constraint direction is undefined there). ``None``: the
         generic linearisation in ``(v, w, gamma)`` on the constraint manifold applies.
+    carries_direction : bool
+        Whether the model's own kernel carries its constraint direction in the state's
+        ``psi_nu`` (the ``parallel`` model, whose direction ``tau`` is undefined at the vertical
+        that its motions reach generically, :mod:`rollingtop.contact.parallel`), as the variants
+        of the meridian model do on their pole levels.
     has_reduction : bool
         Whether the model's motions of a dynamically symmetric body reduce to one degree of
         freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
@@ -151,6 +159,7 @@ class ContactModel:
     select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
     vertical_spin: Callable[[SphericalTop, int], float] | None = None
     vertical_eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
+    carries_direction: bool = False
     has_reduction: bool = False
     colour: str = "#7f7f7f"
 

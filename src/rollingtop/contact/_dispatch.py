@@ -8,13 +8,14 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 - 2: ``meridian``, variant ``north``
 - 3: ``smooth``
 - 4: ``rough``
+- 5: ``parallel``
 """
 
 from __future__ import annotations
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.contact import _rows, meridian, rough, smooth
+from rollingtop.contact import _rows, meridian, parallel, rough, smooth
 
 
 @kernel
@@ -32,6 +33,8 @@ def rows(
         return smooth.rows(p, y, J, bias, dirs, 0)
     if code == 4:
         return rough.rows(p, y, J, bias, dirs, 0)
+    if code == 5:
+        return parallel.rows(p, y, J, bias, dirs, 0)
     return -1
 
 
@@ -49,6 +52,8 @@ def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace
         return smooth.accel(p, y, dy, ws, 0)
     if code == 4:
         return rough.accel(p, y, dy, ws, 0)
+    if code == 5:
+        return parallel.accel(p, y, dy, ws, 0)
     return -1
 
 
@@ -70,6 +75,9 @@ def project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool:
     if code == 4:
         rough.project_velocity(p, y, 0)
         return True
+    if code == 5:
+        parallel.project_velocity(p, y, 0)
+        return True
     return False
 
 
@@ -82,6 +90,8 @@ def direction_rate(code: int, p: FloatArray, y: FloatArray) -> float:
         return meridian.direction_rate(p, y, 1)
     if code == 2:
         return meridian.direction_rate(p, y, 2)
+    if code == 5:
+        return parallel.direction_rate(p, y, 0)
     return _rows.direction_rate(p, y, 0)
 
 
@@ -97,10 +107,13 @@ def sync_direction(code: int, y: FloatArray) -> None:
     if code == 2:
         meridian.sync_direction(y, 2)
         return
+    if code == 5:
+        parallel.sync_direction(y, 0)
+        return
     _rows.sync_direction(y, 0)
 
 
 @inline
 def carries_direction(code: int) -> bool:
     """Whether kernel ``code`` carries its constraint direction in ``psi_nu``."""
-    return code == 1 or code == 2
+    return code == 1 or code == 2 or code == 5
