@@ -13,6 +13,7 @@ from rollingtop import (
     ScenarioError,
     load_scenario,
 )
+from rollingtop.contact import MODELS
 from rollingtop.scenario import DEFAULTS
 
 from .conftest import EXAMPLES, scenario_text
@@ -181,7 +182,7 @@ BIG = "9" * 400
         (dict(initial="gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\nv_tau = [1]"),
          ScenarioError, r"initial.v_tau = \[1\] must be a number"),
         (dict(contact=f'model = "{"x" * 100_000}"'), ContactModelError,
-         r"unknown contact model 'x{77}…' \(known: meridian, smooth, rough\)$"),
+         rf"unknown contact model 'x{{77}}…' \(known: {', '.join(MODELS)}\)$"),
         (dict(contact="model = 3"), ContactModelError, "unknown contact model 3"),
         (dict(body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n" + "k" * 5000
                    + " = 1"),
