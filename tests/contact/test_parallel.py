@@ -96,3 +96,29 @@ def test_arrival_in_finite_time_with_a_finite_pole_rate():
     res = integrate(MODELS["parallel"].code, BODY.params, y0, t, rtol=1e-12, atol=1e-14)
     ahead = res.y[-1]
     assert math.hypot(ahead[12], ahead[13]) == pytest.approx(abs(w @ tau) * 1e-3, rel=0.05)
+
+
+#: Energy and Jellett drift over 50 time units of many pole passages (rtol 1e-10; measured at
+#: most 1e-7 over 600 random bodies and states to t = 100, typically 1e-10).
+PASSAGE_DRIFT = 1e-6
+
+
+def test_random_bodies_and_states_pass_their_poles():
+    """100 random bodies and states (seeded) to t = 50: every run finishes, through (measured)
+    ~1000 pole passages in all, with energy and Jellett's integral conserved."""
+    rng = np.random.default_rng(5)
+    passages = 0
+    for _ in range(100):
+        I1 = rng.uniform(0.2, 1.0)
+        body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=rng.uniform(-0.5, 0.5), I1=I1,
+                            I3=rng.uniform(0.2, min(2 * I1, 1.5)))  # fmt: skip
+        gamma = rng.normal(size=3)
+        y0 = initial_state(body, "parallel", gamma=gamma / np.linalg.norm(gamma),
+                           omega=rng.normal(size=3), free={"v_nu": rng.normal() * 0.5})  # fmt: skip
+        res = integrate(MODELS["parallel"].code, body.params, y0, np.linspace(0.0, 50.0, 10001),
+                        rtol=1e-10, atol=1e-12)  # fmt: skip
+        s = np.hypot(res.y[:, 12], res.y[:, 13])
+        passages += np.count_nonzero((s[1:-1] < s[:-2]) & (s[1:-1] < s[2:]) & (s[1:-1] < 1e-2))
+        for v in evaluate(body, res.y, ["energy", "jellett"]).values():
+            assert np.max(np.abs(v - v[0])) / max(1.0, abs(v[0])) < PASSAGE_DRIFT
+    assert passages > 500
