@@ -16,6 +16,11 @@ if TYPE_CHECKING:
 
 __all__ = ["indicators_figure", "section_figure"]
 
+#: Crossings of a trajectory closer than this in both coordinates count as one point...
+SAME_POINT = 1e-6
+#: ... drawn with this marker size.
+SINGLE_SIZE = 6.0
+
 
 def section_figure(ds: xr.Dataset, *, marker_size: float = 0.6) -> Figure:
     """The crossings in the plane ``(gamma3, w_n)``, one colour per trajectory, each
@@ -28,7 +33,13 @@ def section_figure(ds: xr.Dataset, *, marker_size: float = 0.6) -> Figure:
         g3 = ds["gamma3"].values[k]
         wn = ds["w_n"].values[k]
         ok = np.isfinite(g3)
-        ax.plot(g3[ok], wn[ok], ".", ms=marker_size, color=cmap((k + 0.5) / K), rasterized=True)
+        if not ok.any():
+            continue
+        # a trajectory whose crossings coincide (the paper's model: one point per orbit) is
+        # drawn as one visible dot
+        single = max(np.ptp(g3[ok]), np.ptp(wn[ok])) < SAME_POINT
+        ax.plot(g3[ok], wn[ok], ".", ms=SINGLE_SIZE if single else marker_size,
+                color=cmap((k + 0.5) / K), rasterized=True)  # fmt: skip
     ax.set_xlabel(r"$\gamma_3$ at the crossing")
     ax.set_ylabel(r"$\omega_n = (\omega, n)$")
     held = ds.attrs["held"].replace(",", ", ")
