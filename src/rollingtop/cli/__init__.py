@@ -11,6 +11,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._atlas`: ``atlas`` (the classification over a parameter grid, on Dask);
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;
+- :mod:`._chaos`: ``section``, ``chaos`` (Poincare sections, Lyapunov exponent and MEGNO);
 - :mod:`._verify`: ``verify``;
 - :mod:`._warmup`: ``warmup``.
 """
@@ -20,6 +21,7 @@ from __future__ import annotations
 from rollingtop.cli._app import cli
 from rollingtop.cli._atlas import atlas
 from rollingtop.cli._bifurcation import bifurcation
+from rollingtop.cli._chaos import chaos, section
 from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
@@ -32,7 +34,8 @@ from rollingtop.cli._warmup import warmup
 __all__ = ["cli", "main"]
 
 for _command in (simulate, equilibria, orbits, portrait, bifurcation, rotation, stability, atlas,
-                 path, plot, compare, animate, ensemble, verify, warmup):  # fmt: skip
+                 path, plot, compare, animate, ensemble, section, chaos, verify,
+                 warmup):  # fmt: skip
     cli.add_command(_command)
 
 

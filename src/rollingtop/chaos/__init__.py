@@ -1,0 +1,29 @@
+"""Poincare sections and chaos indicators, for every contact model of the registry.
+
+Everything runs through the compiled dispatch (the kernel code of a model), so a model added
+to :mod:`rollingtop.contact` is served without code here:
+
+- :func:`poincare_section`: crossings of ``w_tau = 0`` (upward) by many trajectories on one
+  level set of the integrals, in parallel (:mod:`.section`);
+- :func:`level_states`: initial states on the level set of a state (:mod:`.level`);
+- :func:`chaos_indicators`: the maximal Lyapunov exponent and MEGNO from the tangent dynamics
+  integrated with the motion (:mod:`.lyapunov`, :mod:`._tangent`);
+- :func:`indicator_map`: the indicators over many initial states, in parallel or on Dask
+  (:mod:`.maps`).
+"""
+
+from __future__ import annotations
+
+from rollingtop.chaos.level import level_states
+from rollingtop.chaos.lyapunov import ChaosIndicators, chaos_indicators
+from rollingtop.chaos.maps import indicator_map
+from rollingtop.chaos.section import poincare_section, section_summary
+
+__all__ = [
+    "ChaosIndicators",
+    "chaos_indicators",
+    "indicator_map",
+    "level_states",
+    "poincare_section",
+    "section_summary",
+]

@@ -1,0 +1,229 @@
+"""Poincare sections on a level set of the integrals, for any contact model.
+
+**The section** is the hyperplane ``w_tau = 0`` crossed upward (``w_tau`` from negative to
+positive), where ``tau = e3 x gamma / s`` (``docs/model.md``, "Reduced variables"). Since
+``gamma3' = s w_tau`` (paper eq. 3.3, a kinematic identity that holds for every model), these are
+the minima of ``gamma3``: the lowest inclinations of the axis, reached once per nutation. The
+event function is the stepper's ``W_TAU`` (``s w_tau = (w, e3 x gamma)``,
+:mod:`rollingtop.dynamics._events`), located on the 7th-order dense output of each step by
+bisection (:func:`rollingtop.integrate._dop853_dense.event_root`, 60 halvings) and the state
+there projected onto the constraints.
+
+**The plane** of the points is ``(gamma3, w_n)``, ``w_n = (w, n)``, ``n = -(gamma1, gamma2, 0)
+/ s``: the inclination at the minimum and the angular velocity about the horizontal axis
+``n`` (the axis's azimuth rate is ``psi' = -w_n / s``). For the paper's model and a
+dynamically symmetric body the reduced system on a level ``(M3, C1, C2)`` has one degree of
+freedom (paper Sec. 3): ``gamma3(t)`` is periodic, so every crossing of a trajectory is the same
+point, ``(gamma3_min, w_n(gamma3_min))`` with ``w_n`` of eq. 3.8: the invariant curves of the
+section degenerate to points, one per orbit. Without such a reduction (a non-symmetric body,
+the smooth or rough plane's generic cases, the non-integrable models) the points of one
+trajectory fill curves (quasi-periodic motion, KAM tori) or areas (chaos). At a given
+``(gamma3, w_n)`` the section may hold several states of the level (the remaining coordinates,
+such as ``w3`` or the azimuth of ``gamma`` in the body, take the values the held integrals
+allow): the plane is a projection, so points of different sheets may overlap.
+
+**Initial states** share the level of the given state (:func:`rollingtop.chaos.level_states`),
+or are given; they are integrated in parallel on all cores, each until it has the asked number
+of crossings.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop._errors import InitialStateError, ScenarioError
+from rollingtop._types import FloatArray
+from rollingtop.body import SphericalTop
+from rollingtop.chaos._kernels import SECTION_STATS, section_batch
+from rollingtop.chaos._parallel import run_threaded
+from rollingtop.chaos.level import held_integrals, level_states, level_values
+from rollingtop.contact import ContactModel, get_model
+from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics.integrals import reduced_components
+from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
+from rollingtop.integrate._dop853 import STATUS_NAMES
+from rollingtop.integrate.driver import compile_kernels
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+__all__ = ["STATE_COMPONENTS", "poincare_section"]
+
+#: Names of the state components (the ``state`` coordinate of the datasets).
+STATE_COMPONENTS = [f"{k}{i}" for k in ("v", "omega", "alpha", "beta", "gamma") for i in (1, 2, 3)]
+STATE_COMPONENTS += ["X", "Y", "psi_nu"]
+#: Largest number of crossings stored (trajectories times crossings).
+MAX_POINTS = 20_000_000
+#: Default number of trajectories when a single state is given.
+DEFAULT_TRAJECTORIES = 16
+
+
+def _check_count(name: str, value: object, lo: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < lo:
+        raise ScenarioError(f"{name} = {value!r} must be an integer >= {lo}")
+    return int(value)
+
+
+def _initial_states(
+    body: SphericalTop, model: ContactModel, states: ArrayLike, trajectories: int | None,
+    hold: Sequence[str] | None, seed: int | None,
+) -> FloatArray:  # fmt: skip
+    Y = np.array(states, dtype=float)
+    if Y.shape == (N_STATE,):
+        n = DEFAULT_TRAJECTORIES if trajectories is None else trajectories
+        return level_states(body, model, Y, _check_count("trajectories", n, 1), hold=hold,
+                            seed=seed)  # fmt: skip
+    if Y.ndim != 2 or Y.shape[1] != N_STATE or Y.shape[0] == 0:
+        raise InitialStateError(f"states must have shape (18,) or (K, 18), got {Y.shape}")
+    if trajectories is not None and trajectories != Y.shape[0]:
+        raise InitialStateError(f"trajectories = {trajectories!r} but {Y.shape[0]} states given")
+    for k, y in enumerate(Y):
+        res = constraint_residuals(body, model, y)
+        if not np.all(np.isfinite(y)) or np.any(np.abs(res) > UNIT_TOLERANCE):
+            raise InitialStateError(
+                f"state {k} is not finite or violates a constraint of model {model.name!r} "
+                "(build states with rollingtop.initial_state or rollingtop.chaos.level_states)"
+            )
+    return Y
+
+
+def poincare_section(
+    body: SphericalTop,
+    model: str | ContactModel,
+    states: ArrayLike,
+    *,
+    crossings: int = 1000,
+    trajectories: int | None = None,
+    hold: Sequence[str] | None = None,
+    seed: int | None = 0,
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    t_max: float = math.inf,
+    max_steps: int = 10**7,
+    threads: int | None = None,
+) -> xr.Dataset:
+    """Crossings of the section ``w_tau = 0`` (upward) by trajectories on one level set.
+
+    Parameters
+    ----------
+    body : SphericalTop
+    model : str or ContactModel
+        Any registered model (through its compiled kernel).
+    states : array_like, shape (18,) or (K, 18)
+        One state, whose level is sampled (:func:`rollingtop.chaos.level_states`: the state
+        itself and ``trajectories - 1`` more), or the initial states themselves.
+    crossings : int
+        Crossings wanted per trajectory.
+    trajectories : int, optional
+        Trajectories sampled on the level (default 16; with K states given: K).
+    hold : sequence of str, optional
+        The integrals held on the level (default: all of the model's for the body).
+    seed : int or None
+        Seed of the sampling.
+    rtol, atol : float
+        Tolerances of the integration (``atol`` default ``rtol / 100``).
+    t_max : float
+        A trajectory stops at this time even with fewer crossings.
+    max_steps : int
+        ... or after this many accepted steps.
+    threads : int, optional
+        Threads (default: numba's, all cores).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``trajectory`` (K), ``crossing`` (N) and ``state`` (18). Variables
+        ``gamma3``, ``w_n``, ``w_tau`` (at the located crossing: zero to ~1e-12), ``t``
+        (K, N; NaN beyond a trajectory's crossings), ``crossing_state`` (K, N, 18),
+        ``initial_state`` (K, 18), per trajectory ``n_crossings``, ``status`` (0: done, else
+        the stepper's code, attribute ``status_names``), ``steps``, ``t_last`` and
+        ``min_normal_force``, and per held integral ``level_<name>`` (its value at each
+        initial state). Attributes: the body, ``model``, ``held``, ``section``, ``plane``.
+        NetCDF-writable (:func:`rollingtop.io.netcdf_bytes`).
+    """
+    import xarray as xr
+
+    model = get_model(model)
+    crossings = _check_count("crossings", crossings, 1)
+    _check_count("max_steps", max_steps, 1)
+    if trajectories is not None:
+        trajectories = _check_count("trajectories", trajectories, 1)
+    if not 1e-15 <= rtol <= 0.1:
+        raise ScenarioError(f"rtol = {rtol!r} must lie in [1e-15, 0.1]")
+    atol = rtol / 100 if atol is None else atol
+    if not (isinstance(atol, int | float) and atol > 0):
+        raise ScenarioError(f"atol = {atol!r} must be > 0")
+    if not (isinstance(t_max, int | float) and t_max > 0):
+        raise ScenarioError(f"t_max = {t_max!r} must be > 0")
+    names = held_integrals(body, model, hold)
+    Y0 = _initial_states(body, model, states, trajectories, hold, seed)
+    K = Y0.shape[0]
+    if K * crossings > MAX_POINTS:
+        raise ScenarioError(f"{K} trajectories x {crossings} crossings exceeds {MAX_POINTS}")
+    codes = np.array([model.kernel_code(body, y) for y in Y0], dtype=np.int64)
+    compile_kernels()
+    ev_t = np.full((K, crossings), np.nan)
+    ev_y = np.full((K, crossings, N_STATE), np.nan)
+    stats = np.zeros((K, len(SECTION_STATS)))
+    wall, used = run_threaded(section_batch, (codes, body.params, Y0, float(t_max), float(rtol),
+                                              float(atol), int(max_steps), ev_t, ev_y, stats),
+                              threads)  # fmt: skip
+    found = stats[:, 1].astype(int)
+    mask = np.arange(crossings)[None, :] >= found[:, None]
+    ev_t[mask] = np.nan
+    ev_y[mask] = np.nan
+    red = reduced_components(ev_y)
+    levels = np.array([level_values(body, model, y, names) for y in Y0])
+    data: dict[str, tuple[Any, NDArray[Any]]] = {
+        "gamma3": (("trajectory", "crossing"), red["gamma3"]),
+        "w_n": (("trajectory", "crossing"), red["w_n"]),
+        "w_tau": (("trajectory", "crossing"), red["w_tau"]),
+        "t": (("trajectory", "crossing"), ev_t),
+        "crossing_state": (("trajectory", "crossing", "state"), ev_y),
+        "initial_state": (("trajectory", "state"), Y0),
+        "n_crossings": ("trajectory", found.astype(np.int64)),
+        "status": ("trajectory", stats[:, 0].astype(np.int32)),
+        "steps": ("trajectory", stats[:, 2].astype(np.int64)),
+        "t_last": ("trajectory", stats[:, 3]),
+        "min_normal_force": ("trajectory", stats[:, 4]),
+    }
+    for k, name in enumerate(names):
+        data[f"level_{name}"] = ("trajectory", levels[:, k])
+    attrs: dict[str, Any] = {f"body_{k}": v for k, v in body.to_dict().items()}
+    attrs.update(
+        model=model.name, held=",".join(names), crossings=crossings, rtol=float(rtol),
+        atol=float(atol), wall_time_s=wall, threads=used, source="rollingtop section",
+        section="w_tau = 0, w_tau increasing (minima of gamma3)", plane="gamma3, w_n",
+        status_names=json.dumps({str(k): v for k, v in STATUS_NAMES.items()}),
+    )  # fmt: skip
+    coords = {"trajectory": np.arange(K), "crossing": np.arange(crossings),
+              "state": STATE_COMPONENTS}  # fmt: skip
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def section_summary(ds: xr.Dataset) -> dict[str, Any]:
+    """JSON-ready summary of a section (``rollingtop section --json``)."""
+    w_tau = np.abs(ds["w_tau"].values)
+    ok = np.isfinite(w_tau)
+    levels = {str(name)[6:]: [float(ds[name].min()), float(ds[name].max())]
+              for name in ds.data_vars if str(name).startswith("level_")}  # fmt: skip
+    return {
+        "model": ds.attrs["model"],
+        "trajectories": int(ds.sizes["trajectory"]),
+        "crossings_per_trajectory": int(ds.attrs["crossings"]),
+        "crossings_found": int(ds["n_crossings"].sum()),
+        "incomplete": int(np.sum(ds["n_crossings"].values < ds.attrs["crossings"])),
+        "max_abs_w_tau": float(w_tau[ok].max()) if ok.any() else None,
+        "min_normal_force": float(ds["min_normal_force"].min()),
+        "held": ds.attrs["held"].split(","),
+        "level_range": levels,
+        "gamma3_range": [float(np.nanmin(ds["gamma3"])), float(np.nanmax(ds["gamma3"]))]
+        if ok.any() else None,
+        "wall_time_s": float(ds.attrs["wall_time_s"]),
+    }  # fmt: skip

@@ -1,0 +1,156 @@
+"""``rollingtop section`` (Poincare sections) and ``rollingtop chaos`` (Lyapunov exponent and
+MEGNO), for the scenario's body, model and initial state."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from rollingtop.cli import _output
+from rollingtop.cli._errors import BadInput
+from rollingtop.cli._options import (
+    atol_option,
+    figure_output,
+    json_option,
+    rtol_option,
+    scenario_argument,
+    t_end_option,
+)
+
+__all__ = ["chaos", "section"]
+
+
+def _hold(value: str | None) -> list[str] | None:
+    if value is None:
+        return None
+    names = [n.strip() for n in value.split(",") if n.strip()]
+    if not names:
+        raise BadInput(f"--hold {value!r}: give integral names separated by commas")
+    return names
+
+
+@click.command()
+@scenario_argument
+@figure_output
+@click.option("--crossings", type=int, default=1000, show_default=True,
+              help="Crossings of the section per trajectory.")  # fmt: skip
+@click.option("--trajectories", type=int, default=16, show_default=True,
+              help="Trajectories on the scenario's level (its own state first).")  # fmt: skip
+@click.option("--hold", default=None, metavar="NAMES",
+              help="Integrals held on the level, comma-separated (default: all of the "
+                   "model's; the energy always).")  # fmt: skip
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the sampling.")
+@click.option("--netcdf", type=click.Path(), default=None, help="Also write the crossings: OUT.nc.")
+@rtol_option
+@atol_option
+@json_option
+def section(
+    scenario: str,
+    output: str,
+    crossings: int,
+    trajectories: int,
+    hold: str | None,
+    seed: int,
+    netcdf: str | None,
+    rtol: float | None,
+    atol: float | None,
+    as_json: bool,
+) -> None:
+    """Poincare section w_tau = 0 (upward: the minima of gamma3) in the plane (gamma3, w_n), of
+    trajectories sampled on the level set of the scenario's initial state (same energy and
+    other integrals of its model)."""
+    from rollingtop.chaos import poincare_section, section_summary
+    from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
+    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
+    from rollingtop.scenario import load_scenario
+
+    check_output_path(output, FIGURE_SUFFIXES)
+    if netcdf is not None:
+        check_output_path(netcdf, (".nc",))
+    sc = load_scenario(scenario).with_overrides(rtol=rtol, atol=atol)
+    y0 = sc.require_state()
+    with _output.status("section:") as show:
+        if show is not None:
+            show(f"{trajectories} trajectories x {crossings} crossings")
+        ds = poincare_section(sc.body, sc.model, y0, crossings=crossings,
+                              trajectories=trajectories, hold=_hold(hold), seed=seed,
+                              rtol=sc.integration.rtol,
+                              atol=sc.integration.resolved_atol)  # fmt: skip
+    from rollingtop.plot.section import section_figure
+
+    save_figure(section_figure(ds), output)
+    if netcdf is not None:
+        write_bytes_atomic(netcdf, netcdf_bytes(ds))
+    summary = section_summary(ds)
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    found, K = summary["crossings_found"], summary["trajectories"]
+    click.echo(f"{found} crossings of {K} trajectories (model {summary['model']}, held: "
+               f"{', '.join(summary['held'])}); max |w_tau| at the crossings "
+               f"{summary['max_abs_w_tau']:.2g}")  # fmt: skip
+    if summary["incomplete"]:
+        click.echo(f"{summary['incomplete']} trajectories stopped before {crossings} crossings")
+    click.echo(f"wrote {output}" + ("" if netcdf is None else f" and {netcdf}"))
+
+
+@click.command()
+@scenario_argument
+@t_end_option
+@click.option("--samples", type=int, default=1000, show_default=True,
+              help="Sample times of the time series.")  # fmt: skip
+@click.option("-o", "--output", type=click.Path(), default=None,
+              help="Write the time series: OUT.nc.")  # fmt: skip
+@click.option("--figure", type=click.Path(), default=None,
+              help="Draw the time series: FIG.png, .svg or .pdf.")  # fmt: skip
+@rtol_option
+@atol_option
+@json_option
+def chaos(
+    scenario: str,
+    t_end: float | None,
+    samples: int,
+    output: str | None,
+    figure: str | None,
+    rtol: float | None,
+    atol: float | None,
+    as_json: bool,
+) -> None:
+    """Maximal Lyapunov exponent and MEGNO along the scenario's motion, from its tangent
+    dynamics: lambda(t_end) (-> 0 like ln t / t for quasi-periodic motion) and the mean MEGNO
+    <Y>(t_end) (-> 2 for quasi-periodic motion, ~ lambda t / 2 for chaotic)."""
+    from rollingtop.chaos import chaos_indicators
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES
+    from rollingtop.scenario import load_scenario
+
+    if output is not None:
+        check_output_path(output, (".nc",))
+    if figure is not None:
+        check_output_path(figure, FIGURE_SUFFIXES)
+    sc = load_scenario(scenario).with_overrides(t_end=t_end, rtol=rtol, atol=atol)
+    opts = sc.integration
+    with _output.status("chaos:") as show:
+        if show is not None:
+            show(f"tangent dynamics to t = {opts.t_end:g}")
+        result = chaos_indicators(sc.body, sc.model, sc.require_state(), t_end=opts.t_end,
+                                  samples=samples, rtol=opts.rtol,
+                                  atol=opts.resolved_atol)  # fmt: skip
+    if output is not None:
+        result.to_netcdf(output)
+    if figure is not None:
+        from rollingtop.plot import save_figure
+        from rollingtop.plot.section import indicators_figure
+
+        save_figure(indicators_figure(result), figure)
+    summary = result.summary()
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    click.echo(f"model {summary['model']}, t = {summary['t_end']:g}: maximal Lyapunov exponent "
+               f"{summary['lyapunov']:.6g}, mean MEGNO <Y> = {summary['megno']:.6g} "
+               f"(Y = {summary['megno_instantaneous']:.6g}); {summary['steps']} steps")  # fmt: skip
+    for path in (output, figure):
+        if path is not None:
+            click.echo(f"wrote {path}")

@@ -1,0 +1,62 @@
+"""``rollingtop section`` and ``rollingtop chaos``: JSON, outputs, one-line errors (exit 2)."""
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from ..conftest import EXAMPLES
+from ..test_cli import run_cli
+
+CHAOTIC = str(EXAMPLES / "chaotic.toml")
+PAPER = str(EXAMPLES / "paper.toml")
+
+
+def test_section_json_figure_and_netcdf(capsys, tmp_path):
+    fig, nc = tmp_path / "s.png", tmp_path / "s.nc"
+    code, out, err = run_cli(capsys, "section", CHAOTIC, "-o", str(fig), "--crossings", "50",
+                             "--trajectories", "3", "--netcdf", str(nc), "--json")  # fmt: skip
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["crossings_found"] == 150
+    assert summary["max_abs_w_tau"] <= 1e-11
+    assert summary["held"] == ["energy", "area", "momentum_x", "momentum_y"]
+    assert fig.stat().st_size > 0
+    with xr.open_dataset(nc, engine="h5netcdf") as ds:
+        assert ds["gamma3"].shape == (3, 50)
+
+
+def test_chaos_json_and_time_series(capsys, tmp_path):
+    nc = tmp_path / "c.nc"
+    code, out, err = run_cli(capsys, "chaos", PAPER, "--t-end", "200", "--samples", "20",
+                             "-o", str(nc), "--json")  # fmt: skip
+    assert code == 0, err
+    summary = json.loads(out)
+    assert set(summary) >= {"lyapunov", "megno"}
+    assert 0 < summary["lyapunov"] < 0.05
+    with xr.open_dataset(nc, engine="h5netcdf") as ds:
+        assert ds["lyapunov"].shape == (20,)
+        assert float(ds["lyapunov"][-1]) == pytest.approx(summary["lyapunov"])
+        assert np.isfinite(ds["megno_mean"]).all()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["chaos", CHAOTIC, "--t-end", "-1"], "t_end"),
+        (["chaos", CHAOTIC, "--samples", "0"], "samples"),
+        (["chaos", CHAOTIC, "-o", "out.txt"], "unknown output format"),
+        (["section", CHAOTIC, "-o", "fig.png", "--crossings", "0"], "crossings"),
+        (["section", CHAOTIC, "-o", "fig.txt"], "unknown output format"),
+        (["section", CHAOTIC, "-o", "fig.png", "--hold", "routh"], "routh"),
+        (["section", "missing.toml", "-o", "fig.png"], "missing.toml"),
+    ],
+)
+def test_bad_input_is_one_line_with_status_2(capsys, tmp_path, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, *args)
+    assert code == 2
+    assert message in err
+    assert err.count("\n") == 1
+    assert not list(tmp_path.iterdir())
