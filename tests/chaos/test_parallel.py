@@ -60,3 +60,18 @@ def test_the_parallel_exponent_by_two_nearby_trajectories():
                                      dt=10.0)  # fmt: skip
     assert other > CHAOTIC_EXPONENT
     assert 1.0 / EXPONENT_FACTOR < other / lam < EXPONENT_FACTOR
+
+
+def test_the_readme_states_what_the_chaos_command_measures():
+    """README: 'the finite-time maximal Lyapunov exponent ... is 0.019 at t = 3000 and the mean
+    MEGNO 30', for examples/parallel_chaotic.toml."""
+    from pathlib import Path
+
+    from rollingtop.scenario import load_scenario
+
+    root = Path(__file__).resolve().parents[2]
+    readme = " ".join((root / "README.md").read_text().split())
+    sc = load_scenario(root / "examples" / "parallel_chaotic.toml")
+    r = chaos_indicators(sc.body, sc.model, sc.require_state(), t_end=sc.integration.t_end)
+    assert f"is {r.lyapunov[-1]:.2g} at `t = 3000`" in readme
+    assert f"the mean MEGNO {r.megno_mean[-1]:.0f} and growing" in readme
