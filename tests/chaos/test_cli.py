@@ -60,3 +60,20 @@ def test_bad_input_is_one_line_with_status_2(capsys, tmp_path, monkeypatch, args
     assert message in err
     assert err.count("\n") == 1
     assert not list(tmp_path.iterdir())
+
+
+def test_chaos_phase_volume(capsys):
+    from rollingtop.chaos.divergence import phase_volume
+    from rollingtop.scenario import load_scenario
+
+    scenario = str(EXAMPLES / "parallel_chaotic.toml")
+    code, out, err = run_cli(capsys, "chaos", scenario, "--t-end", "20", "--phase-volume", "401",
+                             "--json")  # fmt: skip
+    assert code == 0, err
+    volume = json.loads(out)["phase_volume"]
+    sc = load_scenario(scenario)
+    expected = phase_volume(sc.body, sc.model, sc.require_state(), t_end=20.0, samples=401)
+    assert volume["mean_divergence"] == pytest.approx(expected.mean[-1], rel=1e-12)
+    assert volume["dimension"] == 7
+    code, _, err = run_cli(capsys, "chaos", scenario, "--phase-volume", "1")
+    assert code == 2 and "--phase-volume" in err

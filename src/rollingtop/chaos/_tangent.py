@@ -239,10 +239,13 @@ def advance(
                     dop.MAX_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT)  # fmt: skip
                 if rejected > 0:
                     factor = min(1.0, factor)
-                h_abs *= factor
+                # from the step taken, which a sample time may have shortened: scaling the
+                # proposed one instead let it grow without bound over many short steps, and a
+                # rejection then could not bring it below the distance to the sample
+                h_abs = h * factor
                 break
-            h_abs *= dop.MIN_FACTOR if not math.isfinite(err) else max(
-                dop.MIN_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT)  # fmt: skip
+            h_abs = h * (dop.MIN_FACTOR if not math.isfinite(err) else max(
+                dop.MIN_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT))  # fmt: skip
             counts[REJECTED] += 1
             rejected += 1
             if rejected >= dop.MAX_REJECTED_IN_A_ROW:

@@ -104,6 +104,15 @@ def section(
               help="Write the time series: OUT.nc.")  # fmt: skip
 @click.option("--figure", type=click.Path(), default=None,
               help="Draw the time series: FIG.png, .svg or .pdf.")  # fmt: skip
+@click.option(
+    "--phase-volume",
+    "volume_samples",
+    type=click.IntRange(min=2),
+    default=None,
+    metavar="N",
+    help="Also the time average of the divergence of the vector field (phase-volume "
+    "drift; 0 where a smooth invariant measure exists), sampled at N times.",
+)
 @rtol_option
 @atol_option
 @json_option
@@ -113,6 +122,7 @@ def chaos(
     samples: int,
     output: str | None,
     figure: str | None,
+    volume_samples: int | None,
     rtol: float | None,
     atol: float | None,
     as_json: bool,
@@ -145,12 +155,26 @@ def chaos(
 
         save_figure(indicators_figure(result), figure)
     summary = result.summary()
+    if volume_samples is not None:
+        from rollingtop.chaos.divergence import phase_volume
+
+        with _output.status("phase volume:") as show:
+            if show is not None:
+                show(f"divergence at {volume_samples} times")
+            volume = phase_volume(sc.body, sc.model, sc.require_state(), t_end=opts.t_end,
+                                  samples=volume_samples, rtol=opts.rtol,
+                                  atol=opts.resolved_atol)  # fmt: skip
+        summary["phase_volume"] = volume.summary()
     if as_json:
         click.echo(json.dumps(summary))
         return
     click.echo(f"model {summary['model']}, t = {summary['t_end']:g}: maximal Lyapunov exponent "
                f"{summary['lyapunov']:.6g}, mean MEGNO <Y> = {summary['megno']:.6g} "
                f"(Y = {summary['megno_instantaneous']:.6g}); {summary['steps']} steps")  # fmt: skip
+    if volume_samples is not None:
+        click.echo(f"mean divergence (phase-volume drift) "
+                   f"{summary['phase_volume']['mean_divergence']:.6g} on a manifold of "
+                   f"dimension {summary['phase_volume']['dimension']}")  # fmt: skip
     for path in (output, figure):
         if path is not None:
             click.echo(f"wrote {path}")
