@@ -56,7 +56,7 @@ def _tangent_after(body, model, y0, d0, t_end):
     tg.aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
     status = tg.advance(code, p, z, fz, ctrl, np.zeros(3, dtype=np.int64), t_end,
                         np.zeros((16, tg.N_AUG)), np.zeros(tg.N_AUG), np.zeros(tg.N_AUG),
-                        scratch, ws)  # fmt: skip
+                        scratch, ws, 0.0)  # fmt: skip
     assert status == 0
     return start, z[tg.DELTA : tg.N_ERR] * np.exp(ctrl[tg.LOG_SUM])
 
@@ -148,3 +148,18 @@ def test_chaos_indicators_refuse_bad_input(chaotic):
         chaos_indicators(body, model, y0, t_end=1.0, tangent=np.zeros(18))
     with pytest.raises(IntegrationError, match="max_steps"):
         chaos_indicators(body, model, y0, t_end=100.0, samples=2, max_steps=10)
+
+
+def test_indicator_map_on_dask_equals_in_process(chaotic):
+    """The same map on an embedded Dask cluster (chunks of states, one thread each)."""
+    from distributed import Client, LocalCluster
+
+    body, model, y0 = chaotic
+    states = level_states(body, model, y0, 5, seed=1)
+    here = indicator_map(body, model, states, t_end=50.0, samples=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
+        there = indicator_map(body, model, states, t_end=50.0, samples=2, client=client)
+    np.testing.assert_allclose(there["lyapunov"].values, here["lyapunov"].values, rtol=1e-7)
+    np.testing.assert_allclose(there["megno"].values, here["megno"].values, rtol=1e-7)
+    assert np.all(there["status"].values == 0)

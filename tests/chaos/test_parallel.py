@@ -5,6 +5,7 @@ body (``examples/section_parallel.toml``), and the paper's model from the same s
 import math
 
 import numpy as np
+import pytest
 
 from rollingtop import SphericalTop, initial_state
 from rollingtop.chaos import chaos_indicators
@@ -75,3 +76,22 @@ def test_the_readme_states_what_the_chaos_command_measures():
     r = chaos_indicators(sc.body, sc.model, sc.require_state(), t_end=sc.integration.t_end)
     assert f"is {r.lyapunov[-1]:.2g} at `t = 3000`" in readme
     assert f"the mean MEGNO {r.megno_mean[-1]:.0f} and growing" in readme
+
+
+def test_the_tangent_dynamics_stops_at_the_vertical_in_one_line():
+    """A motion that reaches the vertical (seed-0 state of tests/contact/test_parallel.py, at
+    t = 8.6105): the flow has no derivative there; the indicators are refused past it, and a map
+    marks the point with its status."""
+    from rollingtop import IntegrationError
+    from rollingtop.chaos import indicator_map
+    from rollingtop.chaos._tangent import REACHED_VERTICAL
+
+    from ..contact.test_parallel import BODY, _generic_state
+
+    y0 = _generic_state()
+    assert chaos_indicators(BODY, "parallel", y0, t_end=8.0).lyapunov[-1] > 0
+    with pytest.raises(IntegrationError, match="reaches the vertical after t = 8.6"):
+        chaos_indicators(BODY, "parallel", y0, t_end=20.0)
+    ds = indicator_map(BODY, "parallel", np.array([y0, y0]), t_end=20.0)
+    assert list(ds["status"].values) == [REACHED_VERTICAL] * 2
+    assert "reached the vertical" in ds.attrs["status_names"]

@@ -144,6 +144,7 @@ def indicator_batch(
     max_steps: int,
     out: FloatArray,
     stats: FloatArray,
+    s_stop: float,
     stop: IntArray,
 ) -> None:
     """:func:`~rollingtop.chaos._tangent.run_indicators` for every row of ``Y0`` with tangent
@@ -155,4 +156,4 @@ def indicator_batch(
             stats[k, 0] = dop.INTERRUPTED
         else:
             run_indicators(codes[k], p, Y0[k], D0[k], t_samples, rtol, atol, max_steps, out[k],
-                           states, stats[k])  # fmt: skip
+                           states, stats[k], s_stop)  # fmt: skip

@@ -63,6 +63,15 @@ FD_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
 #: for nothing; the exponent needs the tangent's direction, not its last digits.
 TANGENT_TOL = 1e-8
 
+#: Status of a run stopped where the axis passed through the vertical (a model whose motion is not
+#: determined through it: ``ContactModel.determined_through_vertical``).
+REACHED_VERTICAL = -4
+#: Names of the statuses of :func:`run_indicators`.
+STATUS_NAMES = {
+    **dop.STATUS_NAMES,
+    REACHED_VERTICAL: "reached the vertical, where the motion is not determined",
+}
+
 # ctrl: t, h_abs, rtol, atol, sum of ln |delta| at the renormalisations
 T, H_ABS, RTOL, ATOL, LOG_SUM = 0, 1, 2, 3, 4
 # counts: accepted steps, rejected steps, evaluations of the model's rhs
@@ -157,6 +166,18 @@ def renormalise(z: FloatArray, ctrl: FloatArray) -> float:
 
 
 @kernel
+def _signed_tilt(z: FloatArray) -> float:
+    """``sigma = gamma1 tau2 - gamma2 tau1``: the tilt of the axis with the sign of the side of
+    the vertical it is on, for the carried ``tau = sin(psi_nu) alpha - cos(psi_nu) beta``
+    (continuous through a passage, where ``sigma`` changes sign)."""
+    c, s = math.cos(z[17]), math.sin(z[17])
+    t1 = s * z[6] - c * z[9]
+    t2 = s * z[7] - c * z[10]
+    sigma: float = z[12] * t2 - z[13] * t1
+    return sigma
+
+
+@kernel
 def advance(
     code: int,
     p: FloatArray,
@@ -170,6 +191,7 @@ def advance(
     ztmp: FloatArray,
     scratch: FloatArray,
     ws: Workspace,
+    s_stop: float,
 ) -> int:
     """Advance the augmented state ``z`` (derivative ``fz``) to ``t_end`` exactly.
 
@@ -191,12 +213,17 @@ def advance(
         Work array (difference quotients and projections).
     ws : tuple
         Kernel workspace.
+    s_stop : float
+        Nonzero: stop (:data:`REACHED_VERTICAL`) after a step through the vertical, where the
+        signed distance ``sigma = (gamma, tau x e3)`` of the axis from it, with the carried
+        direction ``tau`` (:mod:`rollingtop.contact.parallel`), changes sign.
 
     Returns
     -------
     status : int
-        ``dop.FINISHED``, ``dop.STEP_TOO_SMALL``, ``dop.NOT_FINITE`` or
-        ``dop.TOO_MANY_REJECTED`` (the codes of :mod:`rollingtop.integrate._dop853`).
+        ``dop.FINISHED``, ``dop.STEP_TOO_SMALL``, ``dop.NOT_FINITE``,
+        ``dop.TOO_MANY_REJECTED`` (the codes of :mod:`rollingtop.integrate._dop853`) or
+        :data:`REACHED_VERTICAL`.
     """
     t = ctrl[T]
     h_abs = ctrl[H_ABS]
@@ -204,6 +231,7 @@ def advance(
     atol = ctrl[ATOL]
     tangent_tol = max(rtol, TANGENT_TOL)
     f1, f2, y1, y2 = scratch[0], scratch[1], scratch[2], scratch[3]
+    sigma_before = _signed_tilt(z)
     while t < t_end:
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         rejected = 0
@@ -272,6 +300,13 @@ def advance(
             return dop.NOT_FINITE
         t = t_new
         counts[STEPS] += 1
+        if s_stop != 0.0:
+            sigma = _signed_tilt(z)
+            if sigma * sigma_before < 0.0:
+                ctrl[T] = t
+                ctrl[H_ABS] = h_abs
+                return REACHED_VERTICAL
+            sigma_before = sigma
     ctrl[T] = t
     ctrl[H_ABS] = h_abs
     return dop.FINISHED
@@ -290,6 +325,7 @@ def run_indicators(
     out: FloatArray,
     states: FloatArray,
     stats: FloatArray,
+    s_stop: float,
 ) -> None:
     """Integrate the augmented system from ``(y0, d0)`` at ``t = 0`` through ``t_samples``.
 
@@ -308,6 +344,8 @@ def run_indicators(
         The state at each sample time (only the first ``min(n, len(states))``; may be empty).
     stats : ndarray, shape (4,)
         Status, accepted steps, rejected steps, model rhs evaluations.
+    s_stop : float
+        See :func:`advance`.
     """
     ws = new_workspace()
     K = np.zeros((16, N_AUG))
@@ -334,7 +372,8 @@ def run_indicators(
         for j in range(3):
             out[k, j] = np.nan
     for k in range(t_samples.shape[0]):
-        status = advance(code, p, z, fz, ctrl, counts, t_samples[k], K, znew, ztmp, scratch, ws)
+        status = advance(code, p, z, fz, ctrl, counts, t_samples[k], K, znew, ztmp, scratch, ws,
+                         s_stop)  # fmt: skip
         if status != dop.FINISHED:
             break
         t = ctrl[T]

@@ -32,7 +32,7 @@ from rollingtop._jit import call
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._tangent import run_indicators
+from rollingtop.chaos._tangent import REACHED_VERTICAL, run_indicators
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
@@ -43,7 +43,16 @@ from rollingtop.integrate.driver import _raise_for_status, compile_kernels
 if TYPE_CHECKING:
     import xarray as xr
 
-__all__ = ["ChaosIndicators", "chaos_indicators", "initial_tangent"]
+__all__ = ["ChaosIndicators", "chaos_indicators", "initial_tangent", "vertical_stop"]
+
+
+def vertical_stop(model: ContactModel) -> float:
+    """The ``s_stop`` of the tangent kernel for ``model``: nonzero (stop at a passage through the
+    vertical) for a model whose motion the state there does not determine (the ``parallel``
+    model: its flow has no derivative at the pole, the tangent vector would explode at every
+    passage)."""
+    return 0.0 if model.determined_through_vertical else 1.0
+
 
 #: Seed of the default initial tangent vector (a fixed random direction: reproducible runs).
 TANGENT_SEED = 20231205
@@ -218,7 +227,7 @@ def chaos_indicators(
 
     start = time.perf_counter()
     call(run_indicators, code, body.params, y0, d0, t, float(rtol), atol, int(max_steps), out,
-         states, stats)  # fmt: skip
+         states, stats, vertical_stop(model))  # fmt: skip
     wall = time.perf_counter() - start
     status = int(stats[0])
     if status != FINISHED:
@@ -226,6 +235,13 @@ def chaos_indicators(
         t_stop = float(t[done[-1]]) if done.size else 0.0
         if status == 1:
             raise IntegrationError(f"max_steps = {max_steps} reached near t = {t_stop:.6g}")
+        if status == REACHED_VERTICAL:
+            raise IntegrationError(
+                f"the motion reaches the vertical after t = {t_stop:.6g}, where the "
+                f"{model.name} model's continuation is not determined by the state: the tangent "
+                "dynamics (Lyapunov exponent, MEGNO) is undefined beyond it; choose a shorter "
+                "t_end or a motion that stays away from the vertical"
+            )
         _raise_for_status(status, np.array([t_stop, 0.0, t_end, rtol, atol, 0.0]),
                           np.array([0, 1, 0, 0, 0], dtype=np.int64))  # fmt: skip
         raise IntegrationError(f"{STATUS_NAMES.get(status, status)} near t = {t_stop:.6g}")

@@ -13,10 +13,10 @@ from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
 from rollingtop.chaos._kernels import indicator_batch
 from rollingtop.chaos._parallel import run_threaded
-from rollingtop.chaos.lyapunov import check_options, check_state, initial_tangent
+from rollingtop.chaos._tangent import STATUS_NAMES
+from rollingtop.chaos.lyapunov import check_options, check_state, initial_tangent, vertical_stop
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics._layout import N_STATE
-from rollingtop.integrate._dop853 import STATUS_NAMES
 from rollingtop.integrate.driver import compile_kernels
 
 if TYPE_CHECKING:
@@ -31,14 +31,14 @@ CLIENT_CHUNKS = 4
 
 def _chunk(
     codes: IntArray, params: FloatArray, states: FloatArray, tangents: FloatArray,
-    t: FloatArray, rtol: float, atol: float, max_steps: int, threads: int | None,
+    t: FloatArray, rtol: float, atol: float, max_steps: int, s_stop: float, threads: int | None,
 ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
     """One batch (a Dask task, or the whole map in-process): outputs ``(out, stats)``."""
     compile_kernels()
     out = np.full((len(states), t.size, 3), np.nan)
     stats = np.zeros((len(states), 4))
     run_threaded(indicator_batch, (codes, params, states, tangents, t, rtol, atol, max_steps,
-                                   out, stats), threads)  # fmt: skip
+                                   out, stats, s_stop), threads)  # fmt: skip
     return out, stats
 
 
@@ -105,7 +105,17 @@ def indicator_map(
     codes = np.array([model.kernel_code(body, y) for y in Y], dtype=np.int64)
     tangents = np.repeat(initial_tangent()[None, :], len(Y), axis=0)
     t = np.linspace(0.0, float(t_end), int(samples) + 1)[1:]
-    args = (codes, body.params, Y, tangents, t, float(rtol), atol, int(max_steps))
+    args = (
+        codes,
+        body.params,
+        Y,
+        tangents,
+        t,
+        float(rtol),
+        atol,
+        int(max_steps),
+        vertical_stop(model),
+    )
     if client is not None:
         out, stats = _on_client(client, args)
     else:

@@ -135,6 +135,11 @@ class ContactModel:
         ``psi_nu`` (the ``parallel`` model, whose direction ``tau`` is undefined at the vertical
         that its motions reach generically, :mod:`rollingtop.contact.parallel`), as the variants
         of the meridian model do on their pole levels.
+    determined_through_vertical : bool
+        Whether the state at a vertical axis determines the motion after it (``False`` for the
+        ``parallel`` model: a one-parameter family of continuations leaves the pole,
+        :mod:`rollingtop.contact.parallel`); tools that need a unique flow there (the tangent
+        dynamics of :mod:`rollingtop.chaos`) stop before it.
     has_reduction : bool
         Whether the model's motions of a dynamically symmetric body reduce to one degree of
         freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
@@ -160,6 +165,7 @@ class ContactModel:
     vertical_spin: Callable[[SphericalTop, int], float] | None = None
     vertical_eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
     carries_direction: bool = False
+    determined_through_vertical: bool = True
     has_reduction: bool = False
     colour: str = "#7f7f7f"
 

@@ -304,5 +304,6 @@ MODEL = ContactModel(
     vertical_direction=vertical_direction,
     vertical_eigenvalues=_vertical_eigenvalues,
     carries_direction=True,
+    determined_through_vertical=False,
     colour="#9467bd",
 )
