@@ -17,7 +17,12 @@ PAPER_BODY = dict(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5)
 #: Initial conditions of examples/paper.toml, with each model's free velocity.
 GAMMA0 = (0.0, 0.6, 0.8)
 OMEGA0 = (0.7, -0.3, 2.0)
-FREE = {"meridian": {"v_tau": 0.25}, "smooth": {"v_horizontal": (0.3, -0.2)}, "rough": {}}
+FREE = {
+    "meridian": {"v_tau": 0.25},
+    "smooth": {"v_horizontal": (0.3, -0.2)},
+    "rough": {},
+    "rubber": {},
+}
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -57,7 +62,8 @@ def rng() -> np.random.Generator:
 
 def scenario_text(model: str = "meridian", **sections) -> str:
     """TOML text of a scenario on the paper's body; ``sections`` replace whole tables."""
-    free = {"meridian": "v_tau = 0.25", "smooth": "v_horizontal = [0.3, -0.2]", "rough": ""}[model]
+    free = {"meridian": "v_tau = 0.25", "smooth": "v_horizontal = [0.3, -0.2]", "rough": "",
+            "rubber": ""}[model]  # fmt: skip
     tables = {
         "body": "R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5",
         "contact": f'model = "{model}"',
@@ -66,3 +72,16 @@ def scenario_text(model: str = "meridian", **sections) -> str:
     }
     tables.update(sections)
     return "\n".join(f"[{k}]\n{v}\n" for k, v in tables.items() if v is not None)
+
+
+def admissible_omega(model, gamma, omega):
+    """``omega`` without its components along the model's spin-constraint directions
+    (:attr:`rollingtop.contact.ContactModel.spin_directions`, mutually orthogonal; rubber
+    rolling: the part along ``gamma``), so that ``initial_state`` accepts it; unchanged for a
+    model whose angular velocity is free."""
+    omega = np.array(omega, dtype=float)
+    if model.spin_directions is not None:
+        for d in model.spin_directions(np.asarray(gamma, dtype=float)).values():
+            d = np.asarray(d, dtype=float)
+            omega -= (omega @ d) / (d @ d) * d
+    return omega

@@ -8,13 +8,14 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 - 2: ``meridian``, variant ``north``
 - 3: ``smooth``
 - 4: ``rough``
+- 5: ``rubber``
 """
 
 from __future__ import annotations
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.contact import _rows, meridian, rough, smooth
+from rollingtop.contact import _rows, meridian, rough, rubber, smooth
 
 
 @kernel
@@ -32,6 +33,8 @@ def rows(
         return smooth.rows(p, y, J, bias, dirs, 0)
     if code == 4:
         return rough.rows(p, y, J, bias, dirs, 0)
+    if code == 5:
+        return rubber.rows(p, y, J, bias, dirs, 0)
     return -1
 
 
@@ -49,6 +52,8 @@ def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace
         return smooth.accel(p, y, dy, ws, 0)
     if code == 4:
         return rough.accel(p, y, dy, ws, 0)
+    if code == 5:
+        return rubber.accel(p, y, dy, ws, 0)
     return -1
 
 
@@ -69,6 +74,9 @@ def project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool:
         return True
     if code == 4:
         rough.project_velocity(p, y, 0)
+        return True
+    if code == 5:
+        rubber.project_velocity(p, y, 0)
         return True
     return False
 
