@@ -22,6 +22,7 @@ FREE = {
     "smooth": {"v_horizontal": (0.3, -0.2)},
     "rough": {},
     "parallel": {"v_nu": 0.25},
+    "rubber": {},
 }
 
 
@@ -62,7 +63,8 @@ def rng() -> np.random.Generator:
 
 def scenario_text(model: str = "meridian", **sections) -> str:
     """TOML text of a scenario on the paper's body; ``sections`` replace whole tables."""
-    free = {"meridian": "v_tau = 0.25", "smooth": "v_horizontal = [0.3, -0.2]", "rough": ""}[model]
+    free = {"meridian": "v_tau = 0.25", "smooth": "v_horizontal = [0.3, -0.2]", "rough": "",
+            "rubber": ""}[model]  # fmt: skip
     tables = {
         "body": "R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5",
         "contact": f'model = "{model}"',
@@ -71,3 +73,16 @@ def scenario_text(model: str = "meridian", **sections) -> str:
     }
     tables.update(sections)
     return "\n".join(f"[{k}]\n{v}\n" for k, v in tables.items() if v is not None)
+
+
+def admissible_omega(model, gamma, omega):
+    """``omega`` without its components along the model's spin-constraint directions
+    (:attr:`rollingtop.contact.ContactModel.spin_directions`, mutually orthogonal; rubber
+    rolling: the part along ``gamma``), so that ``initial_state`` accepts it; unchanged for a
+    model whose angular velocity is free."""
+    omega = np.array(omega, dtype=float)
+    if model.spin_directions is not None:
+        for d in model.spin_directions(np.asarray(gamma, dtype=float)).values():
+            d = np.asarray(d, dtype=float)
+            omega -= (omega @ d) / (d @ d) * d
+    return omega

@@ -75,7 +75,7 @@ def test_overrides(tmp_path):
             ScenarioError,
             "unknown key body.J",
         ),
-        (dict(contact='model = "rubber"'), ContactModelError, "unknown contact model 'rubber'"),
+        (dict(contact='model = "glue"'), ContactModelError, "unknown contact model 'glue'"),
         (
             dict(initial="gamma = [0.0, 0.6, 0.9]\nomega = [0.7, -0.3, 2.0]"),
             InitialStateError,

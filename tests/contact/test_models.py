@@ -15,8 +15,10 @@ from rollingtop import InitialStateError, SphericalTop, initial_state
 from rollingtop.contact import KERNELS, MODELS, _codegen, _dispatch, kernel_by_code
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics.integrals import evaluate
-from rollingtop.dynamics.state import constraint_residuals
+from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
 from rollingtop.integrate.driver import integrate
+
+from ..conftest import admissible_omega
 
 #: A symmetric body with the centre of mass below the centre, and a general (I1 != I2) one.
 SYMMETRIC = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5)
@@ -44,6 +46,8 @@ TILTED = (0.0, math.sin(0.6), math.cos(0.6))
 
 
 def _state(body, model, gamma=TILTED, omega=(0.7, -0.3, 2.0)):
+    """A state of ``model``; ``omega`` loses its components that the model forbids."""
+    omega = admissible_omega(model, gamma, omega)
     return initial_state(body, model, gamma=gamma, omega=omega, free=_free(model))
 
 
@@ -145,8 +149,7 @@ def test_pole_passage(name):
     equations are reversible: ``u -> -u`` maps solutions to solutions), passes the pole at
     ``t = 0.3`` and goes on with its constraints and integrals intact."""
     model = MODELS[name]
-    y0 = initial_state(SYMMETRIC, model, gamma=(0.0, 0.0, 1.0), omega=(1.0, 0.5, 3.0),
-                       free=_free(model))  # fmt: skip
+    y0 = _state(SYMMETRIC, model, gamma=(0.0, 0.0, 1.0), omega=(1.0, 0.5, 3.0))
     kernel = model.kernel(SYMMETRIC, y0)
     out = _run(SYMMETRIC, kernel.code, y0, 0.3, n=2).y[-1]
     back = out.copy()
@@ -166,11 +169,38 @@ def test_pole_passage(name):
 @model_names
 def test_bad_free_components_are_refused_with_their_name(name):
     model = MODELS[name]
+    gamma = (0.0, 0.6, 0.8)
+    omega = admissible_omega(model, gamma, (0.3, 0.0, 1.0))
     with pytest.raises(InitialStateError, match="v_nonsense"):
-        initial_state(SYMMETRIC, model, gamma=(0.0, 0.6, 0.8), omega=(0.0, 0.0, 1.0),
-                      free={"v_nonsense": 1.0})  # fmt: skip
+        initial_state(SYMMETRIC, model, gamma=gamma, omega=omega, free={"v_nonsense": 1.0})
     for key, n in model.free_velocity.items():
         wrong = [0.1] * (n + 1)
         with pytest.raises(InitialStateError, match=key):
-            initial_state(SYMMETRIC, model, gamma=(0.0, 0.6, 0.8), omega=(0.0, 0.0, 1.0),
-                          free={key: wrong})  # fmt: skip
+            initial_state(SYMMETRIC, model, gamma=gamma, omega=omega, free={key: wrong})
+
+
+@pytest.mark.parametrize(
+    "name", [n for n, m in MODELS.items() if m.spin_directions is not None] or [None]
+)
+def test_an_omega_against_a_spin_constraint_is_refused(name):
+    """A model that constrains the angular velocity alone (rubber rolling: ``(w, gamma) = 0``)
+    refuses an initial ``omega`` that violates it, naming the constraint and its residual,
+    beyond ``UNIT_TOLERANCE |omega|``, and accepts it within (then the state satisfies it to
+    round-off): it does not project ``omega`` silently."""
+    if name is None:
+        pytest.skip("no registered model constrains the angular velocity alone")
+    model = MODELS[name]
+    gamma = np.array(TILTED)
+    good = admissible_omega(model, gamma, (0.7, -0.3, 2.0))
+    for label, d in model.spin_directions(gamma).items():
+        d = np.asarray(d) / np.linalg.norm(d)
+        bad = good + 0.5 * d
+        with pytest.raises(InitialStateError) as err:
+            initial_state(SYMMETRIC, model, gamma=gamma, omega=bad)
+        message = str(err.value)
+        assert label in message and "0.5" in message and "tolerance" in message
+        assert len(message.splitlines()) == 1
+        inside = good + 0.1 * UNIT_TOLERANCE * np.linalg.norm(good) * d
+        y = initial_state(SYMMETRIC, model, gamma=gamma, omega=inside)
+        assert abs(y[3:6] @ d) < 1e-15 * np.linalg.norm(good)
+        np.testing.assert_allclose(y[3:6], good, atol=UNIT_TOLERANCE * np.linalg.norm(good))

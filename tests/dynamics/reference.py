@@ -32,12 +32,21 @@ def directions(model, alpha, beta, gamma, w):
         p = np.cross(E3, gamma)
         pdot = np.cross(E3, gdot)
         dirs.append((p / s, pdot / s - p * sdot / s**2))
-    elif model == "rough":
+    elif model in ("rough", "rubber"):
         # vp = 0 as f1 plus (vp, alpha) = (vp, beta) = 0 (docs/model.md; the package uses body axes)
         dirs += [(alpha, np.cross(alpha, w)), (beta, np.cross(beta, w))]
     elif model != "smooth":
         raise ValueError(model)
     return dirs
+
+
+def spin_directions(model, gamma, w):
+    """Directions ``e`` of the constraints on the angular velocity alone, ``(w, e) = 0``, and
+    their time derivatives ``e'``: rubber rolling's ``(w, gamma) = 0`` (docs/model.md), kept by
+    a reaction torque ``mu e``."""
+    if model == "rubber":
+        return [(gamma, np.cross(gamma, w))]
+    return []
 
 
 def residuals(model, p, y):
@@ -47,7 +56,8 @@ def residuals(model, p, y):
     v, w = y[0:3], y[3:6]
     alpha, beta, gamma = y[6:9], y[9:12], y[12:15]
     vp = v + np.cross(w, -R * gamma - np.array([0.0, 0.0, a3]))
-    return np.array([vp @ d for d, _ in directions(model, alpha, beta, gamma, w)])
+    contact = [vp @ d for d, _ in directions(model, alpha, beta, gamma, w)]
+    return np.array(contact + [w @ e for e, _ in spin_directions(model, gamma, w)])
 
 
 def rhs(model, p, y):
@@ -64,7 +74,8 @@ def rhs(model, p, y):
     rdot = -R * np.cross(gamma, w)
     vp = v + np.cross(w, r)
     dirs = directions(model, alpha, beta, gamma, w)
-    k = len(dirs)
+    spins = spin_directions(model, gamma, w)
+    k = len(dirs) + len(spins)
     M = np.zeros((6 + k, 6 + k))
     b = np.zeros(6 + k)
     M[0:3, 0:3] = m * np.eye(3)
@@ -78,8 +89,13 @@ def rhs(model, p, y):
         M[6 + i, 0:3] = d
         M[6 + i, 3:6] = np.cross(r, d)
         b[6 + i] = -np.cross(w, rdot) @ d - vp @ ddot
+    for i, (e, edot) in enumerate(spins, start=len(dirs)):
+        # a reaction torque mu e, no force; d/dt (w, e) = (w', e) + (w, e') = 0
+        M[3:6, 6 + i] = -e
+        M[6 + i, 3:6] = e
+        b[6 + i] = -w @ edot
     sol = np.linalg.solve(M, b)
-    lam = sol[6:]
+    lam = sol[6 : 6 + len(dirs)]
     force = sum(l * d for l, (d, _) in zip(lam, dirs, strict=True))
     dy = np.zeros(len(y))
     dy[0:6] = sol[0:6]

@@ -8,6 +8,7 @@ the full equations on both sides of it.
 
 import json
 import math
+import re
 
 import mpmath as mp
 import numpy as np
@@ -28,6 +29,10 @@ from ..test_cli import run_cli
 
 #: Every registered model: a new one is held to its vertical-spin threshold by simulation.
 MODELS = tuple(REGISTRY)
+#: The models that allow a spin about the vertical axis (rubber rolling forbids it:
+#: ``ContactModel.has_vertical_spin``); every other one is held to its refusal.
+SPINNING = tuple(name for name, m in REGISTRY.items() if m.has_vertical_spin)
+NOT_SPINNING = tuple(name for name, m in REGISTRY.items() if not m.has_vertical_spin)
 PAPER = SphericalTop(**PAPER_BODY)
 BODIES = [
     PAPER,
@@ -49,7 +54,8 @@ def _analysed(model):
     return True
 
 
-ANALYSED = [m for m in MODELS if _analysed(m)]
+#: The spinning models whose vertical spin has a linearisation.
+ANALYSED = [m for m in SPINNING if _analysed(m)]
 
 
 @pytest.mark.parametrize("model", ANALYSED)
@@ -101,7 +107,7 @@ def _max_tilt(body, model, omega3, pole=1, t_end=80.0, tilt=1e-3):
 
 
 def test_a_model_without_a_linearisation_refuses_in_one_line():
-    for model in set(MODELS) - set(ANALYSED):
+    for model in set(SPINNING) - set(ANALYSED):
         with pytest.raises(StabilityError, match="undefined at the vertical"):
             vertical_spins(PAPER, model)
     assert {"meridian", "smooth", "rough"} <= set(ANALYSED)
@@ -131,9 +137,38 @@ def test_north_pole_threshold_by_simulation(model):
 
 
 def test_com_below_centre_spins_stably_at_any_rate():
-    for model in ANALYSED:
+    """At rest on a pole (omega3 = 0, an equilibrium of every model, rubber rolling's too):
+    stable with the centre of mass below the sphere's centre, unstable above it (every model
+    with a linearisation there)."""
+    for model in [*ANALYSED, *NOT_SPINNING]:
         ev = vertical_spin_eigenvalues(PAPER, model, 0.0, "north")
         assert np.max(np.abs(ev.real)) < 1e-6 * max(1.0, np.max(np.abs(ev)))
+        ev = vertical_spin_eigenvalues(PAPER, model, 0.0, "south")
+        assert np.max(ev.real) > 1e-3 * np.max(np.abs(ev)), model
+
+
+@pytest.mark.parametrize("model", NOT_SPINNING or [None])
+def test_a_model_without_vertical_spin_refuses_it(model, capsys, tmp_path):
+    """A model that forbids the spin about the vertical axis (its spin constraint is ``w3 = 0``
+    there) has no threshold to compute: one clear StabilityError naming the constraint, in
+    Python and on the command line; and indeed no state with the axis vertical spins about it."""
+    if model is None:
+        pytest.skip("every registered model allows the vertical spin")
+    from rollingtop import InitialStateError, initial_state
+
+    spin = ", ".join(REGISTRY[model].spin_directions(np.array([0.0, 0.0, 1.0])))
+    with pytest.raises(StabilityError, match=re.escape(f"no vertical spin: its constraint {spin}")):
+        vertical_spins(PAPER, model)
+    with pytest.raises(StabilityError, match="no vertical spin"):
+        vertical_spin_eigenvalues(PAPER, model, 1.0, "south")
+    with pytest.raises(InitialStateError, match="omega"):
+        initial_state(PAPER, model, gamma=(0.0, 0.0, 1.0), omega=(0.0, 0.0, 1.0))
+    path = tmp_path / "s.toml"
+    rolling_off_a_pole = "gamma = [0.0, 0.0, 1.0]\nomega = [1.0, 0.0, 0.0]"
+    path.write_text(scenario_text(model, initial=rolling_off_a_pole))
+    code, out, err = run_cli(capsys, "stability", str(path))
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "no vertical spin" in err
 
 
 def test_non_symmetric_body_uses_the_generic_linearisation():

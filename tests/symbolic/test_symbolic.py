@@ -71,6 +71,36 @@ def test_wrong_claims_fail():
         assert result.method  # says which method decided
 
 
+@pytest.mark.parametrize("model", list(MODELS))
+def test_the_manifold_satisfies_every_constraint(model):
+    """The parametrisation on which the claims are decided lies on the model's constraint
+    manifold: every constraint (contact rows and, for rubber rolling, ``(w, gamma) = 0``)
+    vanishes identically on it."""
+    from rollingtop.symbolic.claims import _manifold
+    from rollingtop.symbolic.equations import constraints
+
+    sub = _manifold(model)
+    for c in constraints(model):
+        assert sp.cancel(sp.together(c.xreplace(sub))) == 0, c
+
+
+@pytest.mark.parametrize("name", ["lagrange", "jellett", "area"])
+def test_rubber_rolling_loses_the_integrals_of_the_spin(name):
+    """Rubber rolling (symmetric body) conserves the energy (proved by ``verify``) but not the
+    Lagrange, Jellett or area integral: the time derivative of each along the derived equations
+    does not vanish on the constraint manifold (``decide`` finds it nonzero; the numerical
+    counterpart is tests/dynamics/test_integrals.py)."""
+    from rollingtop.symbolic.claims import _time_derivative, decide
+    from rollingtop.symbolic.equations import derive
+
+    assert name not in MODELS["rubber"].integrals_symmetric
+    rate = _time_derivative(_integrals()[name], derive("rubber", True).field)
+    holds, method = decide(rate, "rubber", symmetric=True)
+    assert not holds, method
+    energy = _time_derivative(_integrals()["energy"], derive("rubber", True).field)
+    assert decide(energy, "rubber", symmetric=True)[0]
+
+
 def test_claims_are_not_vacuous_on_the_manifold():
     """The manifold parametrisation keeps s = |e3 x gamma| consistent (rational, exact)."""
     from rollingtop.symbolic.claims import _manifold

@@ -24,7 +24,7 @@ from __future__ import annotations
 from types import ModuleType
 
 from rollingtop._errors import ContactModelError
-from rollingtop.contact import meridian, parallel, rough, smooth
+from rollingtop.contact import meridian, parallel, rough, rubber, smooth
 from rollingtop.contact._base import ContactModel, Kernel
 
 #: The registry: the model modules, one line each. Kernel codes follow this order (each model's
@@ -34,6 +34,7 @@ MODULES: tuple[ModuleType, ...] = (
     smooth,
     rough,
     parallel,
+    rubber,
 )
 
 MODELS: dict[str, ContactModel] = {m.MODEL.name: m.MODEL for m in MODULES}

@@ -140,6 +140,18 @@ class ContactModel:
         ``parallel`` model: a one-parameter family of continuations leaves the pole,
         :mod:`rollingtop.contact.parallel`); tools that need a unique flow there (the tangent
         dynamics of :mod:`rollingtop.chaos`) stop before it.
+    spin_directions : callable or None
+        ``spin_directions(gamma) -> {name: d}``: the constraints on the angular velocity alone,
+        ``(w, d) = 0`` (rubber rolling: no spin about the normal, ``d = gamma``), each with its
+        name as an error message quotes it; written so that it serves NumPy arrays and sympy
+        matrices alike (the symbolic layer adds these constraints to the contact rows). An initial
+        ``omega`` that violates one is refused (:func:`rollingtop.dynamics.state.initial_state`),
+        not projected. ``None``: the angular velocity is free.
+    symbolic_omega : callable or None
+        ``symbolic_omega(gamma, tau, spin) -> w``: the angular velocity on the manifold of the
+        constraints :attr:`spin_directions`, in terms of the two sympy symbols ``spin`` and the
+        unit vector ``tau = e3 x gamma / s`` (the symbolic layer's parametrisation, rational in
+        ``gamma``); ``None`` with no such constraints.
     has_reduction : bool
         Whether the model's motions of a dynamically symmetric body reduce to one degree of
         freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
@@ -166,12 +178,26 @@ class ContactModel:
     vertical_eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
     carries_direction: bool = False
     determined_through_vertical: bool = True
+    spin_directions: Callable[[Any], dict[str, Any]] | None = None
+    symbolic_omega: Callable[[Any, Any, Any], Any] | None = None
     has_reduction: bool = False
     colour: str = "#7f7f7f"
 
     def integrals(self, symmetric: bool) -> tuple[str, ...]:
         """Names of the first integrals of this model for a (non-)symmetric body."""
         return self.integrals_symmetric if symmetric else self.integrals_general
+
+    @property
+    def has_vertical_spin(self) -> bool:
+        """Whether the body can spin about a vertical symmetry axis (a pole on the plane,
+        ``w = (0, 0, w3)``): no constraint of :attr:`spin_directions` has a vertical
+        component at ``gamma = e3``. Rubber rolling forbids that spin, ``(w, gamma) = w3 = 0``
+        there, so its vertical spins (:mod:`rollingtop.dynamics.stability`) do not exist."""
+        if self.spin_directions is None:
+            return True
+        e3 = np.array([0.0, 0.0, 1.0])
+        return all(float(np.asarray(d, dtype=float) @ e3) == 0.0
+                   for d in self.spin_directions(e3).values())  # fmt: skip
 
     @property
     def kernels(self) -> tuple[Kernel, ...]:

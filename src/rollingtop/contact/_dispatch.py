@@ -9,13 +9,14 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 - 3: ``smooth``
 - 4: ``rough``
 - 5: ``parallel``
+- 6: ``rubber``
 """
 
 from __future__ import annotations
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.contact import _rows, meridian, parallel, rough, smooth
+from rollingtop.contact import _rows, meridian, parallel, rough, rubber, smooth
 
 
 @kernel
@@ -35,6 +36,8 @@ def rows(
         return rough.rows(p, y, J, bias, dirs, 0)
     if code == 5:
         return parallel.rows(p, y, J, bias, dirs, 0)
+    if code == 6:
+        return rubber.rows(p, y, J, bias, dirs, 0)
     return -1
 
 
@@ -54,6 +57,8 @@ def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace
         return rough.accel(p, y, dy, ws, 0)
     if code == 5:
         return parallel.accel(p, y, dy, ws, 0)
+    if code == 6:
+        return rubber.accel(p, y, dy, ws, 0)
     return -1
 
 
@@ -77,6 +82,9 @@ def project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool:
         return True
     if code == 5:
         parallel.project_velocity(p, y, 0)
+        return True
+    if code == 6:
+        rubber.project_velocity(p, y, 0)
         return True
     return False
 

@@ -1,8 +1,11 @@
 """Stability of vertical spins, for every contact model (issue 14, section 2).
 
 A vertical spin -- a pole on the plane, the symmetry axis vertical, spin ``w3`` about it, the
-centre of mass at rest -- is a steady motion of every model: the contact velocity
-``v + w x r`` vanishes because ``r`` and ``w`` are both vertical, and no force has a torque. In
+centre of mass at rest -- is a steady motion of every model that allows the spin: the contact
+velocity ``v + w x r`` vanishes because ``r`` and ``w`` are both vertical, and no force has a
+torque. Rubber rolling forbids it (``(w, gamma) = w3 = 0`` there,
+:attr:`~rollingtop.contact.ContactModel.has_vertical_spin`): it is refused with a
+:class:`StabilityError`, except the rest at a pole (``omega3 = 0``). In
 the body frame ``(v, w, gamma)`` is then constant, and for a model whose equations are regular at
 the vertical these nine variables obey a closed system (they do not involve the frame's other
 vectors or the position). Its linearisation on the constraint manifold -- ``|gamma| = 1`` and the
@@ -96,6 +99,19 @@ def _generic_eigenvalues(
     return out
 
 
+def _require_vertical_spin(model: ContactModel) -> None:
+    """Refuse a model that forbids the spin about a vertical axis
+    (:attr:`~rollingtop.contact.ContactModel.has_vertical_spin`)."""
+    spins = model.spin_directions
+    if spins is not None and not model.has_vertical_spin:
+        names = ", ".join(spins(np.array([0.0, 0.0, 1.0])))
+        raise StabilityError(
+            f"model {model.name!r} has no vertical spin: its constraint {names} forbids a spin "
+            "about the vertical axis (w3 = 0 with the axis vertical); only the rest at a pole "
+            "(omega3 = 0) is an equilibrium"
+        )
+
+
 def vertical_spin_eigenvalues(
     body: SphericalTop, model: str | ContactModel, omega3: float, pole: str = "south"
 ) -> ComplexArray:
@@ -117,12 +133,21 @@ def vertical_spin_eigenvalues(
         ``k`` is the dimension of the constraint manifold in ``(v, w, gamma)`` (the model's own
         linearisation for a model singular at the vertical). Linearly stable when every real part
         is zero (to :data:`UNSTABLE_TOLERANCE`).
+
+    Raises
+    ------
+    StabilityError
+        For ``omega3 != 0`` under a model that forbids the spin about the vertical
+        (:attr:`~rollingtop.contact.ContactModel.has_vertical_spin`: rubber rolling); its rest at
+        a pole, ``omega3 = 0``, is still linearised.
     """
     model = get_model(model)
     if pole not in POLES:
         raise StabilityError(f"pole = {pole!r} must be 'south' or 'north'")
     if not math.isfinite(omega3):
         raise StabilityError(f"omega3 = {omega3!r} must be finite")
+    if omega3 != 0.0:
+        _require_vertical_spin(model)
     if model.vertical_eigenvalues is not None:
         try:
             return model.vertical_eigenvalues(body, float(omega3), POLES[pole])
@@ -197,8 +222,15 @@ def vertical_spins(body: SphericalTop, model: str | ContactModel) -> list[Vertic
     -------
     list of VerticalSpin
         South, then north.
+
+    Raises
+    ------
+    StabilityError
+        Under a model that forbids the spin about the vertical
+        (:attr:`~rollingtop.contact.ContactModel.has_vertical_spin`).
     """
     model = get_model(model)
+    _require_vertical_spin(model)
     out = []
     for pole, sign in POLES.items():
         closed = None

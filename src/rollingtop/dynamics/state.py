@@ -88,6 +88,23 @@ def _start_code(body: SphericalTop, model: ContactModel, y: FloatArray) -> int:
     return model.code
 
 
+def _check_spin(model: ContactModel, gamma: FloatArray, omega: FloatArray) -> None:
+    """Refuse an ``omega`` that violates a constraint of the model on the angular velocity alone
+    (:attr:`ContactModel.spin_directions`, rubber rolling's ``(omega, gamma) = 0``): by more
+    than :data:`UNIT_TOLERANCE` times ``|omega|``. Within it the projection enforces it exactly;
+    beyond it the given ``omega`` is not the model's, and it is not silently changed."""
+    if model.spin_directions is None:
+        return
+    size = float(np.linalg.norm(omega))
+    for name, d in model.spin_directions(gamma).items():
+        res = float(omega @ np.asarray(d, dtype=float))
+        if abs(res) > UNIT_TOLERANCE * size:
+            raise InitialStateError(
+                f"omega = {omega.tolist()} violates the constraint {name} of model "
+                f"{model.name!r} (residual {res:.3g}, tolerance {UNIT_TOLERANCE:g} |omega|)"
+            )
+
+
 def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -> FloatArray:
     """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
     model = get_model(model)
@@ -129,8 +146,8 @@ def initial_state(
         Full body-frame CoM velocity; must satisfy every constraint of the model within 1e-9.
     free : mapping, optional
         The model's free velocity components (``meridian``: ``v_tau``; ``smooth``:
-        ``v_horizontal = (vx, vy)`` along the fixed axes; ``rough``: none). Missing ones are 0.
-        Exclusive with ``v``.
+        ``v_horizontal = (vx, vy)`` along the fixed axes; ``rough``, ``rubber``: none). Missing
+        ones are 0. Exclusive with ``v``.
 
     Returns
     -------
@@ -152,6 +169,12 @@ def initial_state(
     :func:`rollingtop.contact.meridian.select_variant` picks the pole variant that carries
     ``nu``.
     Other models: ``psi_nu = 0`` (unused).
+
+    **Spin constraints.** A model that constrains the angular velocity alone
+    (:attr:`~ContactModel.spin_directions`; rubber rolling: ``(omega, gamma) = 0``) refuses an
+    ``omega`` that violates it by more than :data:`UNIT_TOLERANCE` times ``|omega|``, with an
+    :class:`InitialStateError` naming the constraint and its residual; ``omega`` is not
+    projected onto it.
     """
     model = get_model(model)
     free = dict(free or {})
@@ -168,6 +191,7 @@ def initial_state(
     gamma = _vertical(model, gamma)
     if model.singular is not None and (why := model.singular(body, gamma)) is not None:
         raise InitialStateError(f"model {model.name!r}: {why}")
+    _check_spin(model, gamma, omega)
     alpha = default_alpha(gamma) if alpha is None else _horizontal(alpha, gamma)
     beta = np.cross(gamma, alpha)
     position = _vector("position", position, 2)

@@ -1,7 +1,7 @@
 """Symbolic layer (sympy): derivation of the equations and machine-checked claims.
 
 - :mod:`.equations`: the constrained equations derived from the Lagrangian (Poincare form,
-  multipliers eliminated) for ``meridian``, ``smooth`` and ``rough``, symmetric or general body.
+  multipliers eliminated) for every registered contact model, symmetric or general body.
 - :mod:`.claims`: first integrals, identities, the reduction (3.3) and the invariant measure,
   decided by exact simplification or exact evaluation at random rational points.
 - :mod:`.discover`: linear integrals of the reduced system from an ansatz (finds ``F6``).

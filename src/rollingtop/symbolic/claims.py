@@ -47,6 +47,9 @@ j = sp.Symbol("j", real=True)  # azimuth of the fixed x axis, rationally
 free = sp.symbols(
     f"c1:{1 + max(2, *(sum(m.free_velocity.values()) for m in MODELS.values()))}", real=True
 )
+#: the angular velocity's components on the manifold of a model that constrains it alone
+#: (:attr:`~rollingtop.contact.ContactModel.symbolic_omega`; rubber rolling: ``w`` horizontal)
+spin = sp.symbols("w_a w_b", real=True)
 
 
 @dataclass(frozen=True)
@@ -85,15 +88,18 @@ def _time_derivative(expr: Any, field: dict[Any, Any]) -> Any:
 
 def _manifold(model: str) -> dict[Any, Any]:
     """Rational parametrisation of the constraint manifold: substitutions for gamma, s, v,
-    alpha, beta in terms of ``q, k`` (gamma), the free components and ``w``."""
+    alpha, beta in terms of ``q, k`` (gamma), the free components and ``w``; and for ``w`` in
+    terms of :data:`spin` where the model constrains it (``symbolic_omega``)."""
     sq = 2 * q / (1 + q**2)
     cphi, sphi = (1 - k**2) / (1 + k**2), 2 * k / (1 + k**2)
     gamma = sp.Matrix([sq * cphi, sq * sphi, (1 - q**2) / (1 + q**2)])
     e3 = sp.Matrix([0, 0, 1])
     tau = e3.cross(gamma) / sq  # unit, rational
     r = -S.R * gamma - sp.Matrix([0, 0, S.a3])
-    wxr = S.w.cross(r)
-    v = get_model(model).symbolic_velocity(gamma, tau, wxr, free)
+    contact = get_model(model)
+    w = S.w if contact.symbolic_omega is None else contact.symbolic_omega(gamma, tau, spin)
+    wxr = w.cross(r)  # with the parametrised w: xreplace does not substitute into v's value
+    v = contact.symbolic_velocity(gamma, tau, wxr, free)
     nu = (e3 - gamma[2] * gamma) / sq  # unit, rational
     alpha = ((1 - j**2) * tau + 2 * j * nu) / (1 + j**2)  # generic horizontal unit vector
     beta = gamma.cross(alpha)
@@ -103,6 +109,8 @@ def _manifold(model: str) -> dict[Any, Any]:
         subs[S.v[i]] = v[i]
         subs[S.alpha[i]] = alpha[i]
         subs[S.beta[i]] = beta[i]
+        if contact.symbolic_omega is not None:
+            subs[S.w[i]] = w[i]
     return subs
 
 

@@ -9,7 +9,8 @@ d'Alembert-Lagrange (Poincare) equations with ideal constraint reactions are
     gamma' = gamma x w,
 
 where ``c_k(u, gamma) = (vp, d_k)`` are the model's constraints, linear in ``u``
-(``vp = v + w x r``).
+(``vp = v + w x r``), and those on the angular velocity alone, ``c = (w, d)`` (rubber rolling's
+``(w, gamma) = 0``: its reaction ``lambda dc/dw = lambda gamma`` is a torque).
 The multipliers are eliminated with the differentiated constraints
 ``dc_k/du . u' + dc_k/dgamma . gamma' = 0``: ``lambda = (J M^-1 J^T)^-1 (-b - J M^-1 F)`` with
 ``J = dc/du``, ``b = dc/dgamma . gamma'`` and ``M`` the kinetic Hessian. The meridian constraint
@@ -85,11 +86,16 @@ def _cross(a: Any, b: Any) -> Any:
 
 
 def constraints(model: str, S: Symbols = SYMBOLS) -> list[Any]:
-    """The model's constraints ``c_k(u, gamma) = (vp, d_k)``, linear in ``u``."""
+    """The model's constraints ``c_k(u, gamma) = (vp, d_k)``, then those on the angular velocity
+    alone, ``(w, d) = 0`` (:attr:`~rollingtop.contact.ContactModel.spin_directions`, rubber
+    rolling's ``(w, gamma) = 0``); all linear in ``u``."""
     r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
     vp = S.v + _cross(S.w, r)
-    dirs = get_model(model).symbolic_directions(sp, S.gamma)
-    return [sp.expand(vp.dot(d)) for d in dirs]
+    m = get_model(model)
+    out = [sp.expand(vp.dot(d)) for d in m.symbolic_directions(sp, S.gamma)]
+    if m.spin_directions is not None:
+        out += [sp.expand(S.w.dot(d)) for d in m.spin_directions(S.gamma).values()]
+    return out
 
 
 @dataclass(frozen=True)
@@ -106,7 +112,8 @@ class Derivation:
 
 @cache
 def derive(model: str, symmetric: bool = True) -> Derivation:
-    """Derive the constrained equations of ``model`` (``meridian``, ``smooth``, ``rough``).
+    """Derive the constrained equations of ``model`` (a name of
+    :data:`rollingtop.contact.MODELS`).
 
     With ``symmetric`` the body has ``I2 = I1``.
     """
