@@ -43,7 +43,8 @@ def main(client=None):
     ax.set_xlabel(r"initial $\gamma_3$ (axis tilt)")
     ax.set_ylabel(r"initial $\omega_3$")
     ax.set_title("companion model (parallel), paper's body: " r"$\omega = (2, -0.2, \omega_3)$, "
-                 r"$v_\nu = 0.1$; white: through the vertical", fontsize=9)  # fmt: skip
+                 r"$v_\nu = 0.1$" "\nwhite: the motion passes through the vertical before "
+                 r"$t = 1000$", fontsize=9)  # fmt: skip
     ax.legend(loc="lower left", fontsize=8)
     out = save_figure(fig, Path(__file__).with_name("megno_map.png"), dpi=150)
     finite = grid[np.isfinite(grid)]
