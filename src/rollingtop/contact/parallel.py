@@ -22,9 +22,10 @@ passage) the exact identity ``w_n = -K sigma`` gives
 
 where ``w_n'`` and ``sigma'`` depend on ``K`` through the reaction (the constraint row's bias
 contains ``tau'``). The numerator is affine in ``K`` and vanishes at ``K*``; near the pole
-``K - K* ~ C |sigma|^q`` (``q > 0``, measured ``~0.6`` on the paper's body), so every
-trajectory that approaches funnels into ``K*``: the motion loses its memory of ``C`` there,
-which is the local picture of the missing invariant measure. The reactions stay finite (the
+``K - K* ~ C |sigma|^q`` with ``q`` fixed by the state (measured 0.6 to 15 on first arrivals
+of random states), so where ``q > 0`` every trajectory that approaches funnels into ``K*``:
+the motion loses its memory of ``C`` there, which is the local picture of the missing invariant
+measure. The reactions stay finite (the
 reaction along ``tau`` tends to the value at which the numerator vanishes). *After* the pole the
 equations admit the whole family ``K - K* = C' |sigma|^q``: the motion is not determined by the
 state at the pole. Measured: at some poles ``q < 0`` (``K`` diverges integrably, the axis
@@ -81,8 +82,8 @@ if TYPE_CHECKING:
 BLEND_S = 1e-11
 #: Beyond this ``|sigma|`` the weight is 0 (and the pole rate is not computed).
 POLE_RATE_S = 1e-4
-#: Above this ``s`` the carried ``psi_nu`` is re-synchronised with the axis azimuth modulo ``pi``
-#: after every step (the carried direction's drift from the geometric one is then round-off).
+#: Above this ``s`` the carried ``psi_nu`` relaxes towards the axis azimuth modulo ``pi`` (at the
+#: rate :data:`RELAX`; below it the axis azimuth is too close to undefined to steer by).
 RESYNC_S = 0.05
 #: Rate (per unit time) at which the carried azimuth relaxes towards the axis azimuth modulo
 #: ``pi`` beyond ``RESYNC_S``; the offset it removes is round-off, or what a passage left.
