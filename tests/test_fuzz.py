@@ -198,14 +198,14 @@ def base_document(name: str) -> dict:
 
 
 def test_toml_writer_round_trips():
-    for name in ("paper", "smooth", "rough", "pole", "fig5"):
+    for name in ("paper", "smooth", "rough", "rubber", "pole", "fig5"):
         doc = base_document(name)
         assert tomllib.loads(toml_text(doc)) == doc
 
 
 # ---- strategies ---------------------------------------------------------------------------------
 
-EXAMPLE_NAMES = ("paper", "smooth", "rough", "pole", "fig5")
+EXAMPLE_NAMES = ("paper", "smooth", "rough", "rubber", "pole", "fig5")
 
 hostile_numbers = st.one_of(
     st.sampled_from(
@@ -287,8 +287,8 @@ def nudge(draw, doc: dict) -> None:
         ]))  # fmt: skip
         doc.setdefault("integration", {})[key] = draw(values)
     elif what == "model":
-        doc.setdefault("contact", {})["model"] = draw(st.sampled_from(["meridian", "smooth",
-                                                                       "rough"]))  # fmt: skip
+        models = ["meridian", "smooth", "rough", "rubber"]
+        doc.setdefault("contact", {})["model"] = draw(st.sampled_from(models))
     elif what == "free" and "initial" in doc:
         for key in ("v_tau", "v_horizontal"):
             doc["initial"].pop(key, None)
@@ -331,7 +331,9 @@ def mutated_document(draw) -> tuple[str, dict]:
             doc.pop(table, None)
         elif action == "model":
             doc.setdefault("contact", {})["model"] = draw(
-                st.one_of(st.sampled_from(["meridian", "smooth", "rough"]), hostile_values)
+                st.one_of(
+                    st.sampled_from(["meridian", "smooth", "rough", "rubber"]), hostile_values
+                )
             )
         else:
             doc[table][key] = {"nested": {"deeper": draw(hostile_values)}}
@@ -496,11 +498,12 @@ option_numbers = st.one_of(
 
 @fuzz(80)
 @given(
-    example=st.sampled_from(["paper", "smooth", "rough", "pole"]),
+    example=st.sampled_from(["paper", "smooth", "rough", "rubber", "pole"]),
     options=st.dictionaries(
         st.sampled_from(["--t-end", "--rtol", "--atol", "--samples", "--model"]),
         st.one_of(
-            option_numbers, st.sampled_from(["meridian", "smooth", "rough", "ice", "z" * 5000])
+            option_numbers,
+            st.sampled_from(["meridian", "smooth", "rough", "rubber", "ice", "z" * 5000]),
         ),
         max_size=3,
     ),
@@ -568,7 +571,7 @@ grid_specs = st.one_of(
 
 @fuzz(50)
 @given(
-    example=st.sampled_from(["paper", "smooth", "rough"]),
+    example=st.sampled_from(["paper", "smooth", "rough", "rubber"]),
     grid=grid_specs,
     samples=st.sampled_from([None, "2", "5", "1", "10000000000", "x", "1e10"]),
     threads=st.sampled_from([None, "1", "2", "64", "0", "-3", "9" * 30]),
@@ -637,7 +640,7 @@ def csv_tables(draw) -> bytes:
 
 @pytest.mark.slow
 @fuzz(60)
-@given(example=st.sampled_from(["paper", "smooth", "rough", "pole"]), table=csv_tables())
+@given(example=st.sampled_from(["paper", "smooth", "rough", "rubber", "pole"]), table=csv_tables())
 def test_fuzz_ensemble_tables(example, table):
     with workdir() as folder:
         csv = folder / "ic.csv"

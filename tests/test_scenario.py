@@ -19,7 +19,7 @@ from rollingtop.scenario import DEFAULTS
 from .conftest import EXAMPLES, scenario_text
 
 
-@pytest.mark.parametrize("name", ["paper", "smooth", "rough"])
+@pytest.mark.parametrize("name", ["paper", "smooth", "rough", "rubber"])
 def test_examples_load(name):
     sc = load_scenario(EXAMPLES / f"{name}.toml")
     assert sc.model.name == {"paper": "meridian"}.get(name, name)

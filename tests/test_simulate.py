@@ -22,7 +22,7 @@ from .conftest import EXAMPLES, FREE, GAMMA0, OMEGA0
 OPTIONS = IntegrationOptions(t_end=1.0, rtol=1e-11, samples=11)
 
 
-@pytest.mark.parametrize("example", ["paper", "smooth", "rough"])
+@pytest.mark.parametrize("example", ["paper", "smooth", "rough", "rubber"])
 def test_body_model_state_options_match_the_scenario(example):
     """simulate(body, model, state, options) runs exactly what simulate(scenario) runs."""
     sc = load_scenario(EXAMPLES / f"{example}.toml")
