@@ -154,7 +154,7 @@ class Trajectory(NetCDFOutput):
     @functools.cached_property
     def integrals(self) -> dict[str, FloatArray]:
         """First integrals of the model and body along the samples, each shape (n,)."""
-        names = self.model.integrals(self.body.symmetric)
+        names = self.model.integrals_for(self.body)
         return evaluate(self.body, self.y, names, pole=self.pole_case)
 
     @functools.cached_property

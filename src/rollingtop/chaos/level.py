@@ -62,7 +62,7 @@ def held_integrals(
     """The integrals held on the level: ``hold`` (checked against the model's), else all of the
     model's for this body; the energy is always held."""
     model = get_model(model)
-    own = model.integrals(body.symmetric)
+    own = model.integrals_for(body)
     if hold is None:
         return tuple(own)
     names = tuple(dict.fromkeys(["energy", *hold]))

@@ -131,7 +131,7 @@ class ChaosIndicators(NetCDFOutput):
 
     def integral_drift(self) -> dict[str, float]:
         """Largest ``|I(t) - I(0)|`` over the samples of each integral of the model."""
-        names = self.model.integrals(self.body.symmetric)
+        names = self.model.integrals_for(self.body)
         pole = self.model.kernel(self.body, self.initial).variant
         start = evaluate(self.body, self.initial, names, pole=pole)
         along = evaluate(self.body, self.states, names, pole=pole)

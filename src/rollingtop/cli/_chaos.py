@@ -4,6 +4,7 @@ MEGNO), for the scenario's body, model and initial state."""
 from __future__ import annotations
 
 import json
+import math
 
 import click
 
@@ -42,6 +43,9 @@ def _hold(value: str | None) -> list[str] | None:
                    "model's; the energy always).")  # fmt: skip
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the sampling.")
 @click.option("--netcdf", type=click.Path(), default=None, help="Also write the crossings: OUT.nc.")
+@click.option("--t-max", type=click.FloatRange(min=0.0, min_open=True), default=None,
+              help="Stop each trajectory at this time even with fewer crossings (motions that "
+                   "settle, e.g. onto a steady spin, cross no more).")  # fmt: skip
 @rtol_option
 @atol_option
 @json_option
@@ -53,6 +57,7 @@ def section(
     hold: str | None,
     seed: int,
     netcdf: str | None,
+    t_max: float | None,
     rtol: float | None,
     atol: float | None,
     as_json: bool,
@@ -75,6 +80,7 @@ def section(
             show(f"{trajectories} trajectories x {crossings} crossings")
         ds = poincare_section(sc.body, sc.model, y0, crossings=crossings,
                               trajectories=trajectories, hold=_hold(hold), seed=seed,
+                              t_max=math.inf if t_max is None else t_max,
                               rtol=sc.integration.rtol,
                               atol=sc.integration.resolved_atol)  # fmt: skip
     from rollingtop.plot.section import section_figure

@@ -158,6 +158,15 @@ class ContactModel:
         portraits and absolute-motion quadratures apply.
     colour : str
         Matplotlib colour of the model in figures that compare models.
+    particular_integrals : callable or None
+        ``particular_integrals(body) -> names``: integrals (keys of
+        :data:`rollingtop.dynamics.integrals.INTEGRALS`) the model gains for particular bodies
+        (``parallel``: the slip along ``nu`` when ``a3 = 0`` and ``I3 = I1``); see
+        :meth:`integrals_for`.
+    symbolic_claims : str or None
+        ``"module:function"`` of the symbolic layer returning further claims for
+        :func:`rollingtop.symbolic.verify` (a reduced system, particular cases); imported only
+        there, so the model itself never imports sympy.
     """
 
     name: str
@@ -182,10 +191,20 @@ class ContactModel:
     symbolic_omega: Callable[[Any, Any, Any], Any] | None = None
     has_reduction: bool = False
     colour: str = "#7f7f7f"
+    particular_integrals: Callable[[SphericalTop], tuple[str, ...]] | None = None
+    symbolic_claims: str | None = None
 
     def integrals(self, symmetric: bool) -> tuple[str, ...]:
         """Names of the first integrals of this model for a (non-)symmetric body."""
         return self.integrals_symmetric if symmetric else self.integrals_general
+
+    def integrals_for(self, body: SphericalTop) -> tuple[str, ...]:
+        """Names of the first integrals of this model for ``body``: those of
+        :meth:`integrals`, then those it gains for this particular body, if any."""
+        own = self.integrals(body.symmetric)
+        if self.particular_integrals is None:
+            return own
+        return own + tuple(n for n in self.particular_integrals(body) if n not in own)
 
     @property
     def has_vertical_spin(self) -> bool:

@@ -291,6 +291,20 @@ def _vertical_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> Compl
     )
 
 
+#: Relative tolerance of the particular case ``a3 = 0, I1 = I2 = I3`` (:func:`_particular`).
+PARTICULAR_RTOL = 1e-12
+
+
+def _particular(body: SphericalTop) -> tuple[str, ...]:
+    """The slip along ``nu`` is an integral when the centre of mass is at the geometric centre
+    and the ellipsoid of inertia is a sphere (``a3 = 0``, ``I1 = I2 = I3``; proved by
+    :mod:`rollingtop.symbolic.parallel`, where the ansatz search finds this case)."""
+    I1, I2, I3 = body.inertia
+    spherical = abs(I2 - I1) <= PARTICULAR_RTOL * I1 and abs(I3 - I1) <= PARTICULAR_RTOL * I1
+    balanced = abs(body.a3) <= PARTICULAR_RTOL * body.R
+    return ("slip_nu",) if spherical and balanced else ()
+
+
 MODEL = ContactModel(
     name="parallel",
     description="contact kept, no slip across the horizontal projection of the axis "
@@ -307,4 +321,6 @@ MODEL = ContactModel(
     carries_direction=True,
     determined_through_vertical=False,
     colour="#9467bd",
+    particular_integrals=_particular,
+    symbolic_claims="rollingtop.symbolic.parallel:claims",
 )

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
-from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, V, W
+from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 
 __all__ = ["INTEGRALS", "F6_reduced", "evaluate"]
 
@@ -165,9 +165,28 @@ def routh(body: SphericalTop, Y: FloatArray) -> FloatArray:
     return routh_
 
 
+def slip_nu(body: SphericalTop, Y: FloatArray) -> FloatArray:
+    """The contact point's slip along the carried direction ``nu``: ``(v_P, nu)``.
+
+    An integral of the ``parallel`` model when ``a3 = 0`` and ``I3 = I1``
+    (:mod:`rollingtop.symbolic.parallel`). That model keeps ``v_P`` along ``nu``, whose sign
+    flips with the axis's horizontal projection at a pole passage; the value is therefore
+    ``|v_P|`` with the sign of ``(v_P, nu_c)``, ``nu_c = cos(psi_nu) alpha + sin(psi_nu) beta``
+    the direction the state carries continuously through the vertical
+    (:mod:`rollingtop.contact.parallel`).
+    """
+    vp = Y[..., V] + np.cross(Y[..., W], _arm(body, Y))
+    psi = Y[..., PSI_NU]
+    nu_c = np.cos(psi)[..., None] * Y[..., ALPHA] + np.sin(psi)[..., None] * Y[..., BETA]
+    sign = np.where(np.sum(vp * nu_c, axis=-1) < 0.0, -1.0, 1.0)
+    u: FloatArray = sign * np.sqrt(np.sum(vp * vp, axis=-1))
+    return u
+
+
 #: Every integral by name.
 INTEGRALS: dict[str, Integral] = {
-    f.__name__: f for f in (energy, lagrange, jellett, area, F6, momentum_x, momentum_y, routh)
+    f.__name__: f
+    for f in (energy, lagrange, jellett, area, F6, momentum_x, momentum_y, routh, slip_nu)
 }
 
 

@@ -18,6 +18,7 @@ Each result says which method decided it.
 
 from __future__ import annotations
 
+import importlib
 import random
 import time
 from collections.abc import Sequence
@@ -63,6 +64,9 @@ class Claim:
     expr: sp.Expr
     kind: str = "integral"
     symmetric: bool = True
+    #: parameter values of a particular case, ``((symbol, value), ...)``, substituted into the
+    #: expression to decide (after the time derivative)
+    params: tuple[tuple[Any, Any], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -118,11 +122,17 @@ def _random_rational(rng: random.Random, lo: int = -3, hi: int = 3) -> Any:
     return sp.Rational(Fraction(rng.randint(lo * 97, hi * 97), rng.randint(1, 97)))
 
 
-def decide(expr: Any, model: str, symmetric: bool = True, seed: int = 1) -> tuple[bool, str]:
+def decide(
+    expr: Any, model: str, symmetric: bool = True, seed: int = 1,
+    params: tuple[tuple[Any, Any], ...] = (),
+) -> tuple[bool, str]:  # fmt: skip
     """Does ``expr`` (a function of the state, ``s``, ``theta`` and the parameters) vanish on
-    the manifold of ``model``? Returns ``(holds, method)``."""
+    the manifold of ``model`` (with the parameter values ``params``, if any)? Returns
+    ``(holds, method)``."""
     subs = _manifold(model)
     on = sp.sympify(expr).xreplace(subs)
+    if params:  # after the manifold, whose velocities involve the parameters
+        on = on.xreplace(dict(params))
     if symmetric:
         on = on.xreplace({S.I2: S.I1})
     if sp.count_ops(on, visual=False) <= EXACT_OPS_LIMIT:
@@ -236,6 +246,10 @@ def claims_for(model: str) -> list[Claim]:
         for var, (expr, rhs) in _reduced_claims().items():
             out.append(Claim(f"reduced system (3.3): {var}' follows from the full equations",
                              model, (expr, rhs), "reduced"))  # fmt: skip
+    extra = get_model(model).symbolic_claims
+    if extra is not None:  # "module:function" of the symbolic layer (the model's own claims)
+        module, function = extra.split(":")
+        out.extend(getattr(importlib.import_module(module), function)())
     return out
 
 
@@ -250,7 +264,7 @@ def check(claim: Claim, seed: int = 1) -> ClaimResult:
         expr = _time_derivative(lhs, d.field) - rhs
     else:
         expr = claim.expr
-    holds, method = decide(expr, claim.model, claim.symmetric, seed=seed)
+    holds, method = decide(expr, claim.model, claim.symmetric, seed=seed, params=claim.params)
     return ClaimResult(claim.name, claim.model, "proved" if holds else "failed", method,
                        time.perf_counter() - start)  # fmt: skip
 
