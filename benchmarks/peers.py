@@ -84,7 +84,7 @@ BUF_SIZE = I_COUNT + 3
 def packed(p) -> np.ndarray:
     """The flat buffer: ``p``, the work arrays, the counters (zero)."""
     buf = np.zeros(BUF_SIZE)
-    buf[:N_P] = p
+    buf[:N_P] = p[:N_P]  # the single body's (meridian model)
     buf[I_LAST_T] = np.nan
     return buf
 

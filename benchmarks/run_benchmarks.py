@@ -45,7 +45,7 @@ def numpy_rhs_factory(p, model="meridian"):
     """A plain NumPy right-hand side of the meridian model (MODEL.md, "Dynamics"): the full
     (v', w', lambda) linear system solved with numpy.linalg.solve -- what a careful user would
     write without rollingtop."""
-    R, m, g, a3, I1, I2, I3 = p
+    R, m, g, a3, I1, I2, I3 = p[:7]
     Iv = np.array([I1, I2, I3])
     e3 = np.array([0.0, 0.0, 1.0])
     avec = np.array([0.0, 0.0, a3])

@@ -27,6 +27,8 @@ PARAMETERS = {
     "I1": "central moment of inertia about e1",
     "I2": "central moment of inertia about e2",
     "I3": "central moment of inertia about the symmetry axis e3",
+    "shell_mass": "mass of the spherical shell around the body (model shell-rotor)",
+    "shell_inertia": "moment of inertia of the shell about a diameter (model shell-rotor)",
 }
 
 
@@ -53,6 +55,11 @@ class SphericalTop:
     I2 : float, optional
         Central moment about ``e2``; defaults to ``I1`` (dynamically symmetric body, the case of
         the paper). The triangle inequalities of a rigid body must hold.
+    shell_mass, shell_inertia : float, optional
+        Mass of a spherical shell of radius ``R`` around the body and its moment of inertia
+        about a diameter (a thin shell: ``2/3 shell_mass R^2``), ``>= 0``, default 0: the
+        ``shell-rotor`` model (:mod:`rollingtop.contact.shell_rotor`), where the body is the
+        rotor inside the shell. Other models ignore them.
 
     Raises
     ------
@@ -72,11 +79,13 @@ class SphericalTop:
     I1: float
     I3: float
     I2: float | None = field(default=None)
+    shell_mass: float = 0.0
+    shell_inertia: float = 0.0
 
     def __post_init__(self) -> None:
         problems = []
         values = {}
-        for name in ("R", "m", "g", "a3", "I1", "I3", "I2"):
+        for name in ("R", "m", "g", "a3", "I1", "I3", "I2", "shell_mass", "shell_inertia"):
             x = getattr(self, name)
             if name == "I2" and x is None:
                 continue
@@ -91,8 +100,9 @@ class SphericalTop:
         for name in ("R", "m", "I1", "I2", "I3"):
             if name in values and values[name] <= 0:
                 problems.append(f"{name} = {values[name]:g} must be > 0 ({PARAMETERS[name]})")
-        if "g" in values and values["g"] < 0:
-            problems.append(f"g = {values['g']:g} must be >= 0")
+        for name in ("g", "shell_mass", "shell_inertia"):
+            if name in values and values[name] < 0:
+                problems.append(f"{name} = {values[name]:g} must be >= 0")
         if all(k in values and values[k] > 0 for k in ("I1", "I2", "I3")):
             i1, i2, i3 = values["I1"], values["I2"], values["I3"]
             for name, lhs, a, b, rest in (
@@ -125,9 +135,16 @@ class SphericalTop:
         return np.array([self.I1, self.I2, self.I3])
 
     @property
+    def has_shell(self) -> bool:
+        """Whether a shell with mass or inertia surrounds the body (``shell-rotor``)."""
+        return self.shell_mass > 0.0 or self.shell_inertia > 0.0
+
+    @property
     def params(self) -> NDArray[np.float64]:
-        """Parameters ``(R, m, g, a3, I1, I2, I3)`` for the compiled kernels, shape (7,)."""
-        return np.array([self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3], dtype=float)
+        """Parameters ``(R, m, g, a3, I1, I2, I3, shell_mass, shell_inertia)`` for the compiled
+        kernels, shape (9,)."""
+        return np.array([self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3,
+                         self.shell_mass, self.shell_inertia], dtype=float)  # fmt: skip
 
     @overload
     def rho(self, gamma3: float) -> float: ...
@@ -141,5 +158,8 @@ class SphericalTop:
         )
 
     def to_dict(self) -> dict[str, float]:
-        """Parameters as a plain dictionary (``I2`` included)."""
-        return {k: float(getattr(self, k)) for k in ("R", "m", "g", "a3", "I1", "I2", "I3")}
+        """Parameters as a plain dictionary (``I2`` included; the shell's where there is one)."""
+        keys: tuple[str, ...] = ("R", "m", "g", "a3", "I1", "I2", "I3")
+        if self.has_shell:
+            keys += ("shell_mass", "shell_inertia")
+        return {k: float(getattr(self, k)) for k in keys}

@@ -5,6 +5,9 @@ A scenario names a body, a contact model, initial conditions and integration opt
     [body]        R, m, g, a3, I1, I3, optional I2
     [contact]     model = the name of a registered contact model (rollingtop.contact.MODELS;
                   default DEFAULT_MODEL)
+    [shell]       mass, inertia: the spherical shell around the body, for a model with its
+                  own inertia (ContactModel.own_inertia: shell-rotor, where it is required;
+                  other models refuse it)
     [initial]     gamma, omega, optional alpha, position, and the model's free velocity
                   components (ContactModel.free_velocity) or a full v
     [integration] t_end, rtol, atol, samples, max_steps            (defaults: DEFAULTS)
@@ -166,6 +169,10 @@ class Scenario:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "model", get_model(self.model))
+        try:
+            object.__setattr__(self, "body", self.model.body_for(self.body))
+        except ValueError as err:
+            raise ScenarioError(str(err)) from None
         y0 = None
         spec = self.level
         if self.initial is not None:
@@ -245,7 +252,7 @@ class Scenario:
     def from_dict(cls, data: Mapping[str, Any], source: str | None = None) -> Scenario:
         """Build from the parsed TOML structure (see the module docstring): check every
         table and key, then build the typed objects."""
-        allowed_tables = ("body", "contact", "initial", "integration", "level")
+        allowed_tables = ("body", "contact", "shell", "initial", "integration", "level")
         for key, value in data.items():
             if key not in allowed_tables:
                 raise ScenarioError(
@@ -269,6 +276,7 @@ class Scenario:
         contact_t = data.get("contact", {})
         _reject_unknown("contact", contact_t, ("model",))
         model = get_model(check_model_name("contact.model", contact_t.get("model", DEFAULT_MODEL)))
+        body = _with_shell(body, model, data.get("shell"))
 
         level: LevelSpec | None = None
         if "level" in data:
@@ -311,6 +319,27 @@ class Scenario:
             free={k: init_t[k] for k in free_keys if k in init_t},
         )
         return cls(body, model, initial, integration, source, level)
+
+
+def _with_shell(body: SphericalTop, model: ContactModel, shell: object) -> SphericalTop:
+    """``body`` with the ``[shell]`` table's mass and inertia; required exactly by the models
+    with their own inertia."""
+    if shell is None:
+        if model.own_inertia:
+            raise ScenarioError(f"model {model.name!r} needs a table [shell] (mass, inertia)")
+        return body
+    if not model.own_inertia:
+        own = [name for name, m in MODELS.items() if m.own_inertia]
+        raise ScenarioError(
+            f"[shell] is for model {' or '.join(map(repr, own))}, not {model.name!r}"
+        )
+    assert isinstance(shell, Mapping)
+    _reject_unknown("shell", shell, ("mass", "inertia"))
+    missing = [k for k in ("mass", "inertia") if k not in shell]
+    if missing:
+        raise ScenarioError(f"[shell] is missing {', '.join(missing)}")
+    return replace(body, shell_mass=number("shell", "mass", shell["mass"]),
+                   shell_inertia=number("shell", "inertia", shell["inertia"]))  # fmt: skip
 
 
 def _reject_unknown(table: str, values: Mapping[str, object], allowed: tuple[str, ...]) -> None:

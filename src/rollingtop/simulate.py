@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._errors import ContactLostWarning, InitialStateError
 from rollingtop.body import SphericalTop
-from rollingtop.contact import MODELS, ContactModel, get_model
+from rollingtop.contact import ContactModel, get_model, models_for
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.start import InitialConditions
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals, project_state
@@ -193,6 +193,10 @@ def simulate(
         if model is None or state is None:
             raise TypeError("simulate(body, model, state): a body needs a model and a state")
         contact = _model(model)
+        try:
+            source = contact.body_for(source)
+        except ValueError as err:
+            raise InitialStateError(str(err)) from None
         y0 = _given_state(source, contact, state)
         opts = options if options is not None else IntegrationOptions()
         opts = replace(opts, **given) if given else opts
@@ -284,7 +288,8 @@ def simulate_models(
     ----------
     scenario : Scenario or path
     models : iterable of ContactModel or str, optional
-        Default: every registered model (:data:`rollingtop.contact.MODELS`), in its order.
+        Default: every registered model (:data:`rollingtop.contact.MODELS`), in its order,
+        that takes the scenario's body (``shell-rotor`` only with a shell).
     t_end, rtol, atol, samples, max_steps : optional
         Replace the scenario's integration options (as in :func:`simulate`).
     progress : callable, optional
@@ -299,7 +304,7 @@ def simulate_models(
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     scenario.require_state()
-    chosen = [get_model(m) for m in (MODELS.values() if models is None else models)]
+    chosen = [get_model(m) for m in (models_for(scenario.body) if models is None else models)]
     runs = {}
     for model in chosen:
         report = None if progress is None else _tagged(progress, model.name)

@@ -152,6 +152,16 @@ class Trajectory(NetCDFOutput):
 
     # ---- measured quantities ----------------------------------------------------------------
     @functools.cached_property
+    def model_outputs(self) -> dict[str, FloatArray]:
+        """The model's further per-sample quantities
+        (:attr:`~rollingtop.contact.ContactModel.state_outputs`; ``shell-rotor``:
+        ``shell_omega`` and ``bearing_torque``, shape (n, 3), body frame); empty for the
+        others."""
+        if self.model.state_outputs is None:
+            return {}
+        return self.model.state_outputs(self.body, self.y)
+
+    @functools.cached_property
     def integrals(self) -> dict[str, FloatArray]:
         """First integrals of the model and body along the samples, each shape (n,)."""
         names = self.model.integrals_for(self.body)
@@ -220,6 +230,8 @@ class Trajectory(NetCDFOutput):
             "position": last[POSITION].tolist(),
             "contact_point": self.contact_point[-1].tolist(),
         }
+        for name, values in self.model_outputs.items():
+            final[name] = values[-1].tolist()
         integrals = {}
         for name, values in self.integrals.items():
             drift = float(np.max(np.abs(values - values[0])))
@@ -304,6 +316,8 @@ class Trajectory(NetCDFOutput):
         }
         for name, values in self.integrals.items():
             data[name] = ("t", values)
+        for name, values in self.model_outputs.items():
+            data[name] = (("t", "component"), values)
         ds = xr.Dataset(
             data,
             coords={

@@ -66,7 +66,9 @@ def rhs(model, p, y):
     Only the 17 physical components are used and returned (the package's 18th, the carried
     azimuth of ``nu``, is a device of its pole handling and stays constant here).
     """
-    R, m, g, a3, I1, I2, I3 = p
+    if model == "shell-rotor":
+        return shell_rotor_rhs(p, y)
+    R, m, g, a3, I1, I2, I3 = p[:7]
     Iv = np.array([I1, I2, I3])
     v, w = y[0:3], y[3:6]
     alpha, beta, gamma = y[6:9], y[9:12], y[12:15]
@@ -105,6 +107,72 @@ def rhs(model, p, y):
     dy[15] = v @ alpha
     dy[16] = v @ beta
     return dy, force
+
+
+def _cross_matrix(a):
+    """``[a]x``: ``[a]x b = a x b``."""
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def shell_rotor_rhs(p, y):
+    """The shell-with-rotor pair by Newton-Euler for each body (not the package's Lagrangian
+    formulation): ``y'`` (with the shell's relative spin ``delta = y[17]`` and its rate) and the
+    contact force on the shell.
+
+    Rotor (the body: mass ``m``, inertia ``I`` about its centre of mass ``C``) and shell (mass
+    ``ms``, inertia ``Js`` about any diameter, centre ``O = C - a3 e3``), in the rotor's frame
+    (angular velocity ``w``); the shell turns with ``Omega = w + delta e3``. Unknowns:
+    ``v', w', delta'``, the contact force ``lambda`` at the contact point, the bearing force
+    ``Fb`` of the shell on the rotor and its torque ``tau_b`` about ``C``, perpendicular to
+    ``e3`` (frictionless bearing): 15 unknowns, 15 equations (the rotor's and the shell's
+    momentum and angular momentum, the derivative of the rolling condition
+    ``v - a3 w x e3 - R Omega x gamma = 0``).
+    """
+    R, m, g, a3, I1, I2, I3, ms, Js = p
+    v, w, gamma, d = y[0:3], y[3:6], y[12:15], y[17]
+    a = a3 * E3
+    inertia = np.diag([I1, I2, I3])
+    omega = w + d * E3
+    vO = v - np.cross(w, a)
+    A = np.zeros((15, 15))
+    b = np.zeros(15)
+    iv, iw, idl, il, iF, it = 0, 3, 6, 7, 10, 13
+    e1, e2 = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    # rotor: m (v' + w x v) = -m g gamma + Fb;  I w' + w x I w = tau_b
+    A[0:3, iv : iv + 3] = m * np.eye(3)
+    A[0:3, iF : iF + 3] = -np.eye(3)
+    b[0:3] = -m * np.cross(w, v) - m * g * gamma
+    A[3:6, iw : iw + 3] = inertia
+    A[3:6, it], A[3:6, it + 1] = -e1, -e2
+    b[3:6] = -np.cross(w, inertia @ w)
+    # shell: ms (vO' + w x vO) = -ms g gamma + lambda - Fb, vO' = v' - w' x a
+    A[6:9, iv : iv + 3] = ms * np.eye(3)
+    A[6:9, iw : iw + 3] = ms * _cross_matrix(a)
+    A[6:9, il : il + 3] = -np.eye(3)
+    A[6:9, iF : iF + 3] = np.eye(3)
+    b[6:9] = -ms * np.cross(w, vO) - ms * g * gamma
+    # shell about O: Js (Omega' + w x Omega) = (-R gamma) x lambda - tau_b - a x Fb
+    A[9:12, iw : iw + 3] = Js * np.eye(3)
+    A[9:12, idl] = Js * E3
+    A[9:12, il : il + 3] = -_cross_matrix(-R * gamma)
+    A[9:12, it], A[9:12, it + 1] = e1, e2
+    A[9:12, iF : iF + 3] = _cross_matrix(a)
+    b[9:12] = -Js * np.cross(w, omega)
+    # rolling: v' - a3 w' x e3 - R Omega' x gamma - R Omega x gamma' = 0
+    A[12:15, iv : iv + 3] = np.eye(3)
+    A[12:15, iw : iw + 3] = a3 * _cross_matrix(E3) + R * _cross_matrix(gamma)
+    A[12:15, idl] = R * np.cross(gamma, E3)
+    b[12:15] = R * np.cross(omega, np.cross(gamma, w))
+    x = np.linalg.solve(A, b)
+    dy = np.zeros(len(y))
+    dy[0:6] = x[0:6]
+    dy[6:9] = np.cross(y[6:9], w)
+    dy[9:12] = np.cross(y[9:12], w)
+    dy[12:15] = np.cross(gamma, w)
+    dy[15] = v @ y[6:9]
+    dy[16] = v @ y[9:12]
+    dy[17] = x[idl]
+    return dy, x[il : il + 3]
 
 
 def reactions(model, p, y):

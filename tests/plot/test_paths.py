@@ -41,7 +41,7 @@ def xy(ln):
 
 def energy(p, Y):
     """``m |v|^2 / 2 + (w, I w) / 2 + m g z``, the CoM at height ``z = R + a3 gamma3``."""
-    R, m, g, a3, I1, I2, I3 = p
+    R, m, g, a3, I1, I2, I3 = p[:7]
     v, w = Y[:, 0:3], Y[:, 3:6]
     kinetic = 0.5 * m * np.sum(v * v, axis=1) + 0.5 * (w**2 @ np.array([I1, I2, I3]))
     return kinetic + m * g * (R + a3 * Y[:, 14])

@@ -84,10 +84,10 @@ def plot(scenario: str, output: str, t_end: float | None) -> None:
 def run_models(sc: Scenario) -> dict[str, Trajectory]:
     """:func:`rollingtop.simulate_models` of ``sc`` under every registered model, with one
     progress bar per model on a terminal and the runs' warnings as lines."""
-    from rollingtop.contact import MODELS
+    from rollingtop.contact import models_for
     from rollingtop.simulate import simulate_models
 
-    models = tuple(MODELS.values())
+    models = models_for(sc.body)
     bar = _output.progress_bar("integrating {task.description}")
     if bar is None:
         return _output.with_warnings_reported(lambda: simulate_models(sc, models))

@@ -22,10 +22,14 @@ model battery (``tests/contact/test_models.py``) then runs for it.
 from __future__ import annotations
 
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 from rollingtop._errors import ContactModelError
-from rollingtop.contact import meridian, parallel, rough, rubber, smooth
+from rollingtop.contact import meridian, parallel, rough, rubber, shell_rotor, smooth
 from rollingtop.contact._base import ContactModel, Kernel
+
+if TYPE_CHECKING:
+    from rollingtop.body import SphericalTop
 
 #: The registry: the model modules, one line each. Kernel codes follow this order (each model's
 #: own kernel, then its variants), so a new model goes at the end.
@@ -35,6 +39,7 @@ MODULES: tuple[ModuleType, ...] = (
     rough,
     parallel,
     rubber,
+    shell_rotor,
 )
 
 MODELS: dict[str, ContactModel] = {m.MODEL.name: m.MODEL for m in MODULES}
@@ -52,7 +57,14 @@ def _kernels() -> tuple[Kernel, ...]:
 #: Every compiled kernel, indexed by its code.
 KERNELS: tuple[Kernel, ...] = _kernels()
 
+
+def models_for(body: SphericalTop) -> tuple[ContactModel, ...]:
+    """The registered models, in order, that take ``body``: a model with its own inertia
+    (:attr:`ContactModel.own_inertia`, ``shell-rotor``) only with a shell."""
+    return tuple(m for m in MODELS.values() if body.has_shell or not m.own_inertia)
+
 __all__ = [
+    "models_for",
     "DEFAULT_MODEL",
     "KERNELS",
     "MODELS",

@@ -163,6 +163,19 @@ class ContactModel:
         :data:`rollingtop.dynamics.integrals.INTEGRALS`) the model gains for particular bodies
         (``parallel``: the slip along ``nu`` when ``a3 = 0`` and ``I3 = I1``); see
         :meth:`integrals_for`.
+    own_inertia : bool
+        Whether the model's kinetic energy is more than the body's own (the ``shell-rotor``
+        pair): the general row path of the dynamics (mass matrix ``diag(m, m, m, I)``) does
+        not apply, the model's closed forms are the equations, and the state's last slot is
+        the model's own velocity (:attr:`slot_value`).
+    slot_value : callable or None
+        ``slot_value(body, y) -> float``: the state's last slot for a new state whose ``v``,
+        ``w`` and frame are set (:func:`rollingtop.initial_state`), for a model that keeps a
+        variable of its own there (``shell-rotor``: the shell's relative spin).
+    state_outputs : callable or None
+        ``state_outputs(body, Y) -> {name: array (n, 3)}``: further per-sample quantities of
+        the model's states ``Y`` (n, 18) for the outputs (``shell-rotor``: the shell's angular
+        velocity and the bearing's reaction torque), body frame.
     symbolic_claims : str or None
         ``"module:function"`` of the symbolic layer returning further claims for
         :func:`rollingtop.symbolic.verify` (a reduced system, particular cases); imported only
@@ -193,10 +206,30 @@ class ContactModel:
     colour: str = "#7f7f7f"
     particular_integrals: Callable[[SphericalTop], tuple[str, ...]] | None = None
     symbolic_claims: str | None = None
+    own_inertia: bool = False
+    state_outputs: Callable[[SphericalTop, FloatArray], dict[str, FloatArray]] | None = None
+    slot_value: Callable[[SphericalTop, FloatArray], float] | None = None
 
     def integrals(self, symmetric: bool) -> tuple[str, ...]:
         """Names of the first integrals of this model for a (non-)symmetric body."""
         return self.integrals_symmetric if symmetric else self.integrals_general
+
+    def body_for(self, body: SphericalTop) -> SphericalTop:
+        """``body`` as this model takes it: a model with its own inertia needs a shell
+        (``ValueError`` otherwise: without one the pair is the meridian model, singular at the
+        vertical); the other models drop a shell (they do not carry it)."""
+        if self.own_inertia:
+            if not body.has_shell:
+                raise ValueError(
+                    f"model {self.name!r} needs a shell around the body (shell_mass, "
+                    "shell_inertia; scenario table [shell])"
+                )
+            return body
+        if body.has_shell:
+            from dataclasses import replace
+
+            return replace(body, shell_mass=0.0, shell_inertia=0.0)
+        return body
 
     def integrals_for(self, body: SphericalTop) -> tuple[str, ...]:
         """Names of the first integrals of this model for ``body``: those of

@@ -10,13 +10,14 @@ Written by ``python -m rollingtop.contact._codegen`` from the registry
 - 4: ``rough``
 - 5: ``parallel``
 - 6: ``rubber``
+- 7: ``shell-rotor``
 """
 
 from __future__ import annotations
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.contact import _rows, meridian, parallel, rough, rubber, smooth
+from rollingtop.contact import _rows, meridian, parallel, rough, rubber, shell_rotor, smooth
 
 
 @kernel
@@ -38,6 +39,8 @@ def rows(
         return parallel.rows(p, y, J, bias, dirs, 0)
     if code == 6:
         return rubber.rows(p, y, J, bias, dirs, 0)
+    if code == 7:
+        return shell_rotor.rows(p, y, J, bias, dirs, 0)
     return -1
 
 
@@ -59,6 +62,8 @@ def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace
         return parallel.accel(p, y, dy, ws, 0)
     if code == 6:
         return rubber.accel(p, y, dy, ws, 0)
+    if code == 7:
+        return shell_rotor.accel(p, y, dy, ws, 0)
     return -1
 
 
@@ -86,6 +91,9 @@ def project_velocity(code: int, p: FloatArray, y: FloatArray) -> bool:
     if code == 6:
         rubber.project_velocity(p, y, 0)
         return True
+    if code == 7:
+        shell_rotor.project_velocity(p, y, 0)
+        return True
     return False
 
 
@@ -100,6 +108,8 @@ def direction_rate(code: int, p: FloatArray, y: FloatArray) -> float:
         return meridian.direction_rate(p, y, 2)
     if code == 5:
         return parallel.direction_rate(p, y, 0)
+    if code == 7:
+        return shell_rotor.direction_rate(p, y, 0)
     return _rows.direction_rate(p, y, 0)
 
 
@@ -117,6 +127,9 @@ def sync_direction(code: int, y: FloatArray) -> None:
         return
     if code == 5:
         parallel.sync_direction(y, 0)
+        return
+    if code == 7:
+        shell_rotor.sync_direction(y, 0)
         return
     _rows.sync_direction(y, 0)
 

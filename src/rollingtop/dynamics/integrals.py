@@ -38,9 +38,21 @@ def _Iw(body: SphericalTop, Y: FloatArray) -> FloatArray:
 
 
 def energy(body: SphericalTop, Y: FloatArray) -> FloatArray:
-    """``E = m (v, v)/2 + (w, I w)/2 - m g (r, gamma)``; zero with the CoM on the plane."""
+    """``E = m (v, v)/2 + (w, I w)/2 - m g (r, gamma)``; zero with the CoM on the plane.
+
+    With a shell (:attr:`rollingtop.SphericalTop.has_shell`, model ``shell-rotor``) the pair's:
+    plus ``ms v_O^2/2 + Js |Omega|^2/2``, ``v_O = v - a3 w x e3``, ``Omega = w + delta e3``
+    with the shell's relative spin ``delta`` in the state's last slot
+    (:mod:`rollingtop.contact.shell_rotor`); the shell's centre stays at height ``R``.
+    """
     v, w, gamma = Y[..., V], Y[..., W], Y[..., GAMMA]
     kinetic = 0.5 * body.m * np.sum(v * v, axis=-1) + 0.5 * np.sum(w * _Iw(body, Y), axis=-1)
+    if body.has_shell:
+        o1 = v[..., 0] - body.a3 * w[..., 1]
+        o2 = v[..., 1] + body.a3 * w[..., 0]
+        spin = w[..., 2] + Y[..., PSI_NU]
+        kinetic = kinetic + 0.5 * body.shell_mass * (o1 * o1 + o2 * o2 + v[..., 2] ** 2)
+        kinetic = kinetic + 0.5 * body.shell_inertia * (w[..., 0] ** 2 + w[..., 1] ** 2 + spin**2)
     E: FloatArray = kinetic - body.m * body.g * np.sum(_arm(body, Y) * gamma, axis=-1)
     return E
 

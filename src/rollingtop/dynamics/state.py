@@ -236,6 +236,8 @@ def initial_state(
             else:
                 values[name] = _vector(name, raw, length)
         y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
+    if model.slot_value is not None:
+        y[17] = model.slot_value(body, y)
     call(_kernel.project, _start_code(body, model, y), body.params, y, call(_kernel.new_workspace))
     return y
 
@@ -263,5 +265,9 @@ def project_state(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -
         y[9:12] = np.cross(gamma, y[6:9])
     if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
         y[17] = model.vertical_direction(y[3:6], y[6:9], y[9:12], y[17])
-    call(_kernel.project, _start_code(body, model, y), body.params, y, call(_kernel.new_workspace))
+    ws = call(_kernel.new_workspace)
+    if model.slot_value is not None:  # the rows' projection of (v, w), then the model's slot
+        call(_kernel.project_velocity_rows, _start_code(body, model, y), body.params, y, ws)
+        y[17] = model.slot_value(body, y)
+    call(_kernel.project, _start_code(body, model, y), body.params, y, ws)
     return y

@@ -222,8 +222,22 @@ def invariant_measure_claim() -> tuple[bool, str]:
     )
 
 
+def _model_claims(model: str) -> list[Claim]:
+    """The claims of the model's own symbolic module (``ContactModel.symbolic_claims``)."""
+    extra = get_model(model).symbolic_claims
+    if extra is None:
+        return []
+    module, function = extra.split(":")
+    claims: list[Claim] = getattr(importlib.import_module(module), function)()
+    return claims
+
+
 def claims_for(model: str) -> list[Claim]:
-    """The claims checked for ``model``."""
+    """The claims checked for ``model``: its integrals and identities from the derived
+    equations (:func:`.equations.derive`), then its own module's; a model whose kinetic energy
+    is not the body's alone (``ContactModel.own_inertia``) has only its own."""
+    if get_model(model).own_inertia:
+        return _model_claims(model)
     F = _integrals()
     out = []
     # the integrals the model claims (the routh integral is proved through its square)
@@ -246,10 +260,7 @@ def claims_for(model: str) -> list[Claim]:
         for var, (expr, rhs) in _reduced_claims().items():
             out.append(Claim(f"reduced system (3.3): {var}' follows from the full equations",
                              model, (expr, rhs), "reduced"))  # fmt: skip
-    extra = get_model(model).symbolic_claims
-    if extra is not None:  # "module:function" of the symbolic layer (the model's own claims)
-        module, function = extra.split(":")
-        out.extend(getattr(importlib.import_module(module), function)())
+    out.extend(_model_claims(model))
     return out
 
 
