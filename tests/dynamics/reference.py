@@ -172,6 +172,7 @@ def shell_rotor_rhs(p, y):
     dy[15] = v @ y[6:9]
     dy[16] = v @ y[9:12]
     dy[17] = x[idl]
+    shell_rotor_rhs.bearing_torque = x[it] * e1 + x[it + 1] * e2  # of the last call
     return dy, x[il : il + 3]
 
 
