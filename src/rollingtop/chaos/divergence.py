@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
@@ -48,6 +49,16 @@ FD_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
 #: Singular values of the linearised projection above this count as tangent directions (a
 #: projection's are 0 or 1; the differences' error is ~1e-10).
 TANGENT_SV = 0.5
+
+
+def _refuse_own_inertia(model: ContactModel) -> None:
+    """The manifold's coordinates here are ``v, w`` and the frame; a model with a velocity of
+    its own in the state's last slot (``shell-rotor``) has one more."""
+    if model.own_inertia:
+        raise InitialStateError(
+            f"the phase volume of model {model.name!r} is not computed: its state has a "
+            "velocity beyond v, w and the frame (the shell's spin)"
+        )
 
 
 def _azimuth(y: FloatArray) -> float:
@@ -110,6 +121,7 @@ def manifold_divergence(body: SphericalTop, model: str | ContactModel, y: ArrayL
         carried by the flow.
     """
     model = get_model(model)
+    _refuse_own_inertia(model)
     y = check_state(body, model, y)
     code = model.kernel_code(body, y)
     return _divergence(code, body.params, y, call(_kernel.new_workspace))
@@ -187,6 +199,7 @@ def phase_volume(
     PhaseVolume
     """
     model = get_model(model)
+    _refuse_own_inertia(model)
     y0 = check_state(body, model, state)
     atol_ = check_options(t_end, samples, rtol, atol)
     code = model.kernel_code(body, y0)
