@@ -17,8 +17,8 @@ from rollingtop.trajectory import Trajectory
 
 __all__ = ["draw_rollers", "roller_look", "roller_quads"]
 
-ROLLER, STRIPE, CONTACT, HUB = "#e9a23b", "#4a2c0a", "#d62728", "#3d4f63"
-#: Faces of one barrel: along its axis, around it (four stripes of three faces).
+ROLLER, STRIPE, CONTACT, HUB = "#e9a23b", "#1f3b73", "#d62728", "#3d4f63"
+#: Faces of one barrel: along its axis, around it (one dark stripe of two faces, sideways at rest).
 N_ALONG, N_AROUND = 3, 12
 
 
@@ -69,7 +69,7 @@ def draw_rollers(
     hub_radius = 1 - 2 * float(layout.radius.max()) + 0.02
     hub = sphere_quads(hub_radius, 28, 14)
     north, south = axle(hub_radius - 0.05, 1.25, 0.06)
-    stripes = np.repeat(np.arange(N_AROUND) // 3 % 2, N_ALONG)
+    stripes = np.repeat(np.isin(np.arange(N_AROUND), (2, 3)), N_ALONG).astype(int)
     stripes = np.concatenate([stripes, np.zeros(2 * N_AROUND, int)])  # per face of one barrel
 
     def draw(i: int) -> None:
