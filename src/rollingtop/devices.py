@@ -117,8 +117,9 @@ def shell_spin_angle(t: FloatArray, body: SphericalTop, y: FloatArray) -> FloatA
     sigma = nu[:, 2]
     if np.any(sigma <= 0) or not np.all(np.isfinite(sigma)):
         i = int(np.argmax(~(sigma > 0)))
+        when = f"at t = {t[i]:.6g}" if i == 0 else f"between t = {t[i - 1]:.6g} and {t[i]:.6g}"
         raise ContactModelError(
-            f"the axis passes the vertical at t = {t[i]:.6g}, where the contact slips "
+            f"the axis passes the vertical {when}, where the contact slips "
             f"(u_tau = {tau_slip(body, y[i : i + 1])[0]:.3g}): a shell would spin infinitely fast"
         )
     if t.size < 2:

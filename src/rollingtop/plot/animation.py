@@ -62,8 +62,8 @@ def _scene(
 
     fig = Figure(figsize=size, dpi=dpi)
     ax = fig.add_subplot(projection="3d")
-    half = 2.2 * R
-    ax.set_box_aspect((2 * half, 2 * half, 2.6 * R))  # equal units: the sphere looks round
+    half, top = (2.2 * R, 2.6 * R) if look == "plain" else (1.7 * R, 2.2 * R)
+    ax.set_box_aspect((2 * half, 2 * half, top))  # equal units: the sphere looks round
     ax.set_xlabel("X")
     ax.set_ylabel("Y")
     ax.set_zlabel("Z")
@@ -72,7 +72,8 @@ def _scene(
         from rollingtop.plot.looks._parts import Stage
 
         stage = Stage(ax, R)
-        ax.set_box_aspect((2 * half, 2 * half, 2.6 * R), zoom=1.35)
+        ax.set_position((0.0, 0.0, 1.0, 0.9))  # no axes to label: the scene fills the figure
+        ax.set_box_aspect((2 * half, 2 * half, top), zoom=1.3)
     draw_body = LOOKS[look](ax, geom, traj, VIEW)
     trail = ax.plot([], [], [], color="#ff7f0e", lw=1.2, zorder=1)[0]
     clock = fig.text(0.04, 0.95, "", fontsize=10, family="monospace")
@@ -84,8 +85,8 @@ def _scene(
         mid = (lo + hi) / 2
         ax.set_xlim(mid[0] - span / 2, mid[0] + span / 2)
         ax.set_ylim(mid[1] - span / 2, mid[1] + span / 2)
-        ax.set_zlim(0, 2.6 * R)
-        ax.set_box_aspect((span, span, 2.6 * R), zoom=1.0 if stage is None else 1.35)
+        ax.set_zlim(0, top)
+        ax.set_box_aspect((span, span, top), zoom=1.0 if stage is None else 1.3)
         # the plane as a coarse grid (the devices' stage has a floor of its own)
         grid = np.linspace(-span / 2, span / 2, 9) if stage is None else np.empty(0)
         for g in grid:
@@ -103,7 +104,7 @@ def _scene(
             o = centre[i]
             ax.set_xlim(o[0] - half, o[0] + half)
             ax.set_ylim(o[1] - half, o[1] + half)
-            ax.set_zlim(0, 2.6 * R)
+            ax.set_zlim(0, top)
         if stage is not None:
             stage.update(centre[i])
 

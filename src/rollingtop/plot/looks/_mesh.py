@@ -4,7 +4,8 @@ depth-sorted :class:`~mpl_toolkits.mplot3d.art3d.Poly3DCollection` lit by a fixe
 mplot3d has no z-buffer: it paints the faces of one collection from back to front, so every
 solid of a look goes into one :class:`ShadedMesh` (separate collections would be ordered as
 wholes). Faces facing away from the camera are dropped (they are hidden on closed surfaces, and
-half the faces cost half the time); translucent faces are kept from both sides. Shading:
+half the faces cost half the time; exact under the stage's orthographic projection);
+translucent faces are kept from both sides. Shading:
 ambient plus Lambert plus a Blinn-Phong highlight, the light's direction given like
 :class:`matplotlib.colors.LightSource` (azimuth and altitude, degrees) relative to the camera.
 """
@@ -90,7 +91,7 @@ class ShadedMesh:
         norm = np.linalg.norm(n, axis=1)
         n = n / np.where(norm > 0, norm, 1.0)[:, None]
         facing = n @ self.eye
-        keep = facing > -0.25 if not faces.two_sided else np.ones(len(q), bool)
+        keep = facing > -1e-9 if not faces.two_sided else np.ones(len(q), bool)
         n = np.where((facing < 0)[:, None] & faces.two_sided, -n, n)[keep]
         diffuse = np.clip(n @ self.to_light, 0.0, 1.0)
         spec = faces.gloss * np.clip(n @ self.half, 0.0, 1.0) ** faces.shininess

@@ -74,11 +74,13 @@ def shadow(centre: FloatArray, radius: float, n: int = 32) -> FloatArray:
 
 
 class Stage:
-    """The device looks' surroundings: no axes, a checkerboard floor fixed in space (so sliding
-    shows), the sphere's shadow. Painted in a fixed order: floor, shadow, trail, body."""
+    """The device looks' surroundings: no axes, orthographic projection, a checkerboard floor
+    fixed in space (so sliding shows), the sphere's shadow. Painted in a fixed order: floor,
+    shadow, trail, body."""
 
     def __init__(self, ax: Axes3D, R: float) -> None:
         ax.set_axis_off()
+        ax.set_proj_type("ortho")  # one view direction: the meshes' culling is exact
         ax.computed_zorder = False
         self.ax, self.R = ax, R
         self.floor = Poly3DCollection(np.zeros((0, 4, 3)), linewidths=0.0, zorder=0)

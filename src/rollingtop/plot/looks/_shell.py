@@ -41,12 +41,15 @@ def rotor_quads(a3: float) -> tuple[FloatArray, IntArray]:
     ``x3 = a3`` on a hub, as quads (m, 4, 3) and their stripe flags (m,) (12 sectors around
     ``e3``, alternate ones dark, so its spin shows)."""
     n_phi = 24
-    # flywheel profile along e3: a rim, thinner web, the hub
-    z = a3 + np.array([-0.13, -0.13, -0.13, -0.05, -0.05, 0.05, 0.05, 0.13, 0.13, 0.13])
-    r = np.array([0.0, 0.18, 0.62, 0.62, 0.66, 0.66, 0.62, 0.62, 0.18, 0.0])
-    wheel = revolve(z, r, n_phi)[..., [1, 2, 0]]  # (n_phi * 9, 4, 3), phi-major
-    flag = np.repeat(np.arange(n_phi, dtype=np.int64) // 2 % 2, len(z) - 1)
-    return wheel, flag
+    # flywheel profile along e3: a face in rings (mplot3d sorts small faces well), a chamfer,
+    # the rim, a chamfer, the other face
+    face = np.array([0.0, 0.16, 0.32, 0.46, 0.6])
+    z = a3 + np.concatenate([np.full(5, -0.12), [-0.1, 0.1], np.full(5, 0.12)])
+    r = np.concatenate([face, [0.64, 0.64], face[::-1]])
+    wheel = revolve(z, r, n_phi)[..., [1, 2, 0]]  # (n_phi * 11, 4, 3), phi-major
+    on_face = np.r_[np.ones(4), np.zeros(3), np.ones(4)].astype(np.int64)  # rim unstriped
+    flag = (np.arange(n_phi, dtype=np.int64)[:, None] // 2 % 2) * on_face[None, :]
+    return wheel, flag.reshape(-1)
 
 
 def _shell_lines() -> list[FloatArray]:

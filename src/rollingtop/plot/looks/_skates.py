@@ -19,7 +19,7 @@ from rollingtop.trajectory import Trajectory
 
 __all__ = ["draw_skates", "skate_quads", "skates_look"]
 
-DISK, SECTOR, EDGE, CONTACT = "#9fb3c8", "#5d7792", "#e8eef4", "#d62728"
+DISK, SECTOR, EDGE, CONTACT = "#b4c6d8", "#5f7c9c", "#eef3f8", "#d62728"
 #: Faces around the axis; each disk face is split in rings so that mplot3d sorts it well.
 N_AROUND, N_RINGS = 36, 3
 #: Width of the bevel that sharpens each disk's edge, units of ``R``.
