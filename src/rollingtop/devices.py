@@ -182,8 +182,9 @@ def roller_spin(
     The roller in contact is the one nearest the contact point ``-gamma``; it turns about its
     axis, relative to the sphere, at ``u_tau / (rho R)`` (``rho`` its radius, in units of ``R``):
     then its point on the plane does not move along ``tau``, and along its axis (``nu`` in the
-    limit of a dense layout) the sphere rolls. The rollers are weightless with frictionless
-    bearings: one that leaves the plane keeps the rate it had (the limit of small roller inertia).
+    limit of a dense layout) the sphere rolls. Off the plane a weightless roller's spin is not
+    determined by the model; here one that leaves the plane keeps the rate it had (small inertia,
+    frictionless bearings), a choice of the drawing that lets the turning rollers be seen.
 
     Returns
     -------
