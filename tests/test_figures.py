@@ -129,3 +129,40 @@ def test_animation_refuses_bad_options(capsys, tmp_path, monkeypatch):
         code, out, err = run_cli(capsys, "animate", str(EXAMPLES / "paper.toml"), *args)
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_animation_looks(capsys, tmp_path):
+    """Each device renders (frames counted); the command line names the library's looks."""
+    from rollingtop.cli._figures import LOOKS as CLI_LOOKS
+    from rollingtop.plot.looks import LOOKS
+
+    assert CLI_LOOKS == tuple(LOOKS)
+    for look in ("roller", "shell", "skates"):
+        out = tmp_path / f"{look}.gif"
+        args = ["-o", str(out), "--fps", "4", "--duration", "0.5", "--look", look]
+        code, stdout, err = run_cli(capsys, "animate", str(EXAMPLES / "paper.toml"), *args)
+        assert code == 0, err
+        assert sum(1 for _ in ImageSequence.Iterator(Image.open(out))) == 2
+
+
+def test_animation_devices_need_the_meridian_model(capsys, tmp_path, monkeypatch):
+    """Refused in one line, exit 2, before anything is integrated or written."""
+    import rollingtop.cli._figures as figures
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(figures, "run_scenario", lambda *a, **k: pytest.fail("integrated"))
+    for look in ("roller", "shell", "skates"):
+        code, out, err = run_cli(capsys, "animate", str(EXAMPLES / "smooth.toml"), "-o",
+                                 "roll.gif", "--look", look)  # fmt: skip
+        assert code == 2 and "meridian model's constraint" in err
+        assert len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_animation_shell_refuses_a_pole_passage(capsys, tmp_path):
+    code, out, err = run_cli(capsys, "animate", str(EXAMPLES / "pole.toml"), "-o",
+                             str(tmp_path / "roll.gif"), "--look", "shell", "--duration", "2",
+                             "--fps", "4")  # fmt: skip
+    assert code == 2 and "a shell would spin infinitely fast" in err
+    assert len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []

@@ -17,8 +17,11 @@ if TYPE_CHECKING:
     from rollingtop.scenario import Scenario
     from rollingtop.trajectory import Trajectory
 
-__all__ = ["MAX_FRAMES", "MAX_PERIODS", "animate", "compare", "path", "plot"]
+__all__ = ["LOOKS", "MAX_FRAMES", "MAX_PERIODS", "animate", "compare", "path", "plot"]
 
+#: The animation's looks (:data:`rollingtop.plot.looks.LOOKS`, named here so that the command
+#: line starts without matplotlib; a test holds them equal).
+LOOKS = ("plain", "roller", "shell", "skates")
 #: Bounds of the figure and animation commands' own options (samples and frames they imply).
 MAX_PERIODS = 1e5
 MAX_FRAMES = 100_000
@@ -136,10 +139,19 @@ def compare(scenario: str, output: str, t_end: float | None) -> None:
 @click.option(
     "--camera", type=click.Choice(["follow", "fixed"]), default="follow", show_default=True
 )
+@click.option(
+    "--look",
+    type=click.Choice(LOOKS),
+    default="plain",
+    show_default=True,
+    help="plain wireframe, or the paper's device that realises the meridian constraint: "
+    "roller-bearing sphere, shell with a rotor, sphere of skates (meridian model only).",
+)
 def animate(
-    scenario: str, output: str, fps: int, duration: float, speed: float, camera: str
+    scenario: str, output: str, fps: int, duration: float, speed: float, camera: str, look: str
 ) -> None:
-    """3D animation of the rolling sphere (meridians and axis show the spin, contact trail)."""
+    """3D animation of the rolling sphere (meridians and axis show the spin, contact trail),
+    or of a device that realises the paper's constraint (--look)."""
     from rollingtop.io import check_output_path
     from rollingtop.plot.animation import ANIMATION_SUFFIXES
     from rollingtop.plot.animation import animate as render
@@ -153,8 +165,12 @@ def animate(
     n_frames = int(round(duration * fps))
     t_end = (n_frames - 1) / fps * speed if n_frames > 1 else speed / fps
     sc = load_scenario(scenario).with_overrides(t_end=t_end, samples=max(2, 4 * n_frames))
+    if look != "plain":
+        from rollingtop.devices import check_device
+
+        check_device(look, sc.model)  # before anything runs
     traj = run_scenario(sc)
     with _output.counting("rendering", n_frames) as progress:
-        render(traj, output, fps=fps, duration=duration, speed=speed, camera=camera,
+        render(traj, output, look=look, fps=fps, duration=duration, speed=speed, camera=camera,
                progress=progress)  # fmt: skip
     click.echo(f"wrote {output} ({n_frames} frames)")
