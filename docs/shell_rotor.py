@@ -89,8 +89,9 @@ def sections():
             model = "shell-rotor"
         states = _fig5_states(body)
         ds = poincare_section(body, model, states, crossings=CROSSINGS, seed=0)
-        megno = [float(chaos_indicators(body, model, y, t_end=T_MEGNO).megno_mean[-1])
-                 for y in states]
+        megno = [
+            float(chaos_indicators(body, model, y, t_end=T_MEGNO).megno_mean[-1]) for y in states
+        ]
         # how far the crossings of each trajectory stray from its first (0: periodic nutation)
         g3, wn = ds["gamma3"].values, ds["w_n"].values
         spread = float(np.nanmax(np.hypot(g3 - g3[:, :1], wn - wn[:, :1])))
@@ -140,10 +141,14 @@ def _w_tau(y):
 
 
 def readme_block(rows, slopes, secs):
-    lines = [f"Distance from the meridian model at t = {T_CONV:g} (shell mass = inertia = eps; "
-             f"fitted exponents over {FIT[0]:g} .. {FIT[1]:g}: axis {slopes[0]:.3f}, contact point "
-             f"{slopes[1]:.3f}, angular velocity {slopes[2]:.3f}):", "",
-             "| eps | axis direction | contact point | angular velocity |", "|---|---|---|---|"]
+    lines = [
+        f"Distance from the meridian model at t = {T_CONV:g} (shell mass = inertia = eps; "
+        f"fitted exponents over {FIT[0]:g} .. {FIT[1]:g}: axis {slopes[0]:.3f}, contact point "
+        f"{slopes[1]:.3f}, angular velocity {slopes[2]:.3f}):",
+        "",
+        "| eps | axis direction | contact point | angular velocity |",
+        "|---|---|---|---|",
+    ]
     for eps, a, c, w in rows:
         lines.append(f"| {eps:.0e} | {a:.2e} | {c:.2e} | {w:.2e} |")
     lines += ["", "A thin shell of 10 % and 30 % of the rotor's mass, motions from the Fig. 5 "

@@ -160,10 +160,39 @@ def test_skates_are_disks_on_the_axis_whose_edges_are_parallels():
 
 
 @pytest.mark.parametrize("device", ["roller", "shell", "skates"])
-def test_devices_realise_only_the_meridian_model(device):
+def test_devices_realise_only_the_models_that_declare_them(device):
+    """Every device the meridian model's; the shell also the shell-rotor pair's (whose shell
+    spin is its state's); no other model's."""
     check_device(device, MODELS["meridian"])
+    assert (device in MODELS["shell-rotor"].devices) == (device == "shell")
     for name in ("smooth", "rough", "parallel", "rubber"):
-        with pytest.raises(ContactModelError, match=f"not the '{name}' model"):
+        with pytest.raises(ContactModelError, match=f"not that of model '{name}'"):
             check_device(device, MODELS[name])
     with pytest.raises(ContactModelError, match="unknown device"):
         check_device("sled", MODELS["meridian"])
+
+
+def test_the_pairs_shell_angle_is_its_own_spin_integrated():
+    """For the shell-rotor pair the shell's spin is a state variable (finite through the
+    vertical): the angle is its quadrature, held to solve_ivp's integral of the same motion."""
+    from scipy.integrate import solve_ivp
+
+    from rollingtop import SphericalTop, initial_state, simulate
+    from rollingtop.dynamics import _kernel
+
+    body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5, shell_mass=0.2,
+                        shell_inertia=0.2 * 2 / 3)  # fmt: skip
+    model = MODELS["shell-rotor"]
+    y0 = initial_state(body, model, gamma=[0.0, 0.6, 0.8], omega=[0.7, -0.3, 2.0],
+                       free={"v_tau": 0.25})  # fmt: skip
+    tr = simulate(body, model, y0, t_end=5.0, rtol=1e-12, atol=1e-14, samples=501)
+    chi = shell_spin_angle(tr.t, body, tr.y, model)
+    ws, dy = _kernel.new_workspace(), np.empty(18)
+
+    def rhs(t, z):
+        _kernel.rhs(model.code, body.params, z[:18], dy, ws)
+        return np.concatenate([dy, [z[17]]])
+
+    sol = solve_ivp(rhs, (0.0, 5.0), np.concatenate([y0, [0.0]]), method="DOP853", rtol=1e-12,
+                    atol=1e-14, t_eval=tr.t)  # fmt: skip
+    np.testing.assert_allclose(chi, sol.y[18], rtol=0, atol=1e-8)

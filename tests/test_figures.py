@@ -154,7 +154,7 @@ def test_animation_devices_need_the_meridian_model(capsys, tmp_path, monkeypatch
     for look in ("roller", "shell", "skates"):
         code, out, err = run_cli(capsys, "animate", str(EXAMPLES / "smooth.toml"), "-o",
                                  "roll.gif", "--look", look)  # fmt: skip
-        assert code == 2 and "meridian model's constraint" in err
+        assert code == 2 and "constraint of model 'meridian'" in err
         assert len(err.strip().splitlines()) == 1
     assert list(tmp_path.iterdir()) == []
 

@@ -20,7 +20,9 @@ along ``nu`` (the horizontal projection of the axis ``e3``) and slips freely alo
   ``tau``) and cannot move across it (along its normal ``e3``, whose horizontal part is along
   ``nu``); the sphere rolls over from disk to disk along the meridian (:func:`skate_layout`).
 
-Only the meridian model has this constraint: :func:`check_device` refuses the others. ``nu`` and
+A model declares the devices that realise it (:attr:`rollingtop.contact.ContactModel.devices`:
+the meridian model all three, the ``shell-rotor`` pair its shell, whose spin is then the
+pair's own state variable); :func:`check_device` refuses the others. ``nu`` and
 ``tau`` are taken from the state's carried direction ``psi_nu``
 (``nu = cos(psi_nu) alpha + sin(psi_nu) beta``, :mod:`rollingtop.dynamics._layout`), which is
 regular through a pole passage, where ``sigma`` changes sign.
@@ -36,7 +38,7 @@ from scipy.interpolate import make_interp_spline
 from rollingtop._errors import ContactModelError
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
-from rollingtop.contact import ContactModel
+from rollingtop.contact import MODELS, ContactModel
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 
 __all__ = [
@@ -53,19 +55,26 @@ __all__ = [
     "tau_slip",
 ]
 
-#: The devices of the paper's Sec. 1, each realising the constraint of this contact model.
-DEVICES: dict[str, str] = {"roller": "meridian", "shell": "meridian", "skates": "meridian"}
+#: The devices of the paper's Sec. 1 (a model lists those that realise it:
+#: :attr:`rollingtop.contact.ContactModel.devices`).
+DEVICES: dict[str, str] = {
+    "roller": "roller-bearing sphere (Fig. 1)",
+    "shell": "spherical shell with a rotor (Fig. 2)",
+    "skates": "sphere of skates on ice (Fig. 3)",
+}
 
 
 def check_device(device: str, model: ContactModel) -> None:
     """A :class:`~rollingtop.ContactModelError` unless ``device`` realises ``model``'s
-    constraint."""
+    constraint (:attr:`~rollingtop.contact.ContactModel.devices`)."""
     if device not in DEVICES:
         raise ContactModelError(f"unknown device {device!r} (known: {', '.join(DEVICES)})")
-    if model.name != DEVICES[device]:
+    if device not in model.devices:
+        realised = [m.name for m in MODELS.values() if device in m.devices]
         raise ContactModelError(
-            f"the {device} device realises the {DEVICES[device]} model's constraint (no slip "
-            f"along nu, free slip along tau), not the {model.name!r} model's"
+            f"the {device} device realises the constraint of model "
+            f"{' or '.join(map(repr, realised))} (no slip along nu, free slip along tau), not "
+            f"that of model {model.name!r}"
         )
 
 
@@ -87,16 +96,23 @@ def tau_slip(body: SphericalTop, y: FloatArray) -> FloatArray:
     return np.asarray(np.einsum("ij,ij->i", vp, tau), dtype=np.float64)
 
 
-def shell_spin_rate(body: SphericalTop, y: FloatArray) -> FloatArray:
+def shell_spin_rate(
+    body: SphericalTop, y: FloatArray, model: ContactModel | None = None
+) -> FloatArray:
     """Spin ``delta = Omega3 - w3 = u_tau / (R sigma)`` of the rolling shell relative to the rotor
     (module docstring), shape (n,). Infinite or large where the axis passes the vertical
-    (``sigma = 0``) with slip."""
+    (``sigma = 0``) with slip. A ``model`` with its own inertia (the ``shell-rotor`` pair) keeps
+    ``delta`` in the state's last slot: that is returned."""
+    if model is not None and model.own_inertia:
+        return np.asarray(y[:, PSI_NU], dtype=np.float64)
     nu, _ = constraint_directions(y)
     with np.errstate(divide="ignore", invalid="ignore"):
         return tau_slip(body, y) / (body.R * nu[:, 2])
 
 
-def shell_spin_angle(t: FloatArray, body: SphericalTop, y: FloatArray) -> FloatArray:
+def shell_spin_angle(
+    t: FloatArray, body: SphericalTop, y: FloatArray, model: ContactModel | None = None
+) -> FloatArray:
     """The shell's turn about ``e3`` relative to the rotor, ``chi(t) = int_{t0}^t delta dt``, at
     the sample times ``t`` (n,), from the rate at the samples ``y`` (n, 18).
 
@@ -110,12 +126,14 @@ def shell_spin_angle(t: FloatArray, body: SphericalTop, y: FloatArray) -> FloatA
     Raises :class:`~rollingtop.ContactModelError` where the axis passes the vertical (``sigma``
     changes sign, a pole case of the meridian model): the rotor's contact point slips there
     (``u_tau != 0``), so the shell would have to spin infinitely fast; the shell cannot realise
-    that motion.
+    that motion. The ``shell-rotor`` pair (``model`` with its own inertia) has a shell of mass
+    and its spin in the state: finite everywhere.
     """
     t = np.asarray(t, dtype=float)
+    own = model is not None and model.own_inertia
     nu, _ = constraint_directions(y)
     sigma = nu[:, 2]
-    if np.any(sigma <= 0) or not np.all(np.isfinite(sigma)):
+    if not own and (np.any(sigma <= 0) or not np.all(np.isfinite(sigma))):
         i = int(np.argmax(~(sigma > 0)))
         when = f"at t = {t[i]:.6g}" if i == 0 else f"between t = {t[i - 1]:.6g} and {t[i]:.6g}"
         raise ContactModelError(
@@ -124,7 +142,7 @@ def shell_spin_angle(t: FloatArray, body: SphericalTop, y: FloatArray) -> FloatA
         )
     if t.size < 2:
         return np.zeros_like(t)
-    rate = shell_spin_rate(body, y)
+    rate = shell_spin_rate(body, y, model)
     k = 5 if t.size > 5 else (3 if t.size > 3 else 1)
     spline = make_interp_spline(t, rate, k=k).antiderivative()
     return np.asarray(spline(t) - spline(t[0]), dtype=float)

@@ -17,8 +17,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._errors import ContactLostWarning, InitialStateError
+from rollingtop._jit import call
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, models_for
+from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.start import InitialConditions
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals, project_state
@@ -75,6 +77,16 @@ def _given_state(
         raise InitialStateError(f"state must be {N_STATE} numbers") from None
     if y.shape != (N_STATE,) or not np.all(np.isfinite(y)):
         raise InitialStateError(f"state must be {N_STATE} finite numbers, got shape {y.shape}")
+    if model.slot_value is not None:  # the model's own velocity must agree with v
+        projected = y.copy()
+        call(_kernel.project, model.kernel_code(body, y), body.params, projected,
+             call(_kernel.new_workspace))  # fmt: skip
+        gap = float(np.max(np.abs(projected[0:3] - y[0:3])))
+        if gap > UNIT_TOLERANCE * max(1.0, float(np.max(np.abs(y[0:6])))):
+            raise InitialStateError(
+                f"the state's v and its last slot (model {model.name!r}: the shell's spin) "
+                f"disagree by {gap:.3g}: build it with initial_state or project_state"
+            )
     residuals = constraint_residuals(body, model, y)
     for name, res in zip(model.constraints, residuals, strict=True):
         if abs(res) > UNIT_TOLERANCE:

@@ -60,7 +60,7 @@ def test_the_devices_refuse_other_models():
     sc = load_scenario(EXAMPLES / "smooth.toml")
     traj = simulate(sc, t_end=0.2, samples=3)
     for look in ("roller", "shell", "skates"):
-        with pytest.raises(ContactModelError, match="meridian model's constraint"):
+        with pytest.raises(ContactModelError, match="constraint of model 'meridian'"):
             frame_figure(traj, 0.1, look=look)
 
 

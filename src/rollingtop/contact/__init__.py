@@ -63,6 +63,7 @@ def models_for(body: SphericalTop) -> tuple[ContactModel, ...]:
     (:attr:`ContactModel.own_inertia`, ``shell-rotor``) only with a shell."""
     return tuple(m for m in MODELS.values() if body.has_shell or not m.own_inertia)
 
+
 __all__ = [
     "models_for",
     "DEFAULT_MODEL",

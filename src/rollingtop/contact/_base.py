@@ -176,6 +176,10 @@ class ContactModel:
         ``state_outputs(body, Y) -> {name: array (n, 3)}``: further per-sample quantities of
         the model's states ``Y`` (n, 18) for the outputs (``shell-rotor``: the shell's angular
         velocity and the bearing's reaction torque), body frame.
+    devices : tuple of str
+        The devices of the paper's Sec. 1 (:data:`rollingtop.devices.DEVICES`) that realise
+        this model's constraint, drawn by ``rollingtop animate --look`` (the meridian model:
+        all three; ``shell-rotor``: the shell).
     symbolic_claims : str or None
         ``"module:function"`` of the symbolic layer returning further claims for
         :func:`rollingtop.symbolic.verify` (a reduced system, particular cases); imported only
@@ -207,6 +211,7 @@ class ContactModel:
     particular_integrals: Callable[[SphericalTop], tuple[str, ...]] | None = None
     symbolic_claims: str | None = None
     own_inertia: bool = False
+    devices: tuple[str, ...] = ()
     state_outputs: Callable[[SphericalTop, FloatArray], dict[str, FloatArray]] | None = None
     slot_value: Callable[[SphericalTop, FloatArray], float] | None = None
 

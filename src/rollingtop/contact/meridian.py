@@ -388,4 +388,5 @@ MODEL = ContactModel(
     vertical_eigenvalues=_vertical_eigenvalues,
     has_reduction=True,
     colour="#1f77b4",
+    devices=("roller", "shell", "skates"),
 )

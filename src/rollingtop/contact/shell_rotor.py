@@ -34,11 +34,15 @@ With ``u = T(gamma) q`` and ``u' = T q' + k``, ``k = (R Omega x gamma', 0, 0)``,
 drops out of ``T^T (M u' - F) = 0``: a 4x4 SPD system ``(T^T M T) q' = T^T (F - M k)``
 (:func:`accelerations`); then ``lambda = (M u')_v - F_v``.
 
-**Integrals.** Energy (the pair's, :func:`rollingtop.dynamics.integrals.energy` with the shell's
-terms). The rotor's axial spin ``w3``: the bearing is frictionless and every force the shell
-exerts on the rotor acts on the axis, so its torque about ``C`` has no ``e3`` component, and
-Euler's equation gives ``I3 w3' = (I1 - I2) w1 w2 = 0`` for a symmetric rotor (Lagrange's
-integral ``I3 w3``).
+**Integrals** (all proved by :mod:`rollingtop.symbolic.shell_rotor`): energy (the pair's,
+:func:`rollingtop.dynamics.integrals.energy` with the shell's terms); the rotor's axial spin
+``w3`` -- the bearing is frictionless and every force the shell exerts on the rotor acts on the
+axis, so its torque about ``C`` has no ``e3`` component, and Euler's equation gives
+``I3 w3' = (I1 - I2) w1 w2 = 0`` for a symmetric rotor (Lagrange's integral ``I3 w3``); a
+Jellett integral about the pair's centre of mass and the pair's ``F6``
+(:func:`rollingtop.dynamics.integrals.jellett`, :func:`~rollingtop.dynamics.integrals.F6` for a
+body with a shell): as many as the meridian model has, which it becomes as the shell's mass and
+inertia vanish.
 """
 
 from __future__ import annotations
@@ -328,13 +332,14 @@ MODEL = ContactModel(
     "its axis (the paper's Sec. 1 realization; [shell] mass and inertia)",
     constraints=("contact (vp, gamma) = 0", "no slip of the rotor along nu (vp, nu) = 0"),
     free_velocity={"v_tau": 1},
-    integrals_symmetric=("energy", "lagrange"),
+    integrals_symmetric=("energy", "lagrange", "jellett", "F6"),
     integrals_general=("energy",),
     velocity=_velocity,
     symbolic_directions=_symbolic_directions,
     symbolic_velocity=_symbolic_velocity,
     vertical_eigenvalues=_vertical_eigenvalues,
     own_inertia=True,
+    devices=("shell",),
     slot_value=relative_spin,
     state_outputs=outputs,
     symbolic_claims="rollingtop.symbolic.shell_rotor:claims",

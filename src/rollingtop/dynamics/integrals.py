@@ -64,9 +64,26 @@ def lagrange(body: SphericalTop, Y: FloatArray) -> FloatArray:
 
 
 def jellett(body: SphericalTop, Y: FloatArray) -> FloatArray:
-    """Jellett's integral ``F4 = (I w, r)``."""
-    F4: FloatArray = np.sum(_Iw(body, Y) * _arm(body, Y), axis=-1)
-    return F4
+    """Jellett's integral ``F4 = (I w, r)``.
+
+    With a shell (``shell-rotor``, :mod:`rollingtop.symbolic.shell_rotor`) the pair's:
+    ``(K_G, r_G)``, the angular momentum about the pair's centre of mass ``G`` against the
+    contact point seen from ``G``: ``K_G = I w + Js Omega + m (C - G) x v + ms (O - G) x v_O``,
+    ``r_G = -R gamma - a3 e3 - G`` (``C``: the rotor's centre of mass, the origin; ``O = -a3 e3``
+    the shell's centre; ``G = ms O / (m + ms)``)."""
+    if not body.has_shell:
+        F4: FloatArray = np.sum(_Iw(body, Y) * _arm(body, Y), axis=-1)
+        return F4
+    ms, Js, a3 = body.shell_mass, body.shell_inertia, body.a3
+    e3 = np.array([0.0, 0.0, 1.0])
+    O = -a3 * e3
+    G = ms * O / (body.m + ms)
+    v, w = Y[..., V], Y[..., W]
+    omega = w + Y[..., PSI_NU][..., None] * e3
+    v_O = v - np.cross(w, a3 * e3)
+    K = _Iw(body, Y) + Js * omega + body.m * np.cross(-G, v) + ms * np.cross(O - G, v_O)
+    pair: FloatArray = np.sum(K * (_arm(body, Y) - G), axis=-1)
+    return pair
 
 
 def area(body: SphericalTop, Y: FloatArray) -> FloatArray:
@@ -144,6 +161,25 @@ def F6_reduced(
     return F6
 
 
+def _f6_pair(body: SphericalTop, Y: FloatArray) -> FloatArray:
+    """The shell-rotor pair's ``F6``: ``Omega3 sqrt(N) + R I3 w3 Phi(gamma3)``
+    (:func:`rollingtop.symbolic.shell_rotor.f6_pair`, where it is derived and proved)."""
+    R, m, a3, I1, I3 = body.R, body.m, body.a3, body.I1, body.I3
+    ms, Js = body.shell_mass, body.shell_inertia
+    g3 = Y[..., 14]
+    K = (m + ms) * I1 + m * ms * a3**2
+    alpha = Js * (I1 + Js + ms * R**2 + m * R**2 + m * a3**2) + R**2 * K
+    beta = 2.0 * Js * m * R * a3
+    kappa = R**2 * K
+    N = alpha + beta * g3 - kappa * g3**2
+    p = (m + ms) * R
+    arc = np.arccos(np.clip((2 * kappa * g3 - beta) / np.sqrt(beta**2 + 4 * alpha * kappa), -1, 1))
+    phi = -p / kappa * np.sqrt(N) - (m * a3 + p * beta / (2 * kappa)) / np.sqrt(kappa) * arc
+    w3 = Y[..., 5]
+    f6: FloatArray = (w3 + Y[..., PSI_NU]) * np.sqrt(N) + R * I3 * w3 * phi
+    return f6
+
+
 def F6(body: SphericalTop, Y: FloatArray, pole: str | None = None) -> FloatArray:
     """The paper's new linear integral (symmetric body, meridian model, eq. 3.9) of states ``Y``:
     :func:`F6_reduced` of the reduced variables of :func:`reduced_components`, where
@@ -151,6 +187,8 @@ def F6(body: SphericalTop, Y: FloatArray, pole: str | None = None) -> FloatArray
     stays constant through the pole passages of a pole case, where the paper's unsigned
     expression changes sign.
     """
+    if body.has_shell:  # the shell-rotor pair's
+        return _f6_pair(body, Y)
     c = reduced_components(Y, pole)
     M3: FloatArray = body.I3 * Y[..., 5]
     return F6_reduced(body, M3, c["gamma3"], c["s"], c["theta"], c["v_tau"], c["w_n"])

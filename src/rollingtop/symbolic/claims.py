@@ -145,7 +145,7 @@ def decide(
         for x in symbols:
             if x in (q, k):
                 values[x] = sp.Rational(rng.randint(1, 50), rng.randint(51, 120))  # in (0, 1)
-            elif x in (S.m, S.I1, S.I2, S.I3, S.R):
+            elif x in (S.m, S.I1, S.I2, S.I3, S.R) or x.is_positive:  # masses, inertias
                 values[x] = sp.Rational(rng.randint(20, 200), rng.randint(20, 100))
             else:
                 values[x] = _random_rational(rng)

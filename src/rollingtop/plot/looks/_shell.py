@@ -118,5 +118,5 @@ def shell_look(
 ) -> Callable[[int], None]:
     """:func:`draw_shell` with the meridian model's shell spin
     (:func:`rollingtop.devices.shell_spin_angle` at the samples, interpolated at the frames)."""
-    chi = shell_spin_angle(traj.t, traj.body, traj.y)
+    chi = shell_spin_angle(traj.t, traj.body, traj.y, traj.model)
     return draw_shell(ax, geom, geom.at(chi, traj.t), view)
