@@ -22,14 +22,11 @@ an ``[axes]`` table whose keys are body or level keys, each a list of values or
 from __future__ import annotations
 
 import contextlib
-import functools
 import hashlib
-import io
 import json
 import os
 import shutil
 import tomllib
-import warnings
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,27 +34,38 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rollingtop._atlas_cells import BODY_KEYS, LEVEL_KEYS, classify_cells
+from rollingtop._atlas_store import (
+    _dataset,
+    _load_partial,
+    _partial_folder,
+    _save_chunk,
+    _write,
+    check_atlas_output,
+)
 from rollingtop._checks import short_repr
-from rollingtop._errors import BodyError, RollingTopError, ScenarioError
+from rollingtop._errors import RollingTopError, ScenarioError
 from rollingtop._types import FloatArray
-from rollingtop.body import SphericalTop
-from rollingtop.io import check_output_path, netcdf_bytes, read_input_text, write_bytes_atomic
+from rollingtop.io import read_input_text, write_bytes_atomic
 
 if TYPE_CHECKING:
     import xarray as xr
     from distributed import Client
 
-__all__ = ["AtlasError", "AtlasSpec", "atlas", "classify_cells", "load_atlas_spec"]
+__all__ = [
+    "AtlasError",
+    "AtlasSpec",
+    "atlas",
+    "check_atlas_output",
+    "classify_cells",
+    "load_atlas_spec",
+]
 
-BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3")
-LEVEL_KEYS = ("M3", "C1", "C2")
 AXIS_KEYS = BODY_KEYS + LEVEL_KEYS
 #: Largest number of cells of one atlas.
 MAX_CELLS = 10_000_000
 #: Cells per Dask task (a chunk, and a file of the partial folder).
 DEFAULT_CHUNK = 200
-#: Centres whose rotation number is kept per cell.
-MAX_CENTRES = 3
 #: Bumped when the classification changes: partial results of another version are not reused.
 ATLAS_VERSION = 1
 #: Status of a cell.
@@ -67,11 +75,8 @@ STATUS = {
     2: "pole level (C1 = +-M3)",
     3: "level too large",
 }
-SUFFIXES = (".nc", ".zarr")
 #: Most worker processes per core of the embedded local cluster.
 MAX_WORKERS_PER_CORE = 4
-#: Largest chunk along each dimension of a Zarr store.
-ZARR_CHUNK = 64
 MAX_SPEC_BYTES = 1_000_000
 
 
@@ -208,76 +213,6 @@ def load_atlas_spec(path: str | os.PathLike[str]) -> AtlasSpec:
         raise AtlasError(f"{path}: {exc}") from None
 
 
-# ---- the classification of cells (pure functions: Dask tasks) ---------------------------------
-
-FIELDS = ("status", "n_steady", "n_centres", "n_saddles", "n_folds")
-
-
-@functools.lru_cache(maxsize=4096)
-def _fold_count(*key: float) -> int:
-    """Folds of the diagram of ``(body, M3, C1)`` (independent of ``C2``): cached in each worker
-    process across its tasks, since neighbouring cells share them."""
-    from rollingtop.reduction.bifurcation import folds
-
-    body = SphericalTop(**dict(zip(BODY_KEYS, key[:6], strict=True)))
-    return len(folds(body, key[6], key[7]))
-
-
-def classify_cells(
-    fixed: Mapping[str, float], names: tuple[str, ...], values: FloatArray
-) -> dict[str, np.ndarray]:
-    """Classify the cells ``values`` (shape (k, len(names))): one Dask task.
-
-    Returns
-    -------
-    dict of str to ndarray
-        ``status, n_steady, n_centres, n_saddles, n_folds``, shape (k,), int (-1 where the cell
-        is not classified, see :data:`STATUS`); ``rotation_centre`` and ``centre_gamma3``,
-        shape (k, :data:`MAX_CENTRES`), NaN-padded, the centres in order of ``gamma3``.
-    """
-    from rollingtop.reduction.bifurcation import _critical
-    from rollingtop.reduction.level import LevelSet, LevelSetError
-    from rollingtop.reduction.rotation import centre_rotation_number
-    from rollingtop.reduction.steady import steady_motion
-
-    k = values.shape[0]
-    out = {name: np.full(k, -1, dtype=np.int16) for name in FIELDS}
-    out["rotation_centre"] = np.full((k, MAX_CENTRES), np.nan)
-    out["centre_gamma3"] = np.full((k, MAX_CENTRES), np.nan)
-    for n in range(k):
-        p = dict(fixed)
-        p.update(zip(names, (float(x) for x in values[n]), strict=True))
-        try:
-            body = SphericalTop(**{key: p[key] for key in BODY_KEYS})
-        except BodyError:
-            out["status"][n] = 1
-            continue
-        try:
-            level = LevelSet(body, p["M3"], p["C1"], p["C2"])
-        except LevelSetError:
-            out["status"][n] = 3
-            continue
-        if level.pole is not None:
-            out["status"][n] = 2
-            continue
-        th, _, u2 = _critical(level)
-        g3 = np.cos(th)
-        out["status"][n] = 0
-        out["n_steady"][n] = len(g3)
-        out["n_centres"][n] = int(np.sum(u2 > 0))
-        out["n_saddles"][n] = int(np.sum(u2 < 0))
-        out["n_folds"][n] = _fold_count(*(p[key] for key in (*BODY_KEYS, "M3", "C1")))
-        centres = [t for t, c in zip(th, u2 > 0, strict=True) if c][:MAX_CENTRES]
-        for c, t in enumerate(centres):
-            m = steady_motion(level, float(t))
-            out["centre_gamma3"][n, c] = m.gamma3
-            out["rotation_centre"][n, c] = centre_rotation_number(m)
-    return out
-
-
-# ---- running it on Dask, resumably --------------------------------------------------------------
-
-
 @contextlib.contextmanager
 def _client(client: Client | None, workers: int | None, scheduler: str | None) -> Iterator[Client]:
     """The given client; else one connected to ``scheduler``; else an embedded local cluster of
@@ -310,107 +245,6 @@ def _client(client: Client | None, workers: int | None, scheduler: str | None) -
             local.close()
     finally:
         cluster.close()
-
-
-def _partial_folder(output: Path) -> Path:
-    return output.with_name(output.name + ".partial")
-
-
-def _load_partial(folder: Path, digest: str) -> dict[int, dict[str, np.ndarray]]:
-    """Chunks saved by an earlier run of the same spec (``{}`` if none)."""
-    if not folder.exists():
-        return {}
-    try:
-        saved = json.loads((folder / "spec.json").read_text())
-    except (OSError, ValueError):
-        saved = {}
-    if saved.get("digest") != digest:
-        raise AtlasError(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
-                         "remove it to start over")  # fmt: skip
-    done = {}
-    for f in folder.glob("chunk-*.npz"):
-        with contextlib.suppress(OSError, ValueError, KeyError):
-            with np.load(f) as z:
-                done[int(f.stem.split("-")[1])] = {key: z[key] for key in z.files}
-    return done
-
-
-def _save_chunk(folder: Path, k: int, result: Mapping[str, np.ndarray]) -> None:
-    buf = io.BytesIO()
-    np.savez(buf, **result)  # type: ignore[arg-type]
-    write_bytes_atomic(folder / f"chunk-{k:06d}.npz", buf.getvalue())
-
-
-def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> xr.Dataset:
-    import xarray as xr
-
-    dims = tuple(spec.axes)
-    merged = {key: np.concatenate([parts[k][key] for k in sorted(parts)])
-              for key in parts[min(parts)]}  # fmt: skip
-    data_vars = {}
-    docs = {
-        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large",
-        "n_steady": "steady motions (critical points of U in (-1, 1)); -1: not classified",
-        "n_centres": "steady motions that are centres (U'' > 0)",
-        "n_saddles": "steady motions that are saddles (U'' < 0)",
-        "n_folds": "folds of the (C2, h) bifurcation diagram of (M3, C1)",
-        "rotation_centre": "rotation number psi'/omega at each centre (in order of gamma3)",
-        "centre_gamma3": "gamma3 of each centre",
-    }
-    for key, values in merged.items():
-        if values.ndim == 1:
-            data_vars[key] = (dims, values.reshape(spec.shape), {"description": docs[key]})
-        else:
-            data_vars[key] = ((*dims, "centre"), values.reshape((*spec.shape, values.shape[1])),
-                              {"description": docs[key]})  # fmt: skip
-    attrs = {"fixed_json": json.dumps(spec.fixed), "axes": " ".join(dims),
-             "description": "rollingtop atlas: classification of the meridian model's reduced "
-                            "motions over body parameters and integrals (issue 14)"}  # fmt: skip
-    return xr.Dataset(data_vars, coords={k: v for k, v in spec.axes.items()}, attrs=attrs)
-
-
-def _write(ds: xr.Dataset, output: Path) -> None:
-    """The finished atlas, atomically: NetCDF through a temporary file, Zarr through a
-    temporary store renamed into place."""
-    if output.suffix.lower() == ".nc":
-        write_bytes_atomic(output, netcdf_bytes(ds))
-        return
-    tmp = output.with_name(f".{output.name}.tmp{os.getpid()}")
-    shutil.rmtree(tmp, ignore_errors=True)
-    try:
-        # stored in chunks of at most ZARR_CHUNK along each dimension (dask arrays)
-        chunked = ds.chunk({dim: min(int(n), ZARR_CHUNK) for dim, n in ds.sizes.items()})
-        with warnings.catch_warnings():  # zarr 3: consolidated metadata is an extension
-            warnings.filterwarnings("ignore", message=".*[Cc]onsolidated metadata.*")
-            chunked.to_zarr(tmp, mode="w")
-        old = output.with_name(f".{output.name}.old{os.getpid()}")
-        if output.exists():
-            os.replace(output, old)  # a folder cannot be renamed onto a folder
-            try:
-                os.replace(tmp, output)
-            except OSError:
-                os.replace(old, output)  # put the previous store back
-                raise
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, output)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-
-
-def check_atlas_output(output: str | os.PathLike[str]) -> Path:
-    """The output path, checked before any work (``.nc`` or ``.zarr``; a ``.zarr`` store may
-    exist and is replaced)."""
-    path = Path(output)
-    if path.suffix.lower() == ".zarr" and path.is_dir():
-        if not any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs")):
-            raise AtlasError(f"cannot write {str(path)!r}: a folder that is not a Zarr store "
-                             "is in the way")  # fmt: skip
-        return path
-    try:
-        return check_output_path(path, SUFFIXES)
-    except RollingTopError as exc:
-        raise AtlasError(str(exc)) from None
 
 
 def atlas(

@@ -1,0 +1,136 @@
+"""Storage of the parameter atlas (:mod:`rollingtop.atlas`): the partial folder of finished
+chunks that lets an interrupted run resume, the Dataset of the finished atlas, and its atomic
+write (NetCDF, or a Zarr store renamed into place)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import shutil
+import warnings
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from rollingtop._errors import RollingTopError
+from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from rollingtop.atlas import AtlasSpec
+
+#: Largest chunk along each dimension of a Zarr store.
+ZARR_CHUNK = 64
+SUFFIXES = (".nc", ".zarr")
+
+
+def _partial_folder(output: Path) -> Path:
+    return output.with_name(output.name + ".partial")
+
+
+def _load_partial(folder: Path, digest: str) -> dict[int, dict[str, np.ndarray]]:
+    """Chunks saved by an earlier run of the same spec (``{}`` if none)."""
+    if not folder.exists():
+        return {}
+    try:
+        saved = json.loads((folder / "spec.json").read_text())
+    except (OSError, ValueError):
+        saved = {}
+    if saved.get("digest") != digest:
+        raise _atlas_error(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
+                         "remove it to start over")  # fmt: skip
+    done = {}
+    for f in folder.glob("chunk-*.npz"):
+        with contextlib.suppress(OSError, ValueError, KeyError):
+            with np.load(f) as z:
+                done[int(f.stem.split("-")[1])] = {key: z[key] for key in z.files}
+    return done
+
+
+def _save_chunk(folder: Path, k: int, result: Mapping[str, np.ndarray]) -> None:
+    buf = io.BytesIO()
+    np.savez(buf, **result)  # type: ignore[arg-type]
+    write_bytes_atomic(folder / f"chunk-{k:06d}.npz", buf.getvalue())
+
+
+def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> xr.Dataset:
+    import xarray as xr
+
+    dims = tuple(spec.axes)
+    merged = {key: np.concatenate([parts[k][key] for k in sorted(parts)])
+              for key in parts[min(parts)]}  # fmt: skip
+    data_vars = {}
+    docs = {
+        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large",
+        "n_steady": "steady motions (critical points of U in (-1, 1)); -1: not classified",
+        "n_centres": "steady motions that are centres (U'' > 0)",
+        "n_saddles": "steady motions that are saddles (U'' < 0)",
+        "n_folds": "folds of the (C2, h) bifurcation diagram of (M3, C1)",
+        "rotation_centre": "rotation number psi'/omega at each centre (in order of gamma3)",
+        "centre_gamma3": "gamma3 of each centre",
+    }
+    for key, values in merged.items():
+        if values.ndim == 1:
+            data_vars[key] = (dims, values.reshape(spec.shape), {"description": docs[key]})
+        else:
+            data_vars[key] = ((*dims, "centre"), values.reshape((*spec.shape, values.shape[1])),
+                              {"description": docs[key]})  # fmt: skip
+    attrs = {"fixed_json": json.dumps(spec.fixed), "axes": " ".join(dims),
+             "description": "rollingtop atlas: classification of the meridian model's reduced "
+                            "motions over body parameters and integrals (issue 14)"}  # fmt: skip
+    return xr.Dataset(data_vars, coords={k: v for k, v in spec.axes.items()}, attrs=attrs)
+
+
+def _write(ds: xr.Dataset, output: Path) -> None:
+    """The finished atlas, atomically: NetCDF through a temporary file, Zarr through a
+    temporary store renamed into place."""
+    if output.suffix.lower() == ".nc":
+        write_bytes_atomic(output, netcdf_bytes(ds))
+        return
+    tmp = output.with_name(f".{output.name}.tmp{os.getpid()}")
+    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        # stored in chunks of at most ZARR_CHUNK along each dimension (dask arrays)
+        chunked = ds.chunk({dim: min(int(n), ZARR_CHUNK) for dim, n in ds.sizes.items()})
+        with warnings.catch_warnings():  # zarr 3: consolidated metadata is an extension
+            warnings.filterwarnings("ignore", message=".*[Cc]onsolidated metadata.*")
+            chunked.to_zarr(tmp, mode="w")
+        old = output.with_name(f".{output.name}.old{os.getpid()}")
+        if output.exists():
+            os.replace(output, old)  # a folder cannot be renamed onto a folder
+            try:
+                os.replace(tmp, output)
+            except OSError:
+                os.replace(old, output)  # put the previous store back
+                raise
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, output)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def check_atlas_output(output: str | os.PathLike[str]) -> Path:
+    """The output path, checked before any work (``.nc`` or ``.zarr``; a ``.zarr`` store may
+    exist and is replaced)."""
+    path = Path(output)
+    if path.suffix.lower() == ".zarr" and path.is_dir():
+        if not any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs")):
+            raise _atlas_error(f"cannot write {str(path)!r}: a folder that is not a Zarr store "
+                             "is in the way")  # fmt: skip
+        return path
+    try:
+        return check_output_path(path, SUFFIXES)
+    except RollingTopError as exc:
+        raise _atlas_error(str(exc)) from None
+
+
+def _atlas_error(message: str) -> RollingTopError:
+    from rollingtop.atlas import AtlasError
+
+    return AtlasError(message)
