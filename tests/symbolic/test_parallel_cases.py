@@ -61,6 +61,7 @@ def test_density_obstruction_and_the_limit_density():
     assert not _reduce(density / (s_sym * K)).free_symbols & {P.G, s_sym}
 
 
+@pytest.mark.slow  # ~5 s; also in rollingtop verify (test_every_claim_is_proved)
 def test_the_cases_claims_are_proved():
     for claim in P.claims():
         result = check(claim)

@@ -74,6 +74,7 @@ def _random_state(rng, body):
     return y
 
 
+@pytest.mark.slow  # ~15 s; rollingtop verify proves them too (test_every_claim_is_proved)
 @pytest.mark.parametrize("group", GROUPS)
 def test_claims_are_proved(pair_claims, group):
     chosen = [c for c in pair_claims if group in c.name]
