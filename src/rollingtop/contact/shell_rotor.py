@@ -222,11 +222,12 @@ def accelerations(
 
 @inline
 def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
-    """The pair's accelerations (:func:`accelerations`); ``delta'`` is the model's
-    :func:`direction_rate`. The reaction's rows for
+    """The pair's accelerations (:func:`accelerations`), ``delta'`` included (the kernel writes
+    the kinematics first, :func:`direction_rate` a placeholder). The reaction's rows for
     :func:`rollingtop.dynamics._kernel.reaction`: the contact force along the body axes."""
-    vd1, vd2, vd3, wd1, wd2, wd3, _, l1, l2, l3 = accelerations(p, y)
+    vd1, vd2, vd3, wd1, wd2, wd3, dd, l1, l2, l3 = accelerations(p, y)
     dy[0], dy[1], dy[2], dy[3], dy[4], dy[5] = vd1, vd2, vd3, wd1, wd2, wd3
+    dy[DELTA] = dd  # after the kinematics (rollingtop.dynamics._kernel.rhs)
     dirs, lam = ws[2], ws[4]
     for k in range(3):
         for c in range(3):
@@ -237,8 +238,9 @@ def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: 
 
 @inline
 def direction_rate(p: FloatArray, y: FloatArray, variant: int) -> float:
-    """``delta'``, the rate of the state's last slot (:func:`accelerations`)."""
-    return accelerations(p, y)[6]
+    """0: the rate of the state's last slot, ``delta'``, is written by :func:`accel` with the
+    accelerations (computed once)."""
+    return 0.0
 
 
 @inline

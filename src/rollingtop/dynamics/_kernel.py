@@ -113,10 +113,12 @@ def rhs(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) 
     """
     # the model's closed form where it has one (the general path, rhs_rows, serves any model and
     # is what a new model needs; a closed form is an optional speed-up)
+    # the kinematics first: a model whose last slot is a velocity of its own (shell-rotor) sets
+    # its rate with the accelerations
+    _kinematics(code, p, y, dy)
     nc = _dispatch.accel(code, p, y, dy, ws)
     if nc < 0:
         return rhs_rows(code, p, y, dy, ws)
-    _kinematics(code, p, y, dy)
     return nc
 
 
