@@ -82,6 +82,7 @@ __all__ = [
     "bifurcation_diagram",
     "critical_c2",
     "critical_energy",
+    "describe_signature",
     "folds",
     "region_orbits",
     "region_signature",
