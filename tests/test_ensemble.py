@@ -111,6 +111,33 @@ def test_samples_bodies_and_pole_cases(paper_body):
         simulate_ensemble(paper_body, "meridian", [plain], t_end=1.0)  # made for another body
 
 
+@pytest.mark.parametrize(
+    ("example", "expected"),
+    [
+        ("shell_rotor.toml", {"energy", "lagrange", "jellett", "F6"}),
+        # a3 = 0, I3 = I1: the particular integral (the slip along nu) is monitored too
+        ("parallel_balanced.toml", {"energy", "jellett", "slip_nu"}),
+        ("rubber.toml", None),
+    ],
+)
+def test_new_models_match_single_runs(example, expected):
+    """The ensemble integrates every registered model as a single run does, and monitors the
+    integrals the model claims for the body (its particular ones included), as a trajectory does."""
+    sc = load_scenario(EXAMPLES / example).with_overrides(t_end=3.0, rtol=1e-11)
+    single = simulate(sc)
+    names = set(single.integrals)
+    if expected is not None:
+        assert names == expected
+    res = simulate_ensemble(sc.body, sc.model, [sc.y0, sc.y0], t_end=3.0, rtol=1e-11,
+                            atol=sc.integration.resolved_atol)  # fmt: skip
+    assert set(res.integrals) == names and np.all(res.status == 0)
+    np.testing.assert_allclose(res.final[1], single.y[-1], rtol=0, atol=SAME_RUN)
+    for name in names:
+        ref = single.integrals[name][-1] - single.integrals[name][0]
+        assert res.integrals[name]["drift"][0] == pytest.approx(ref, abs=1e-12), name
+        assert abs(ref) < 1e-9, name
+
+
 def test_cli_ensemble(capsys, tmp_path):
     out = tmp_path / "ens.nc"
     csv = tmp_path / "ic.csv"

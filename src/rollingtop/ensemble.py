@@ -338,11 +338,12 @@ def _ensemble_integrals(
     initial: FloatArray,
     final: FloatArray,
 ) -> dict[str, dict[str, FloatArray]]:
-    shared: set[str] = set()  # the integrals every body has
-    for k, b in enumerate({id(b): b for b in bodies}.values()):
-        own = set(model.integrals(b.symmetric))
-        shared = own if k == 0 else shared & own
-    names = [n for n in model.integrals(True) if n in shared]
+    # the integrals every body has (with the model's particular ones, e.g. parallel's slip)
+    unique = list({id(b): b for b in bodies}.values())
+    shared = set(model.integrals_for(unique[0]))
+    for b in unique[1:]:
+        shared &= set(model.integrals_for(b))
+    names = [n for n in model.integrals_for(unique[0]) if n in shared]
     result: dict[str, dict[str, FloatArray]] = {
         n: {"initial": np.empty(len(bodies)), "final": np.empty(len(bodies))} for n in names
     }
