@@ -60,7 +60,11 @@ def switch_model(
 
 
 def _projected(scenario: Scenario, model: ContactModel) -> Scenario:
-    y = project_state(scenario.body, model, scenario.require_state())
+    try:
+        body = model.body_for(scenario.body)
+    except ValueError as err:
+        raise InitialStateError(str(err)) from None
+    y = project_state(body, model, scenario.require_state(), source=scenario.model)
     return replace(scenario, model=model, initial=InitialConditions.from_state(y), level=None)
 
 

@@ -56,6 +56,42 @@ def test_level_states_hold_every_integral(paper_state, chaotic):
         assert np.ptp(Y[:, 14]) > 0.05  # the orientations differ
 
 
+def test_level_states_of_the_shell_rotor_pair():
+    """The pair's level: the shell's spin (the state's last slot) is set with the velocities, so
+    the samples hold the pair's integrals; checked here by the pair's energy written out (rotor
+    + shell, docs/model.md) and by the shell's rolling without slip, and simulate takes them."""
+    from rollingtop import load_scenario, simulate
+
+    from ..conftest import EXAMPLES
+
+    sc = load_scenario(EXAMPLES / "shell_rotor.toml")
+    body, y0 = sc.body, sc.y0
+    Y = level_states(body, "shell-rotor", y0, 5, seed=2)
+    e3 = np.array([0.0, 0.0, 1.0])
+
+    def pair_energy(y):
+        v, w, gamma, delta = y[0:3], y[3:6], y[12:15], y[17]
+        v_centre = v - body.a3 * np.cross(w, e3)  # the shell's centre, the rotor's geometric one
+        shell_w = w + delta * e3  # the shell turns with the rotor but about its axis
+        rotor = 0.5 * body.m * v @ v + 0.5 * w @ (np.array(body.inertia) * w)
+        shell = (
+            0.5 * body.shell_mass * v_centre @ v_centre
+            + 0.5 * body.shell_inertia * shell_w @ shell_w
+        )
+        return rotor + shell + body.m * body.g * body.a3 * gamma[2], v_centre - body.R * np.cross(
+            shell_w, gamma
+        )
+
+    e0, _ = pair_energy(y0)
+    for y in Y:
+        e, slip = pair_energy(y)
+        assert e == pytest.approx(e0, abs=1e-9 * (1 + abs(e0)))
+        np.testing.assert_allclose(slip, 0.0, atol=1e-12)  # the shell rolls without slipping
+    assert np.ptp(Y[:, 14]) > 0.05
+    run = simulate(body, "shell-rotor", Y[3], t_end=1.0)  # a consistent pair state
+    assert abs(run.integrals["energy"][-1] - run.integrals["energy"][0]) < 1e-9
+
+
 def test_level_states_refuse_bad_input(paper_state):
     with pytest.raises(InitialStateError, match="routh"):
         level_states(PAPER, "meridian", paper_state, 3, hold=["routh"])

@@ -155,3 +155,26 @@ def test_a_state_whose_shell_spin_disagrees_with_v_is_refused():
     y[17] += 0.5
     with pytest.raises(RollingTopError, match="the shell's spin"):
         simulate(body, MODEL, y, t_end=1.0)
+
+
+def test_the_pairs_state_under_the_other_models():
+    """compare / --model from a pair: the last slot is the shell's spin, not a direction; the
+    other models start from the axis azimuth. The rotor's state already satisfies the meridian
+    constraint (its contact point slips only across the axis: v_P = R delta e3 x gamma), so the
+    meridian model takes it unchanged."""
+    from rollingtop import load_scenario, simulate_models
+    from rollingtop.simulate import switch_model
+
+    sc = load_scenario(EXAMPLES / "shell_rotor.toml").with_overrides(t_end=0.5)
+    y = sc.y0
+    to_meridian, change = switch_model(sc, "meridian")
+    np.testing.assert_allclose(change, 0.0, atol=1e-12)
+    azimuth = math.atan2(y[11], y[8])
+    for name in ("meridian", "parallel"):
+        switched, _ = switch_model(sc, name)
+        assert switched.y0[17] == pytest.approx(azimuth, abs=1e-12), name
+    runs = simulate_models(sc)
+    assert set(runs) == set(MODELS)
+    for name, run in runs.items():
+        for integral, values in run.integrals.items():
+            assert abs(values[-1] - values[0]) < 1e-9, (name, integral)

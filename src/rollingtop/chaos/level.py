@@ -12,11 +12,14 @@ subset ``hold``. A sample is drawn in two steps:
    an orthonormal basis of it. Every integral but the energy is linear in ``u`` for the models
    of the registry; their values fix ``c`` up to the null space ``N`` of their (numerical)
    Jacobian: ``c = c_p + x n`` with ``c_p`` the least-squares solution and ``n`` a random unit
-   direction of ``N``, orthogonal to ``c_p`` in the kinetic-energy metric. The energy then fixes
-   ``x^2``, with a random sign; an orientation where the level's energy is out of reach is
-   drawn again. Newton iterations on all held integrals (least-squares steps) polish the result,
-   so an integral that is not linear in ``u`` is held as well, and each sample is checked: every
-   held integral within :data:`LEVEL_RTOL` of its value (relative to ``1 +`` its size).
+   direction of ``N``, orthogonal to ``c_p`` in the kinetic-energy metric. The energy, quadratic
+   in ``x``, then fixes ``x`` (one of its two roots at random); an orientation where the level's
+   energy is out of reach is drawn again. A model with its own velocity in the state's last
+   slot (:attr:`~rollingtop.contact.ContactModel.slot_value`: the shell-rotor pair's shell
+   spin) has it set from ``u`` at every evaluation, so its integrals are the pair's. Newton
+   iterations on all held integrals (least-squares steps) polish the result, so an integral that
+   is not linear in ``u`` is held as well, and each sample is checked: every held integral within
+   :data:`LEVEL_RTOL` of its value (relative to ``1 +`` its size).
 
 The orientations are uniform; the velocities are not uniform in the level's invariant measure
 (there is none in general for a nonholonomic model), which a Poincare section does not need.
@@ -131,6 +134,9 @@ def _sample(
     def states(c: FloatArray) -> FloatArray:
         Y = np.repeat(y[None, :], len(c), axis=0)
         Y[:, :6] = c @ basis
+        if model.slot_value is not None:  # the model's own velocity (the pair's shell spin)
+            for row in Y:
+                row[17] = model.slot_value(body, row)
         return Y
 
     def jacobian(c: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -157,13 +163,15 @@ def _sample(
     n -= c * (n @ Mb @ c) / (c @ Mb @ c) if c @ Mb @ c > 0 else 0.0
     if not np.linalg.norm(n) > 1e-12:
         return None
-    T_c = 0.5 * c @ Mb @ c
-    T_n = 0.5 * n @ Mb @ n
-    E_c = float(_values(body, states(c[None, :]), ["energy"])[0, 0])
-    x2 = (target[energy_row] - E_c) / T_n
-    if not x2 >= 0.0 or T_c < 0:
+    # the energy along c + x n is quadratic in x (the kinetic energy is a quadratic form in the
+    # velocities, the model's own slot included): E(x) = e0 + b x + a x^2 from three values
+    e_m, e0, e_p = _values(body, states(np.array([c - n, c, c + n])), ["energy"])[:, 0]
+    a, b = 0.5 * (e_p + e_m) - e0, 0.5 * (e_p - e_m)
+    disc = b * b - 4.0 * a * (e0 - target[energy_row])
+    if not (a > 0.0 and disc >= 0.0):
         return None
-    c = c + rng.choice((-1.0, 1.0)) * math.sqrt(x2) * n
+    x = (-b + rng.choice((-1.0, 1.0)) * math.sqrt(disc)) / (2.0 * a)
+    c = c + x * n
     for _ in range(20):  # Newton, least-squares steps
         F, Jac = jacobian(c)
         res = target - F

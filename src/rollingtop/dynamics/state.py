@@ -242,7 +242,13 @@ def initial_state(
     return y
 
 
-def project_state(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -> FloatArray:
+def project_state(
+    body: SphericalTop,
+    model: str | ContactModel,
+    y: ArrayLike,
+    *,
+    source: str | ContactModel | None = None,
+) -> FloatArray:
     """The state nearest to ``y`` that satisfies ``model``'s constraints.
 
     Orientation, position and ``psi_nu`` are kept; the velocities ``u = (v, w)`` move to the
@@ -253,9 +259,16 @@ def project_state(body: SphericalTop, model: str | ContactModel, y: ArrayLike) -
     :attr:`~ContactModel.vertical_tolerance` is set exactly vertical, and ``psi_nu`` becomes the
     model's carried direction there (meridian: the direction in which the axis leaves the
     vertical; kept when ``w1 = w2 = 0``, where it is free).
+
+    ``source`` is the model ``y`` was made for, if another: where its last slot is its own
+    (:attr:`~ContactModel.slot_value`; the shell-rotor pair's shell spin) and ``model``'s is a
+    direction, the slot starts again from the axis azimuth, as in :func:`initial_state`.
     """
     model = get_model(model)
     y = np.array(y, dtype=float)
+    if source is not None and get_model(source).slot_value is not None and model.slot_value is None:
+        a3, b3 = float(y[8]), float(y[11])
+        y[17] = math.atan2(b3, a3) if math.hypot(a3, b3) > 0 else 0.0
     gamma = _vertical(model, y[12:15])
     if model.singular is not None and (why := model.singular(body, gamma)) is not None:
         raise InitialStateError(f"model {model.name!r}: {why}")
