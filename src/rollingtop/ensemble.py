@@ -16,7 +16,7 @@ from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, kernel_by_code
-from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.ensemble_tables import (
     MAX_TABLE_BYTES,
@@ -147,8 +147,7 @@ class EnsembleResult(NetCDFOutput):
         """Per-trajectory results as an :class:`xarray.Dataset` (samples included if kept)."""
         import xarray as xr
 
-        comp = [f"{k}{i}" for k in ("v", "omega", "alpha", "beta", "gamma") for i in (1, 2, 3)]
-        comp += ["X", "Y", "psi_nu"]
+        comp = state_components(self.model.slot_name)
         data: dict[str, tuple[str | tuple[str, ...], NDArray[Any]]] = {
             "initial_state": (("trajectory", "state"), self.initial),
             "final_state": (("trajectory", "state"), self.final),

@@ -362,6 +362,9 @@ class Trajectory(NetCDFOutput):
         for name, values in self.integrals.items():
             cols.append(name)
             blocks.append(values[:, None])
+        for name, values in self.model_outputs.items():  # shell-rotor: shell_omega1..3, ...
+            cols += [f"{name}{c}" for c in "123"]
+            blocks.append(values)
         return cols, np.hstack(blocks)
 
     def to_csv(self, path: str | os.PathLike[str]) -> Path:

@@ -223,3 +223,9 @@ def test_an_omega_against_a_spin_constraint_is_refused(name):
         y = initial_state(SYMMETRIC, model, gamma=gamma, omega=inside)
         assert abs(y[3:6] @ d) < 1e-15 * np.linalg.norm(good)
         np.testing.assert_allclose(y[3:6], good, atol=UNIT_TOLERANCE * np.linalg.norm(good))
+
+
+def test_every_model_has_its_own_colour():
+    """compare draws every model in its colour: no two alike."""
+    colours = [model.colour.lower() for model in MODELS.values()]
+    assert len(set(colours)) == len(colours), colours

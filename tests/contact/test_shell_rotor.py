@@ -178,3 +178,27 @@ def test_the_pairs_state_under_the_other_models():
     for name, run in runs.items():
         for integral, values in run.integrals.items():
             assert abs(values[-1] - values[0]) < 1e-9, (name, integral)
+
+
+def test_the_pairs_outputs_name_the_shell(tmp_path):
+    """CSV and NetCDF carry the shell's angular velocity and the bearing torque as --json does,
+    and the state's last slot is called the shell's spin, not a direction."""
+
+    from rollingtop import load_scenario, simulate_ensemble
+
+    sc = load_scenario(EXAMPLES / "shell_rotor.toml").with_overrides(t_end=0.5, samples=6)
+    run = simulate(sc)
+    outputs = run.model_outputs
+    header = run.to_csv(tmp_path / "pair.csv").read_text().splitlines()
+    header = [line for line in header if not line.startswith("#")]
+    cols = header[0].split(",")
+    table = np.loadtxt(header[1:], delimiter=",")
+    for name in ("shell_omega", "bearing_torque"):
+        idx = [cols.index(f"{name}{c}") for c in "123"]
+        np.testing.assert_allclose(table[:, idx], outputs[name], rtol=1e-15, atol=1e-300)
+    # the shell turns with the rotor and about the axis by the slot's spin
+    np.testing.assert_allclose(outputs["shell_omega"] - run.y[:, 3:6],
+                               np.outer(run.y[:, 17], [0, 0, 1]), atol=1e-14)  # fmt: skip
+    ens = simulate_ensemble(sc.body, sc.model, [sc.y0], t_end=0.5, samples=3)
+    ds = ens.to_xarray()
+    assert list(ds["state"].values[-3:]) == ["X", "Y", "shell_spin"]

@@ -34,7 +34,7 @@ from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.chaos._tangent import REACHED_VERTICAL, run_indicators
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
 from rollingtop.integrate._dop853 import FINISHED, STATUS_NAMES
@@ -157,8 +157,6 @@ class ChaosIndicators(NetCDFOutput):
         """The time series as an :class:`xarray.Dataset` (dimension ``t``)."""
         import xarray as xr
 
-        from rollingtop.chaos.section import STATE_COMPONENTS
-
         data = {
             "lyapunov": ("t", self.lyapunov),
             "megno": ("t", self.megno),
@@ -169,7 +167,9 @@ class ChaosIndicators(NetCDFOutput):
         attrs: dict[str, Any] = {f"body_{k}": v for k, v in self.body.to_dict().items()}
         attrs.update(model=self.model.name, source="rollingtop chaos",
                      summary_json=json.dumps(self.summary()))  # fmt: skip
-        return xr.Dataset(data, coords={"t": self.t, "state": STATE_COMPONENTS}, attrs=attrs)
+        return xr.Dataset(
+            data, coords={"t": self.t, "state": state_components(self.model.slot_name)}, attrs=attrs
+        )
 
 
 def chaos_indicators(

@@ -44,7 +44,7 @@ from rollingtop.chaos._kernels import SECTION_STATS, section_batch
 from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import reduced_components
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
 from rollingtop.integrate._dop853 import STATUS_NAMES
@@ -56,8 +56,7 @@ if TYPE_CHECKING:
 __all__ = ["STATE_COMPONENTS", "poincare_section"]
 
 #: Names of the state components (the ``state`` coordinate of the datasets).
-STATE_COMPONENTS = [f"{k}{i}" for k in ("v", "omega", "alpha", "beta", "gamma") for i in (1, 2, 3)]
-STATE_COMPONENTS += ["X", "Y", "psi_nu"]
+STATE_COMPONENTS = state_components()
 #: Largest number of crossings stored (trajectories times crossings).
 MAX_POINTS = 20_000_000
 #: Default number of trajectories when a single state is given.
@@ -205,7 +204,7 @@ def poincare_section(
         status_names=json.dumps({str(k): v for k, v in STATUS_NAMES.items()}),
     )  # fmt: skip
     coords = {"trajectory": np.arange(K), "crossing": np.arange(crossings),
-              "state": STATE_COMPONENTS}  # fmt: skip
+              "state": state_components(model.slot_name)}  # fmt: skip
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -172,6 +172,10 @@ class ContactModel:
         ``slot_value(body, y) -> float``: the state's last slot for a new state whose ``v``,
         ``w`` and frame are set (:func:`rollingtop.initial_state`), for a model that keeps a
         variable of its own there (``shell-rotor``: the shell's relative spin).
+    slot_name : str
+        Name of the state's last slot in the outputs: ``psi_nu`` (the constraint direction's
+        azimuth) unless the model keeps its own velocity there (``shell-rotor``:
+        ``shell_spin``, the shell's spin about the axis relative to the rotor).
     state_outputs : callable or None
         ``state_outputs(body, Y) -> {name: array (n, 3)}``: further per-sample quantities of
         the model's states ``Y`` (n, 18) for the outputs (``shell-rotor``: the shell's angular
@@ -214,6 +218,7 @@ class ContactModel:
     devices: tuple[str, ...] = ()
     state_outputs: Callable[[SphericalTop, FloatArray], dict[str, FloatArray]] | None = None
     slot_value: Callable[[SphericalTop, FloatArray], float] | None = None
+    slot_name: str = "psi_nu"
 
     def integrals(self, symmetric: bool) -> tuple[str, ...]:
         """Names of the first integrals of this model for a (non-)symmetric body."""

@@ -181,5 +181,5 @@ MODEL = ContactModel(
     symbolic_velocity=_symbolic_velocity,
     spin_directions=_spin_directions,
     symbolic_omega=_symbolic_omega,
-    colour="#9467bd",
+    colour="#ff7f0e",
 )

@@ -343,6 +343,7 @@ MODEL = ContactModel(
     own_inertia=True,
     devices=("shell",),
     slot_value=relative_spin,
+    slot_name="shell_spin",
     state_outputs=outputs,
     symbolic_claims="rollingtop.symbolic.shell_rotor:claims",
     colour="#8c564b",

@@ -8,8 +8,11 @@ the azimuth in the fixed frame of the meridian constraint's direction ``nu``.
 ``psi_nu`` equals the axis azimuth ``psi = atan2(beta3, alpha3)`` (unwrapped) away from the
 poles. In a pole case of the meridian model it is *carried* through the pole, where ``psi`` is
 undefined, and after a pole passage it differs from ``psi`` by ``pi`` (the paper's ``tau, n``
-and ``nu`` change sign there): see :mod:`rollingtop.contact.meridian`. Parameters travel as the
-vector ``p = (R, m, g, a3, I1, I2, I3)`` (:attr:`rollingtop.SphericalTop.params`).
+and ``nu`` change sign there): see :mod:`rollingtop.contact.meridian`. A model may keep a
+velocity of its own in that slot instead (:attr:`rollingtop.contact.ContactModel.slot_name`; the
+``shell-rotor`` pair: the shell's spin relative to the rotor). Parameters travel as the vector
+``p = (R, m, g, a3, I1, I2, I3, shell_mass, shell_inertia)``
+(:attr:`rollingtop.SphericalTop.params`).
 """
 
 V = slice(0, 3)
@@ -20,5 +23,14 @@ GAMMA = slice(12, 15)
 POSITION = slice(15, 17)
 PSI_NU = 17
 N_STATE = 18
+
+
+def state_components(slot_name: str = "psi_nu") -> list[str]:
+    """Names of the 18 state components, the last as the model calls it
+    (:attr:`rollingtop.contact.ContactModel.slot_name`)."""
+    names = [f"{k}{i}" for k in ("v", "omega", "alpha", "beta", "gamma") for i in (1, 2, 3)]
+    return [*names, "X", "Y", slot_name]
+
+
 #: Largest number of constraint rows a contact model may impose (rubber rolling: 4).
 MAX_ROWS = 4
