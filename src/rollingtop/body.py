@@ -57,9 +57,10 @@ class SphericalTop:
         the paper). The triangle inequalities of a rigid body must hold.
     shell_mass, shell_inertia : float, optional
         Mass of a spherical shell of radius ``R`` around the body and its moment of inertia
-        about a diameter (a thin shell: ``2/3 shell_mass R^2``), ``>= 0``, default 0: the
-        ``shell-rotor`` model (:mod:`rollingtop.contact.shell_rotor`), where the body is the
-        rotor inside the shell. Other models ignore them.
+        about a diameter (a thin shell: ``2/3 shell_mass R^2``), ``>= 0`` (the inertia ``> 0``
+        where the mass is), default 0: the ``shell-rotor`` model
+        (:mod:`rollingtop.contact.shell_rotor`), where the body is the rotor inside the shell.
+        Other models ignore them.
 
     Raises
     ------
@@ -103,6 +104,12 @@ class SphericalTop:
         for name in ("g", "shell_mass", "shell_inertia"):
             if name in values and values[name] < 0:
                 problems.append(f"{name} = {values[name]:g} must be >= 0")
+        if values.get("shell_mass", 0.0) > 0 and values.get("shell_inertia") == 0.0:
+            problems.append(
+                f"shell_inertia = 0 with shell_mass = {values['shell_mass']:g} > 0: a shell has "
+                "inertia about its diameters (a thin one 2/3 shell_mass R^2); without it the "
+                "shell-rotor pair is singular at a vertical axis"
+            )
         if all(k in values and values[k] > 0 for k in ("I1", "I2", "I3")):
             i1, i2, i3 = values["I1"], values["I2"], values["I3"]
             for name, lhs, a, b, rest in (

@@ -143,8 +143,24 @@ def test_the_shell_table_is_required_and_only_for_the_pair():
         Scenario.from_dict(other)
     with pytest.raises(RollingTopError, match="shell_mass = -1 must be >= 0"):
         Scenario.from_dict({**data, "shell": {"mass": -1.0, "inertia": 0.1}})
+    with pytest.raises(RollingTopError, match="shell_inertia = 0 with shell_mass = 0.2"):
+        Scenario.from_dict({**data, "shell": {"mass": 0.2, "inertia": 0.0}})
     # switching a pair's scenario to another model drops the shell (no energy terms of it)
     assert not Scenario.from_dict(data).with_overrides(model="meridian").body.has_shell
+
+
+def test_at_a_vertical_axis_the_pairs_contact_point_cannot_slip():
+    """The shell's spin about the vertical does not move the contact point: the rotor's v_tau
+    (its contact point's slip for the meridian model) must be 0 there, and the state is the
+    rolling one, v = -w x r."""
+    body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5, shell_mass=0.2,
+                        shell_inertia=0.2 * 2 / 3)  # fmt: skip
+    omega = np.array([2.0, -0.2, 3.0])
+    with pytest.raises(RollingTopError, match="v_tau = 0.3: at a vertical axis"):
+        initial_state(body, "shell-rotor", gamma=(0, 0, 1), omega=omega, free={"v_tau": 0.3})
+    y = initial_state(body, "shell-rotor", gamma=(0, 0, 1), omega=omega)
+    r = np.array([0.0, 0.0, -body.R - body.a3])  # contact point from the centre of mass
+    np.testing.assert_allclose(y[0:3], -np.cross(omega, r), atol=1e-15)
 
 
 def test_a_state_whose_shell_spin_disagrees_with_v_is_refused():

@@ -305,8 +305,18 @@ def _velocity(
     beta: FloatArray,
     free: FreeVelocity,
 ) -> FloatArray:
-    """The rotor's ``v`` exactly as for the meridian model (free ``v_tau``)."""
+    """The rotor's ``v`` exactly as for the meridian model (free ``v_tau``). At a vertical axis
+    the shell's spin does not move the contact point, which then cannot slip: only
+    ``v_tau = 0`` is the pair's (an ``InitialStateError`` otherwise)."""
     from rollingtop.contact import meridian
+
+    if gamma[0] == 0.0 and gamma[1] == 0.0 and free["v_tau"] != 0.0:
+        from rollingtop._errors import InitialStateError
+
+        raise InitialStateError(
+            f"v_tau = {free['v_tau']:g}: at a vertical axis the shell-rotor pair's contact point "
+            "cannot slip (the shell's spin about the vertical does not move it); give v_tau = 0"
+        )
 
     return meridian.MODEL.velocity(body, gamma, omega, alpha, beta, free)
 
