@@ -1,6 +1,7 @@
 """Symbolic layer: the derived equations equal the compiled kernel; the claims are proved; a wrong
 claim fails; the discovery helper finds F6."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -144,3 +145,23 @@ def test_cli_verify(capsys):
         assert c["result"] == "proved"
     assert any("routh" in c["name"] for c in claims)
     assert len(claims_for("rough")) == len(claims)
+
+
+LOST = [
+    ("parallel", {"lagrange", "area"}),
+    ("rough", {"lagrange", "area"}),
+    ("rubber", {"lagrange", "jellett", "area"}),
+]
+
+
+@pytest.mark.parametrize(("model", "lost"), LOST)
+def test_verify_shows_the_lost_integrals_vary(model, lost):
+    """The classical integrals a model does not claim are claims of their own, "not conserved",
+    proved by a nonzero rate; the same negated claim of a conserved integral fails."""
+    negated = {c.name: c for c in claims_for(model) if not c.vanishes}
+    assert set(negated) == {f"{n} integral not conserved" for n in lost}
+    for claim in negated.values():
+        assert check(claim).result == "proved", claim.name
+    energy = next(c for c in claims_for(model) if c.name == "energy integral conserved")
+    wrong = dataclasses.replace(energy, name="energy not conserved", vanishes=False)
+    assert check(wrong).result == "failed"

@@ -37,6 +37,8 @@ __all__ = ["Claim", "ClaimResult", "claims_for", "decide", "verify"]
 EXACT_OPS_LIMIT = 4000
 #: Random rational points of the fallback.
 N_POINTS = 4
+#: The classical integrals of a rolling top: each one a model does not claim is shown to vary.
+LOST_CANDIDATES = ("lagrange", "jellett", "area")
 
 S = SYMBOLS
 # extra symbols: s = sqrt(gamma1^2 + gamma2^2) and theta = arccos(gamma3) as variables with
@@ -57,7 +59,9 @@ spin = sp.symbols("w_a w_b", real=True)
 class Claim:
     """``expr`` must vanish on the manifold of ``model``; ``kind``: "integral" (``expr`` is the
     integral, its time derivative is tested), "identity" (``expr`` itself) or "given" (an
-    already-built expression of the state and ``s``)."""
+    already-built expression of the state and ``s``). With ``vanishes=False`` the claim is the
+    opposite, that ``expr`` (its rate, for an integral) is not identically zero: an integral the
+    model does not conserve, proved by exact simplification or by a rational counterexample."""
 
     name: str
     model: str
@@ -67,6 +71,7 @@ class Claim:
     #: parameter values of a particular case, ``((symbol, value), ...)``, substituted into the
     #: expression to decide (after the time derivative)
     params: tuple[tuple[Any, Any], ...] = ()
+    vanishes: bool = True
 
 
 @dataclass(frozen=True)
@@ -248,6 +253,10 @@ def claims_for(model: str) -> list[Claim]:
         out.append(Claim(label, model, F[name]))
     out.append(Claim("energy integral conserved, general body (I1 != I2)", model, F["energy"],
                      symmetric=False))  # fmt: skip
+    # the classical integrals the model loses: shown to vary (a nonzero rate)
+    for name in LOST_CANDIDATES:
+        if name not in get_model(model).integrals_symmetric:
+            out.append(Claim(f"{name} integral not conserved", model, F[name], vanishes=False))
     if get_model(model).has_reduction:
         out.append(
             Claim(
@@ -276,7 +285,8 @@ def check(claim: Claim, seed: int = 1) -> ClaimResult:
     else:
         expr = claim.expr
     holds, method = decide(expr, claim.model, claim.symmetric, seed=seed, params=claim.params)
-    return ClaimResult(claim.name, claim.model, "proved" if holds else "failed", method,
+    proved = holds == claim.vanishes
+    return ClaimResult(claim.name, claim.model, "proved" if proved else "failed", method,
                        time.perf_counter() - start)  # fmt: skip
 
 
