@@ -272,3 +272,19 @@ def test_chunks_of_the_compiled_loop_take_the_same_steps(monkeypatch):
     for key in ("steps", "rejected_steps", "rhs_evals"):
         assert chunked.stats[key] == whole.stats[key]
     np.testing.assert_array_equal(chunked.normal_force, whole.normal_force)
+
+
+def test_a_short_parameter_vector_never_reaches_a_kernel():
+    """The kernels read p without bounds checks: the shell-rotor kernel reads the shell's two
+    entries, so the warm-up body and every vector handed to the integrators have all nine (a
+    seven-entry warm-up vector made the first run of a process fail at random)."""
+    from rollingtop.dynamics._layout import N_PARAMS, WARMUP_PARAMS
+    from rollingtop.integrate.ensemble import integrate_batch
+
+    sc = scenario(t_end=1.0, rtol=1e-10)
+    assert len(WARMUP_PARAMS) == N_PARAMS == sc.body.params.shape[0]
+    with pytest.raises(ValueError, match=r"params must have shape \(9,\)"):
+        integrate(MERIDIAN, sc.body.params[:7], sc.y0, [0.0, 1.0], rtol=1e-8, atol=1e-10)
+    with pytest.raises(ValueError, match=r"params must have shape \(1, 9\)"):
+        integrate_batch(np.zeros(1, dtype=np.int64), sc.body.params[None, :7], sc.y0[None, :],
+                        np.array([0.0, 1.0]), rtol=1e-8, atol=1e-10)  # fmt: skip

@@ -199,7 +199,7 @@ def advance(
     ----------
     code : int
         Kernel code of the contact model.
-    p : ndarray, shape (7,)
+    p : ndarray, shape (9,)
         Body parameters.
     z, fz : ndarray, shape (N_AUG,)
         Augmented state (``delta`` of unit norm, on the tangent space) and its derivative.

@@ -32,5 +32,11 @@ def state_components(slot_name: str = "psi_nu") -> list[str]:
     return [*names, "X", "Y", slot_name]
 
 
+#: Length of the parameter vector ``p`` (:attr:`rollingtop.SphericalTop.params`).
+N_PARAMS = 9
+#: ``p`` of the body the kernels are compiled (warmed up) with: the paper's body in a light
+#: shell, every entry read by some kernel (the ``shell-rotor`` kernel reads the shell's two; a
+#: shorter vector made it read past the end, at random a non-finite value).
+WARMUP_PARAMS = (1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5, 0.2, 0.15)
 #: Largest number of constraint rows a contact model may impose (rubber rolling: 4).
 MAX_ROWS = 4

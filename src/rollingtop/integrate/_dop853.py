@@ -211,7 +211,7 @@ def run(
     ----------
     code : int
         Contact model code.
-    p : ndarray, shape (7,)
+    p : ndarray, shape (9,)
         Body parameters.
     y, f : ndarray, shape (18,)
         Current state (projected) and its derivative; updated in place.

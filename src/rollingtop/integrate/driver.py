@@ -16,7 +16,7 @@ from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import KERNELS
 from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._events import EVENTS
-from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop.integrate import _dop853 as dop
 
 __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
@@ -112,7 +112,7 @@ def compile_kernels() -> float:
     if _compile_time is not None:
         return 0.0
     start = time.perf_counter()
-    p = np.array([1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5])
+    p = np.array(WARMUP_PARAMS)
     y = np.zeros(N_STATE)
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
@@ -242,8 +242,8 @@ def integrate(
     code : int
         Kernel code (:class:`rollingtop.contact.Kernel`): ``model.kernel(body, y0).code``, the
         model's own or the variant it picks for this state.
-    params : ndarray, shape (7,)
-        ``SphericalTop.params``.
+    params : ndarray, shape (9,)
+        ``SphericalTop.params`` (:data:`~rollingtop.dynamics._layout.N_PARAMS` entries).
     y0 : ndarray, shape (18,)
         Constraint-consistent initial state (:func:`rollingtop.dynamics.state.initial_state`).
     t_eval : ndarray, shape (n,)
@@ -283,6 +283,9 @@ def integrate(
         raise ValueError("t_eval must be finite")
     if y0.shape != (N_STATE,):
         raise ValueError(f"y0 must have shape ({N_STATE},), got {y0.shape}")
+    params = np.ascontiguousarray(params, dtype=float)
+    if params.shape != (N_PARAMS,):  # the kernels do not check their reads
+        raise ValueError(f"params must have shape ({N_PARAMS},), got {params.shape}")
     if events is not None and events not in EVENTS:
         raise ValueError(f"unknown event {events!r} (known: {', '.join(EVENTS)})")
     if event_direction not in (-1, 0, 1):
@@ -291,7 +294,7 @@ def integrate(
     compile_s = compile_kernels()
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
-        np.asarray(params, dtype=float),
+        params,
         y0,
         t_eval,
         float(rtol),

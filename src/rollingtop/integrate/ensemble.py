@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 from rollingtop._jit import call, compiled
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
+from rollingtop.dynamics._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop.integrate import _dop853 as dop
 
 __all__ = ["integrate_batch", "compile_ensemble"]
@@ -151,7 +151,7 @@ def compile_ensemble() -> float:
     start = time.perf_counter()
     y = np.zeros((1, N_STATE))
     y[0, 6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
-    P = np.array([[1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5]])
+    P = np.array([WARMUP_PARAMS])
     call(_batch, np.zeros(1, dtype=np.int64), P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
            np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
            np.zeros(1, dtype=np.int64))  # fmt: skip
@@ -177,7 +177,7 @@ def integrate_batch(
     ----------
     codes : ndarray of int, shape (N,)
         Kernel code of each trajectory.
-    params : ndarray, shape (N, 7)
+    params : ndarray, shape (N, 9)
         Body parameters of each trajectory.
     states : ndarray, shape (N, 18)
         Constraint-consistent initial states.
@@ -212,6 +212,9 @@ def integrate_batch(
     N = states.shape[0]
     codes = np.ascontiguousarray(codes, dtype=np.int64)
     params = np.ascontiguousarray(params, dtype=float)
+    if params.shape != (N, N_PARAMS) or codes.shape != (N,):  # the kernels do not check reads
+        raise ValueError(f"params must have shape ({N}, {N_PARAMS}) and codes ({N},), got "
+                         f"{params.shape} and {codes.shape}")  # fmt: skip
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     out = np.full((N, t_eval.size, N_STATE), np.nan)
     final = np.full((N, N_STATE), np.nan)
