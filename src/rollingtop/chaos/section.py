@@ -142,7 +142,8 @@ def poincare_section(
         (K, N; NaN beyond a trajectory's crossings), ``crossing_state`` (K, N, 18),
         ``initial_state`` (K, 18), per trajectory ``n_crossings``, ``status`` (0: done, else
         the stepper's code, attribute ``status_names``), ``steps``, ``t_last`` and
-        ``min_normal_force``, and per held integral ``level_<name>`` (its value at each
+        ``min_normal_force`` (over the accepted steps' ends: negative where the body would
+        leave the plane), and per held integral ``level_<name>`` (its value at each
         initial state). Attributes: the body, ``model``, ``held``, ``section``, ``plane``.
         NetCDF-writable (:func:`rollingtop.io.netcdf_bytes`).
     """
@@ -222,6 +223,7 @@ def section_summary(ds: xr.Dataset) -> dict[str, Any]:
         "incomplete": int(np.sum(ds["n_crossings"].values < ds.attrs["crossings"])),
         "max_abs_w_tau": float(w_tau[ok].max()) if ok.any() else None,
         "min_normal_force": float(ds["min_normal_force"].min()),
+        "contact_lost": int(np.sum(ds["min_normal_force"].values < 0)),
         "held": ds.attrs["held"].split(","),
         "level_range": levels,
         "gamma3_range": [float(np.nanmin(ds["gamma3"])), float(np.nanmax(ds["gamma3"]))]

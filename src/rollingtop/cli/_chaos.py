@@ -89,6 +89,11 @@ def section(
     if netcdf is not None:
         write_bytes_atomic(netcdf, netcdf_bytes(ds))
     summary = section_summary(ds)
+    if summary["contact_lost"]:
+        click.echo(f"rollingtop: warning: {summary['contact_lost']} of {summary['trajectories']} "
+                   "trajectories need a negative normal force at some time (the body would leave "
+                   "the plane; the model keeps the contact): drawn with open circles",
+                   err=True)  # fmt: skip
     if as_json:
         click.echo(json.dumps(summary))
         return

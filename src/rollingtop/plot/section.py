@@ -23,12 +23,14 @@ SINGLE_SIZE = 6.0
 
 
 def section_figure(ds: xr.Dataset, *, marker_size: float = 0.6) -> Figure:
-    """The crossings in the plane ``(gamma3, w_n)``, one colour per trajectory, each
-    trajectory's start marked on the level's range of ``gamma3`` below."""
+    """The crossings in the plane ``(gamma3, w_n)``, one colour per trajectory; a trajectory
+    whose normal force turns negative at some time (the body would leave the plane: the model
+    keeps the contact) is drawn with open circles and counted in the title."""
     fig = Figure(figsize=(7.0, 5.6))
     ax = fig.add_subplot()
     K = ds.sizes["trajectory"]
     cmap = colormaps["turbo"]
+    lost = ds["min_normal_force"].values < 0
     for k in range(K):
         g3 = ds["gamma3"].values[k]
         wn = ds["w_n"].values[k]
@@ -38,15 +40,21 @@ def section_figure(ds: xr.Dataset, *, marker_size: float = 0.6) -> Figure:
         # a trajectory whose crossings coincide (the paper's model: one point per orbit) is
         # drawn as one visible dot
         single = max(np.ptp(g3[ok]), np.ptp(wn[ok])) < SAME_POINT
-        ax.plot(g3[ok], wn[ok], ".", ms=SINGLE_SIZE if single else marker_size,
-                color=cmap((k + 0.5) / K), rasterized=True)  # fmt: skip
+        colour = cmap((k + 0.5) / K)
+        if lost[k]:
+            ax.plot(g3[ok], wn[ok], "o", ms=SINGLE_SIZE if single else 4 * marker_size,
+                    mfc="none", mec=colour, mew=0.4, rasterized=True)  # fmt: skip
+        else:
+            ax.plot(g3[ok], wn[ok], ".", ms=SINGLE_SIZE if single else marker_size,
+                    color=colour, rasterized=True)  # fmt: skip
     ax.set_xlabel(r"$\gamma_3$ at the crossing")
     ax.set_ylabel(r"$\omega_n = (\omega, n)$")
     held = ds.attrs["held"].replace(",", ", ")
     energy = float(ds["level_energy"].values[0])
     found = int(ds["n_crossings"].sum())
     ax.set_title(f"Poincare section w_tau = 0 (upward), model {ds.attrs['model']}\n"
-                 f"E = {energy:.6g}; held: {held}; {K} trajectories, {found} crossings",
+                 f"E = {energy:.6g}; held: {held}; {K} trajectories, {found} crossings"
+                 + (f"; {int(lost.sum())} lose contact (open circles)" if lost.any() else ""),
                  fontsize=9)  # fmt: skip
     body = ", ".join(f"{k[5:]} = {ds.attrs[k]:g}" for k in ds.attrs if k.startswith("body_"))
     ax.text(0.01, 0.01, body, transform=ax.transAxes, fontsize=7, color="0.35")
