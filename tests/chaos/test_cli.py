@@ -33,7 +33,7 @@ def test_chaos_json_and_time_series(capsys, tmp_path):
                              "-o", str(nc), "--json")  # fmt: skip
     assert code == 0, err
     summary = json.loads(out)
-    assert set(summary) >= {"lyapunov", "megno"}
+    assert set(summary) >= {"lyapunov", "megno", "wall_time_s", "compile_time_s"}
     assert 0 < summary["lyapunov"] < 0.05
     with xr.open_dataset(nc, engine="h5netcdf") as ds:
         assert ds["lyapunov"].shape == (20,)

@@ -37,7 +37,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
     type=click.Path(dir_okay=False),
     default=None,
     help="CSV of initial conditions: columns gamma1..3, omega1..3, alpha1..3, "
-    "position1..2, v1..3, the model's free components (v_tau, v_horizontal1..2) or "
+    "position1..2, v1..3, the model's free components (v_tau, v_nu, v_horizontal1..2) or "
     "theta; missing ones take the scenario's values.",
 )
 @click.option(

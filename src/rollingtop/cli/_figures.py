@@ -145,7 +145,8 @@ def compare(scenario: str, output: str, t_end: float | None) -> None:
     default="plain",
     show_default=True,
     help="plain wireframe, or the paper's device that realises the meridian constraint: "
-    "roller-bearing sphere, shell with a rotor, sphere of skates (meridian model only).",
+    "roller-bearing sphere, shell with a rotor, sphere of skates (meridian model; the "
+    "shell-rotor model: the shell, turning with its own spin).",
 )
 def animate(
     scenario: str, output: str, fps: int, duration: float, speed: float, camera: str, look: str
