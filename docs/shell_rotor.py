@@ -95,11 +95,11 @@ def sections():
         # how far the crossings of each trajectory stray from its first (0: periodic nutation)
         g3, wn = ds["gamma3"].values, ds["w_n"].values
         spread = float(np.nanmax(np.hypot(g3 - g3[:, :1], wn - wn[:, :1])))
-        with warnings.catch_warnings():  # the meridian model's h = 6.4, 7 lose contact at t ~ 1.5
+        with warnings.catch_warnings():  # lost contacts are drawn faded
             warnings.simplefilter("ignore", ContactLostWarning)
-            runs = [simulate(body, model, y, t_end=50.0, rtol=1e-11, samples=5001).y
+            runs = [simulate(body, model, y, t_end=50.0, rtol=1e-11, samples=5001)
                     for y in states]  # fmt: skip
-        out[ms] = (ds, megno, spread, runs)
+        out[ms] = (ds, megno, spread, [(r.y, r.contact_lost_at is not None) for r in runs])
     return out
 
 
@@ -119,8 +119,10 @@ def figures(rows, slopes, secs):
     fig = Figure(figsize=(13.5, 4.6), layout="constrained")
     axes = fig.subplots(1, len(secs), sharex=True, sharey=True)
     for ax, (ms, (ds, megno, spread, runs)) in zip(axes, secs.items(), strict=True):
-        for k, y in enumerate(runs):
-            ax.plot(y[:, 14], _w_tau(y), lw=0.8, color=f"C{k}", label=f"h = {H[k]:g}")
+        for k, (y, lost) in enumerate(runs):
+            # a motion that loses its contact is faded (a dash pattern fills in as it retraces)
+            ax.plot(y[:, 14], _w_tau(y), lw=0.8, color=f"C{k}", alpha=0.3 if lost else 1.0,
+                    label=f"h = {H[k]:g}" + (" (loses contact)" if lost else ""))  # fmt: skip
             n = int(ds["n_crossings"][k])
             ax.plot(ds["gamma3"][k, :n], ds["w_tau"][k, :n], "o", ms=4, color=f"C{k}")
         what = "meridian model (no shell)" if ms == 0 else f"shell-rotor, thin shell of {ms:g} m"
@@ -129,8 +131,9 @@ def figures(rows, slopes, secs):
     axes[0].set_ylabel(r"$\omega_\tau$")
     axes[0].legend(fontsize=7, loc="lower left")
     fig.suptitle("The rotor's (gamma3, w_tau), t <= 50, from the paper's Fig. 5 level "
-                 "(M3 = 1, C1 = 0.5, C2 = -2). Dots: the section w_tau = 0 upward, "
-                 f"{CROSSINGS} crossings each, on one point")  # fmt: skip
+                 "(M3 = 1, C1 = 0.5, C2 = -2).\nDots: the section w_tau = 0 upward, "
+                 f"{CROSSINGS} crossings each, on one point.\nFaded: the normal force turns "
+                 "negative (the body would leave the plane; the model keeps the contact)")  # fmt: skip
     save_figure(fig, ROOT / "docs" / "shell_sections.png")
 
 
