@@ -133,7 +133,8 @@ def figures(rows, slopes, secs):
     fig.suptitle("The rotor's (gamma3, w_tau), t <= 50, from the paper's Fig. 5 level "
                  "(M3 = 1, C1 = 0.5, C2 = -2).\nDots: the section w_tau = 0 upward, "
                  f"{CROSSINGS} crossings each, on one point.\nFaded: the normal force turns "
-                 "negative (the body would leave the plane; the model keeps the contact)")  # fmt: skip
+                 "negative (the body would leave the plane; the model keeps the contact)"
+                 )  # fmt: skip
     save_figure(fig, ROOT / "docs" / "shell_sections.png")
 
 

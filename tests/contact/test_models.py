@@ -57,10 +57,11 @@ def _for(model, body):
     return dataclasses.replace(body, **SHELL) if model.own_inertia else body
 
 
-def _state(body, model, gamma=TILTED, omega=(0.7, -0.3, 2.0)):
+def _state(body, model, gamma=TILTED, omega=(0.7, -0.3, 2.0), free=None):
     """A state of ``model``; ``omega`` loses its components that the model forbids."""
     omega = admissible_omega(model, gamma, omega)
-    return initial_state(body, model, gamma=gamma, omega=omega, free=_free(model))
+    free = _free(model) if free is None else free
+    return initial_state(body, model, gamma=gamma, omega=omega, free=free)
 
 
 def _run(body, code, y0, t_end, n=201):
@@ -166,7 +167,9 @@ def test_pole_passage(name):
     ``t = 0.3`` and goes on with its constraints and integrals intact."""
     model = MODELS[name]
     body = _for(model, SYMMETRIC)
-    y0 = _state(body, model, gamma=(0.0, 0.0, 1.0), omega=(1.0, 0.5, 3.0))
+    # the shell-rotor pair's contact point cannot slip at a vertical axis: its v_tau is 0 there
+    free = {} if model.own_inertia else None
+    y0 = _state(body, model, gamma=(0.0, 0.0, 1.0), omega=(1.0, 0.5, 3.0), free=free)
     kernel = model.kernel(body, y0)
     out = _run(body, kernel.code, y0, 0.3, n=2).y[-1]
     back = out.copy()
