@@ -12,8 +12,6 @@ the written expression and do not depend on reassociation).
   which cost more than the arithmetic -- the whole stepper ran about twice as slow
   (``benchmarks/``). Such a function must not allocate or return arrays.
 - :func:`inline`: a small helper inlined into its caller at numba's IR level.
-- :func:`called`: a helper compiled once as a function of its own and called (the models
-  outside the paper's: inlining them into every entry point doubled the cold compile).
 - :func:`compiled`: a driver that may allocate (reference counting on), with extra options.
 
 The decorators are typed (they return the function's own type), so that type checkers see the
