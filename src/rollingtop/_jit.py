@@ -46,15 +46,6 @@ def inline(func: F) -> F:
     return cast(F, njit(**BASE_OPTIONS, inline="always")(func))
 
 
-def called(func: F) -> F:
-    """Compile ``func`` as a helper of its own, called from its compiled callers (LLVM may
-    still inline it). Cheaper to compile than :func:`inline` where many entry points inline the
-    same large helper; used by the models outside the paper's (measured: the cold compile of
-    every kernel 122 s with all helpers inlined; the paper's model stays inlined, its step at
-    the speed of hand-written C)."""
-    return cast(F, njit(**BASE_OPTIONS)(func))
-
-
 def compiled(**options: Any) -> Callable[[F], F]:
     """Compile a function that may allocate, with :data:`BASE_OPTIONS` and ``options``."""
 

@@ -60,7 +60,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import called, kernel
+from rollingtop._jit import inline, kernel
 from rollingtop._types import ComplexArray, Float3, Float6, FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
@@ -90,7 +90,7 @@ RESYNC_S = 0.05
 RELAX = 1.0
 
 
-@called
+@inline
 def tau_carried(y: FloatArray) -> Float3:
     """``tau = nu x gamma`` with the carried ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``:
     ``tau = sin(psi_nu) alpha - cos(psi_nu) beta``."""
@@ -98,7 +98,7 @@ def tau_carried(y: FloatArray) -> Float3:
     return s * y[6] - c * y[9], s * y[7] - c * y[10], s * y[8] - c * y[11]
 
 
-@called
+@inline
 def tau_rate(y: FloatArray, t1: float, t2: float, t3: float, rate: float) -> Float3:
     """``tau' = psi_nu' (gamma x tau) + tau x w`` of a carried direction turning at ``rate``."""
     w1, w2, w3 = y[3], y[4], y[5]
@@ -110,7 +110,7 @@ def tau_rate(y: FloatArray, t1: float, t2: float, t3: float, rate: float) -> Flo
     )
 
 
-@called
+@inline
 def _spin_rate(
     p: FloatArray, y: FloatArray, t1: float, t2: float, t3: float, td1: float, td2: float,
     td3: float,
@@ -146,7 +146,7 @@ def _spin_rate(
     )
 
 
-@called
+@inline
 def _pole_residual(
     p: FloatArray, y: FloatArray, t1: float, t2: float, t3: float, K: float
 ) -> float:
@@ -165,7 +165,7 @@ def _pole_residual(
     return residual
 
 
-@called
+@inline
 def pole_rate(p: FloatArray, y: FloatArray) -> float:
     """``K*``: the rate of the carried direction at which ``K'`` has no ``1/sigma`` term (the
     limit of ``psi' = -w_n / s`` along every motion that reaches the pole; module docstring).
@@ -182,7 +182,7 @@ def pole_rate(p: FloatArray, y: FloatArray) -> float:
     return rate
 
 
-@called
+@inline
 def carried_rate(p: FloatArray, y: FloatArray) -> float:
     """``psi_nu'``: the rate ``K = -w_n / sigma`` (``n = e3 x tau``, ``sigma = -(gamma, n)``)
     that keeps the carried ``tau`` perpendicular to the axis (``(tau, e3) = 0``), blended into
@@ -207,7 +207,7 @@ def carried_rate(p: FloatArray, y: FloatArray) -> float:
     return rate
 
 
-@called
+@inline
 def tau_of(p: FloatArray, y: FloatArray) -> Float6:
     """The carried constraint direction and its rate (:func:`carried_rate`)."""
     t1, t2, t3 = tau_carried(y)
@@ -226,14 +226,14 @@ def rows(
     return 2
 
 
-@called
+@inline
 def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """Closed form of the accelerations (:func:`.rhs_contact` with the row along ``tau``)."""
     t1, t2, t3, td1, td2, td3 = tau_of(p, y)
     return rhs_contact(p, y, dy, ws, True, t1, t2, t3, td1, td2, td3)
 
 
-@called
+@inline
 def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     """Closed form of the velocity projection (:func:`.project_contact` with the row along
     ``tau``)."""
@@ -241,13 +241,13 @@ def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     project_contact(p, y, True, t1, t2, t3)
 
 
-@called
+@inline
 def direction_rate(p: FloatArray, y: FloatArray, variant: int) -> float:
     """``psi_nu'``: :func:`carried_rate`."""
     return carried_rate(p, y)
 
 
-@called
+@inline
 def sync_direction(y: FloatArray, variant: int) -> None:
     """Nothing: the carried azimuth is never reset (it relaxes, :func:`carried_rate`)."""
     return

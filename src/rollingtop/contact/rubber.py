@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import called, kernel
+from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._rows import contact_arm_rate, contact_row, free_forces
@@ -52,7 +52,7 @@ def rows(
     return 4
 
 
-@called
+@inline
 def _solve4(
     p: FloatArray,
     r1: float,
@@ -83,7 +83,7 @@ def _solve4(
     return x1 - mu * z1, x2 - mu * z2, x3 - mu * z3, mu
 
 
-@called
+@inline
 def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """Closed form of the accelerations: the rough model's (:func:`.rough.accel`) with the
     torque ``mu gamma`` and the row ``(w', gamma) = -(w, gamma') = 0``, whose right-hand side is
@@ -115,7 +115,7 @@ def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: 
     return 4
 
 
-@called
+@inline
 def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     """Closed form of the velocity projection (:func:`rollingtop.dynamics._kernel.project`):
     ``(lambda, mu) = A^-1 (vp, (w, gamma))``, ``v <- v - lambda / m``,

@@ -53,7 +53,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import called, kernel
+from rollingtop._jit import inline, kernel
 from rollingtop._types import ComplexArray, FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity
 from rollingtop.contact._rows import contact_row, normal_row
@@ -87,7 +87,7 @@ def rows(
     return 2
 
 
-@called
+@inline
 def momenta(
     p: FloatArray, v1: float, v2: float, v3: float, w1: float, w2: float, w3: float, d: float
 ) -> tuple[float, float, float, float, float, float, float]:
@@ -107,7 +107,7 @@ def momenta(
     )
 
 
-@called
+@inline
 def _column(
     p: FloatArray, g1: float, g2: float, g3: float, w1: float, w2: float, w3: float, d: float
 ) -> tuple[float, float, float]:
@@ -122,7 +122,7 @@ def _column(
     )
 
 
-@called
+@inline
 def _dot_mt(
     p: FloatArray, g1: float, g2: float, g3: float, i: int,
     x1: float, x2: float, x3: float, x4: float, x5: float, x6: float, x7: float,
@@ -136,7 +136,7 @@ def _dot_mt(
     return c1 * x1 + c2 * x2 + c3 * x3 + w1 * x4 + w2 * x5 + w3 * x6 + d * x7
 
 
-@called
+@inline
 def _gram(p: FloatArray, g1: float, g2: float, g3: float, i: int, j: int) -> float:
     """``(T^T M T)_ij``."""
     w1 = 1.0 if j == 0 else 0.0
@@ -148,7 +148,7 @@ def _gram(p: FloatArray, g1: float, g2: float, g3: float, i: int, j: int) -> flo
     return _dot_mt(p, g1, g2, g3, i, m1, m2, m3, m4, m5, m6, m7)
 
 
-@called
+@inline
 def _solve4(
     A11: float, A21: float, A22: float, A31: float, A32: float, A33: float,
     A41: float, A42: float, A43: float, A44: float,
@@ -176,7 +176,7 @@ def _solve4(
     return x1, x2, x3, x4
 
 
-@called
+@inline
 def accelerations(
     p: FloatArray, y: FloatArray
 ) -> tuple[float, float, float, float, float, float, float, float, float, float]:
@@ -220,7 +220,7 @@ def accelerations(
     return vd1, vd2, vd3, wd1, wd2, wd3, dd, Q1 - F1, Q2 - F2, Q3 - F3
 
 
-@called
+@inline
 def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """The pair's accelerations (:func:`accelerations`), ``delta'`` included (the kernel writes
     the kinematics first, :func:`direction_rate` a placeholder). The reaction's rows for
@@ -236,19 +236,19 @@ def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: 
     return 3
 
 
-@called
+@inline
 def direction_rate(p: FloatArray, y: FloatArray, variant: int) -> float:
     """0: the rate of the state's last slot, ``delta'``, is written by :func:`accel` with the
     accelerations (computed once)."""
     return 0.0
 
 
-@called
+@inline
 def sync_direction(y: FloatArray, variant: int) -> None:
     """Nothing to re-synchronise: the last slot is the shell's spin, not a direction."""
 
 
-@called
+@inline
 def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
     """Onto the constraints: ``v`` from the independent velocities ``(w, delta)`` (module
     docstring), which satisfies all three conditions exactly."""
