@@ -59,11 +59,16 @@ def switch_model(
     return switched, switched.require_state()[:6] - scenario.require_state()[:6]
 
 
-def _projected(scenario: Scenario, model: ContactModel) -> Scenario:
+def _body_for(model: ContactModel, body: SphericalTop) -> SphericalTop:
+    """:meth:`ContactModel.body_for`, its refusal as an :class:`InitialStateError`."""
     try:
-        body = model.body_for(scenario.body)
+        return model.body_for(body)
     except ValueError as err:
         raise InitialStateError(str(err)) from None
+
+
+def _projected(scenario: Scenario, model: ContactModel) -> Scenario:
+    body = _body_for(model, scenario.body)
     y = project_state(body, model, scenario.require_state(), source=scenario.model)
     return replace(scenario, model=model, initial=InitialConditions.from_state(y), level=None)
 
@@ -209,10 +214,7 @@ def simulate(
         if model is None or state is None:
             raise TypeError("simulate(body, model, state): a body needs a model and a state")
         contact = _model(model)
-        try:
-            source = contact.body_for(source)
-        except ValueError as err:
-            raise InitialStateError(str(err)) from None
+        source = _body_for(contact, source)
         y0 = _given_state(source, contact, state)
         opts = options if options is not None else IntegrationOptions()
         opts = replace(opts, **given) if given else opts

@@ -207,7 +207,7 @@ def initial_state(
     y[3:6] = omega
     y[6:9], y[9:12], y[12:15] = alpha, beta, gamma
     y[15:17] = position
-    y[17] = math.atan2(beta[2], alpha[2]) if math.hypot(alpha[2], beta[2]) > 0 else 0.0
+    y[17] = _axis_azimuth(y)
     if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
         y[17] = model.vertical_direction(omega, alpha, beta)
     if v is not None:
@@ -242,6 +242,13 @@ def initial_state(
     return y
 
 
+def _axis_azimuth(y: FloatArray) -> float:
+    """The axis azimuth ``psi = atan2(beta3, alpha3)`` of the frame in ``y``; 0 at a vertical
+    axis (where ``atan2`` of signed zeros could give ``pi``)."""
+    a3, b3 = float(y[8]), float(y[11])
+    return math.atan2(b3, a3) if math.hypot(a3, b3) > 0 else 0.0
+
+
 def project_state(
     body: SphericalTop,
     model: str | ContactModel,
@@ -267,8 +274,7 @@ def project_state(
     model = get_model(model)
     y = np.array(y, dtype=float)
     if source is not None and get_model(source).slot_value is not None and model.slot_value is None:
-        a3, b3 = float(y[8]), float(y[11])
-        y[17] = math.atan2(b3, a3) if math.hypot(a3, b3) > 0 else 0.0
+        y[17] = _axis_azimuth(y)
     gamma = _vertical(model, y[12:15])
     if model.singular is not None and (why := model.singular(body, gamma)) is not None:
         raise InitialStateError(f"model {model.name!r}: {why}")
