@@ -17,7 +17,7 @@ import shutil
 from pathlib import Path
 
 #: Subpackages whose modules are compiled into the kernels.
-KERNEL_PACKAGES = ("contact", "dynamics", "integrate")
+KERNEL_PACKAGES = ("_compiled", "chaos", "contact", "dynamics", "integrate")
 CACHE_ROOT = Path(__file__).resolve().parent / ".numba-cache"
 
 

@@ -242,12 +242,14 @@ def check_pieces(lib: ctypes.CDLL, sc: Any, code: int, n_states: int = 200) -> d
     ``n_states`` states along W1's first 50 time units (perturbed by 1e-3) with random stages:
     all 0 when the two round alike."""
     import rollingtop
+    from rollingtop._compiled import for_code
     from rollingtop._jit import call
-    from rollingtop.dynamics import _kernel
-    from rollingtop.integrate import _dop853, _dop853_dense, _dop853_stages
+    from rollingtop.dynamics._kernel import new_workspace, reaction
+    from rollingtop.integrate import _dop853_dense, _dop853_stages
 
+    kernels = for_code(code)  # the meridian model's compiled package
     p = np.ascontiguousarray(sc.body.params, dtype=float)
-    ws = call(_kernel.new_workspace)
+    ws = call(new_workspace)
     ys = rollingtop.simulate(sc.with_overrides(t_end=50.0, samples=n_states)).y
     rng = np.random.default_rng(1)
     rtol, atol = sc.integration.rtol, sc.integration.resolved_atol
@@ -257,13 +259,13 @@ def check_pieces(lib: ctypes.CDLL, sc: Any, code: int, n_states: int = 200) -> d
     for y in ys:
         y = np.ascontiguousarray(y + rng.normal(scale=1e-3, size=N_STATE))
         dy_rt, dy_c = np.zeros(N_STATE), np.zeros(N_STATE)
-        nc = call(_kernel.rhs, code, p, y, dy_rt, ws)
-        N_rt, _ = call(_kernel.reaction, nc, y, ws)
+        nc = call(kernels.dynamics.rhs, code, p, y, dy_rt, ws)
+        N_rt, _ = call(reaction, nc, y, ws)
         N_c = lib.rt_rhs(_ptr(p), _ptr(y), _ptr(dy_c))
         differ["rhs"] += int(np.sum(dy_rt != dy_c))
         differ["normal force"] += int(N_rt != N_c)
         a, b = y.copy(), y.copy()
-        call(_kernel.project, code, p, a, ws)
+        call(kernels.dynamics.project, code, p, a, ws)
         lib.rt_project(_ptr(p), _ptr(b))
         differ["project"] += int(np.sum(a != b))
         K = rng.normal(size=(16, N_STATE))
@@ -281,7 +283,7 @@ def check_pieces(lib: ctypes.CDLL, sc: Any, code: int, n_states: int = 200) -> d
         differ["scaled_errors"] += sum(int(np.sum(u != v)) for u, v in zip(e_rt, e_c, strict=True))
         K_rt, K_c = K.copy(), K.copy()
         F_rt, F_c = np.zeros((7, N_STATE)), np.zeros((7, N_STATE))
-        call(_dop853_dense.prepare_dense, code, p, K_rt, y, ynew, h, np.zeros(N_STATE), F_rt, ws)
+        call(kernels.dense.prepare_dense, code, p, K_rt, y, ynew, h, np.zeros(N_STATE), F_rt, ws)
         lib.rt_prepare_dense(_ptr(p), _ptr(K_c), _ptr(y), _ptr(ynew), h, _ptr(F_c))
         differ["prepare_dense"] += int(np.sum(F_rt != F_c))
         x = float(rng.uniform())
@@ -289,7 +291,7 @@ def check_pieces(lib: ctypes.CDLL, sc: Any, code: int, n_states: int = 200) -> d
         call(_dop853_dense.dense_eval, F_rt, y, x, o_rt)
         lib.rt_dense_eval(_ptr(F_rt), _ptr(y), x, _ptr(o_c))
         differ["dense_eval"] += int(np.sum(o_rt != o_c))
-        h_rt = call(_dop853.initial_step, code, p, y, dy_rt, 1e4, 0.0, rtol, atol,
+        h_rt = call(kernels.stepper.initial_step, code, p, y, dy_rt, 1e4, 0.0, rtol, atol,
                     np.zeros(N_STATE), np.zeros(N_STATE), ws)  # fmt: skip
         h_c = lib.rt_initial_step(_ptr(p), _ptr(y), _ptr(dy_rt), 1e4, 0.0, rtol, atol)
         differ["initial_step"] += int(h_rt != h_c)
@@ -373,7 +375,7 @@ def measure(rounds: int) -> dict[str, Any] | None:
     sc, code = w1_problem()
     from rollingtop.integrate.driver import compile_kernels
 
-    compile_kernels()
+    compile_kernels("meridian")
     c, rt = run_c(sc, lib), integrate_rollingtop(sc, code)
     assert c is not None
     counts = {
@@ -450,7 +452,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     from rollingtop.integrate.driver import compile_kernels
 
-    print(f"rollingtop kernels compiled or loaded in {compile_kernels():.1f} s")
+    print(f"rollingtop kernels compiled or loaded in {compile_kernels('meridian'):.1f} s")
     if args.check:
         differ = check_pieces(lib, sc, code)
         verdict = "all equal to the last bit" if not any(differ.values()) else "DIFFERENT"

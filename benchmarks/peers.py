@@ -4,7 +4,7 @@ Run:  python benchmarks/peers.py [--t-end 1e3] [--rounds 3]     (a quick version
 
 W1 is the paper's body (examples/paper.toml) from its initial state to ``t_end`` at rtol 1e-10,
 atol 1e-12.  Every peer integrates the same 18 equations with the same tolerances, calling
-rollingtop's compiled right-hand side (``rollingtop.dynamics._kernel.rhs``) through the interface
+rollingtop's compiled right-hand side (the model's ``dynamics.rhs``, :mod:`rollingtop._compiled`) through the interface
 the peer wants -- except "solve_ivp, NumPy rhs", which is what a user would write without
 rollingtop (``run_benchmarks.numpy_rhs_factory``), and diffrax, which needs a JAX rhs:
 
@@ -45,12 +45,7 @@ from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from run_benchmarks import (  # noqa: E402
-    ROOT,
-    compiled_rhs_factory,
-    median_time,
-    numpy_rhs_factory,
-)
+from _common import ROOT, compiled_rhs_factory, median_time, numpy_rhs_factory  # noqa: E402
 
 #: Said in every result: what the comparison does not include.
 NO_PROJECTION = (
@@ -102,7 +97,9 @@ def rhs_kernels(code: int) -> dict[str, object]:
     plain one (timed) and a counting one (``buf[I_COUNT] += 1`` per call, and the same-t count)."""
     from numba import carray, cfunc, njit, types
 
-    from rollingtop.dynamics import _kernel
+    from rollingtop._compiled import for_code
+
+    model_rhs = for_code(code).dynamics.rhs
 
     _check_workspace_layout()
     o1, o2, o3, o4, o5, o6 = (N_P + int(v) for v in np.cumsum([0, *map(np.prod, _WS_SHAPES)]))
@@ -133,7 +130,7 @@ def rhs_kernels(code: int) -> dict[str, object]:
                 count(t, buf)
             p, ws = views(buf)
             dy = np.empty(18)
-            _kernel.rhs(code, p, y, dy, ws)
+            model_rhs(code, p, y, dy, ws)
             return dy
 
         # CyRK nbsolve2_ivp: void(double* dy, double t, double* y, double* args)
@@ -145,7 +142,7 @@ def rhs_kernels(code: int) -> dict[str, object]:
             if counting:
                 count(t, buf)
             p, ws = views(buf)
-            _kernel.rhs(code, p, carray(y_, (18,)), carray(dy_, (18,)), ws)
+            model_rhs(code, p, carray(y_, (18,)), carray(dy_, (18,)), ws)
 
         # CyRK pysolve_ivp with pass_dy_as_arg=True: diffeq(dy, t, y, *args), called from Python
         @njit
@@ -153,7 +150,7 @@ def rhs_kernels(code: int) -> dict[str, object]:
             if counting:
                 count(t, buf)
             p, ws = views(buf)
-            _kernel.rhs(code, p, y, dy, ws)
+            model_rhs(code, p, y, dy, ws)
 
         # numbalsoda: void(double t, double* u, double* du, double* data)
         @cfunc(types.void(types.float64, types.CPointer(types.float64),
@@ -163,7 +160,7 @@ def rhs_kernels(code: int) -> dict[str, object]:
             if counting:
                 count(t, buf)
             p, ws = views(buf)
-            _kernel.rhs(code, p, carray(u_, (18,)), carray(du_, (18,)), ws)
+            model_rhs(code, p, carray(u_, (18,)), carray(du_, (18,)), ws)
 
         return {"nb": nb_diffeq, "cy": cy_diffeq, "py": py_diffeq, "nbl": lsoda_rhs}
 

@@ -16,7 +16,8 @@ W2  ensemble of 1e4 initial states, t = 100: trajectories per second on 1 and 2 
     parallel efficiency.
 W3  work-precision: final-state error at t = 100 against a reference solved at rtol 1e-14 by two
     methods (rollingtop and solve_ivp), for rtol 1e-6 ... 1e-13.
-Cold start: import + compile in a fresh process, with an empty numba cache and with a warm one.
+Cold start: what a newcomer waits for (portrait, simulate, a second model, warmup), each a whole
+    process with an empty numba cache, and with a warm one (:func:`cold_start`).
 
 Timings are medians of repeated runs in this one process (the slow baselines run fewer times);
 nothing here is asserted: this is not part of the test suite.
@@ -27,7 +28,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -38,109 +38,9 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-
-def numpy_rhs_factory(p, model="meridian"):
-    """A plain NumPy right-hand side of the meridian model (MODEL.md, "Dynamics"): the full
-    (v', w', lambda) linear system solved with numpy.linalg.solve -- what a careful user would
-    write without rollingtop."""
-    R, m, g, a3, I1, I2, I3 = p[:7]
-    Iv = np.array([I1, I2, I3])
-    e3 = np.array([0.0, 0.0, 1.0])
-    avec = np.array([0.0, 0.0, a3])
-
-    def rhs(t, y):
-        v, w = y[0:3], y[3:6]
-        alpha, beta, gamma = y[6:9], y[9:12], y[12:15]
-        r = -R * gamma - avec
-        gdot = np.cross(gamma, w)
-        rdot = -R * gdot
-        vp = v + np.cross(w, r)
-        g3, g3dot = gamma[2], gdot[2]
-        s = np.sqrt(1.0 - g3 * g3)
-        pvec = e3 - g3 * gamma
-        nu = pvec / s
-        nudot = (-g3dot * gamma - g3 * gdot) / s + pvec * g3 * g3dot / s**3
-        dirs = ((gamma, gdot), (nu, nudot))
-        M = np.zeros((8, 8))
-        b = np.zeros(8)
-        M[0:3, 0:3] = m * np.eye(3)
-        M[3:6, 3:6] = np.diag(Iv)
-        b[0:3] = m * np.cross(v, w) - m * g * gamma
-        b[3:6] = np.cross(Iv * w, w)
-        for i, (d, dd) in enumerate(dirs):
-            rxd = np.cross(r, d)
-            M[0:3, 6 + i] = -d
-            M[3:6, 6 + i] = -rxd
-            M[6 + i, 0:3] = d
-            M[6 + i, 3:6] = rxd
-            b[6 + i] = -np.cross(w, rdot) @ d - vp @ dd
-        sol = np.linalg.solve(M, b)
-        dy = np.zeros_like(y)
-        dy[0:6] = sol[0:6]
-        dy[6:9] = np.cross(alpha, w)
-        dy[9:12] = np.cross(beta, w)
-        dy[12:15] = gdot
-        dy[15] = v @ alpha
-        dy[16] = v @ beta
-        return dy
-
-    return rhs
-
-
-def compiled_rhs_factory(code, p):
-    """solve_ivp calling rollingtop's compiled right-hand side through one compiled function of
-    a single array (``f(t, y) -> dy``), the cheapest call numba offers from Python."""
-    from numba import njit
-
-    from rollingtop.dynamics import _kernel
-
-    @njit
-    def f(y):
-        dy = np.empty(18)
-        ws = (np.empty((4, 6)), np.empty(4), np.empty((4, 3)), np.empty((4, 4)), np.empty(4))
-        _kernel.rhs(code, p, y, dy, ws)
-        return dy
-
-    f(np.ascontiguousarray(np.r_[np.zeros(6), np.eye(3).ravel(), 0.0, 0.0, 0.0]))
-
-    def rhs(t, y):
-        return f(y)
-
-    return rhs
-
-
-def median_time(fn, repeat):
-    times, result = [], None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), times, result
-
-
-def machine() -> dict:
-    import numba
-    import scipy
-
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return {
-        "cpu": cpu,
-        "cores": os.cpu_count(),
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "scipy": scipy.__version__,
-        "numba": numba.__version__,
-    }
+from _common import ROOT, compiled_rhs_factory, machine, median_time, numpy_rhs_factory  # noqa: E402
 
 
 def w1(t_end, repeat, numpy_repeat):
@@ -285,9 +185,17 @@ def w3(t_end):
     return out
 
 
-#: The command timed for the start-up of the command line: a short run of the paper's scenario.
+#: The commands timed for the start-up of the command line (issue 23), run from the repository
+#: root in fresh processes: the README's first picture, a short run of the paper's scenario, then
+#: (same cache) a short run of another model's, and the warm-up of every model.
+PORTRAIT_COMMAND = ["-m", "rollingtop.cli", "portrait", "examples/fig5.toml", "-o"]
 SIMULATE_COMMAND = ["-m", "rollingtop.cli", "simulate", "examples/paper.toml", "--t-end", "1",
                     "--json"]  # fmt: skip
+ROUGH_COMMAND = ["-m", "rollingtop.cli", "simulate", "examples/rough.toml", "--t-end", "1",
+                 "--json"]  # fmt: skip
+WARMUP_COMMAND = ["-m", "rollingtop.cli", "warmup", "--json"]
+#: Modules that ``import rollingtop`` must not import (they load with the commands that use them).
+HEAVY_MODULES = ("matplotlib", "xarray", "dask", "distributed", "sympy")
 
 
 def _wall(argv, env) -> float:
@@ -296,27 +204,69 @@ def _wall(argv, env) -> float:
     return time.perf_counter() - start
 
 
+def _imported_heavy() -> tuple[list[str], float]:
+    """The heavy top-level packages ``import rollingtop`` loads (``-X importtime``) and the time
+    of the import itself (whole process minus a bare interpreter is not asked: the import's own
+    cumulative time)."""
+    proc = subprocess.run([sys.executable, "-X", "importtime", "-c", "import rollingtop"],
+                          capture_output=True, text=True, check=True, cwd=ROOT)  # fmt: skip
+    names, total = set(), 0.0
+    for line in proc.stderr.splitlines():
+        parts = [p.strip() for p in line.split("|")]
+        if len(parts) == 3 and parts[1].isdigit():
+            name = parts[2]
+            names.add(name.split(".")[0])
+            if name == "rollingtop":
+                total = int(parts[1]) / 1e6
+    return sorted(n for n in names if n in HEAVY_MODULES), total
+
+
 def cold_start(warm_runs: int = 5):
-    """Import + compile in a fresh process, and the wall time of ``rollingtop simulate`` (a short
-    run of examples/paper.toml), each with an empty numba cache and with a warm one (the median
-    of ``warm_runs`` processes)."""
-    code = ("import time; t = time.perf_counter(); import rollingtop; "
-            "from rollingtop.integrate import compile_kernels; compile_kernels(); "
-            "print(time.perf_counter() - t)")  # fmt: skip
+    """What a newcomer waits for, each a whole process with ``NUMBA_CACHE_DIR`` pointing at a
+    new folder: the README's portrait, a short ``simulate`` of the paper's model, then (same
+    cache) of the rough model, and ``rollingtop warmup`` (every model); then, with the cache
+    warm, the medians of ``warm_runs`` short ``simulate`` and ``portrait`` processes; and what
+    ``import rollingtop`` loads."""
     out = {}
-    with tempfile.TemporaryDirectory() as cache:
-        env = os.environ | {"NUMBA_CACHE_DIR": cache}
-        for label in ("empty_cache_s", "warm_cache_s"):
-            proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                                  text=True, check=True)  # fmt: skip
-            out[label] = float(proc.stdout.strip().splitlines()[-1])
-    with tempfile.TemporaryDirectory() as cache:
-        env = os.environ | {"NUMBA_CACHE_DIR": cache}
+    with tempfile.TemporaryDirectory() as tmp:
+        png = os.path.join(tmp, "fig5.png")
+        env = os.environ | {"NUMBA_CACHE_DIR": os.path.join(tmp, "portrait")}
+        out["portrait_empty_cache_s"] = _wall([*PORTRAIT_COMMAND, png], env)
+        out["portrait_warm_cache_s"] = statistics.median(
+            _wall([*PORTRAIT_COMMAND, png], env) for _ in range(warm_runs)
+        )
+        env = os.environ | {"NUMBA_CACHE_DIR": os.path.join(tmp, "simulate")}
         out["simulate_empty_cache_s"] = _wall(SIMULATE_COMMAND, env)
+        out["rough_after_paper_s"] = _wall(ROUGH_COMMAND, env)
         out["simulate_warm_cache_s"] = statistics.median(
             _wall(SIMULATE_COMMAND, env) for _ in range(warm_runs)
         )
+        env = os.environ | {"NUMBA_CACHE_DIR": os.path.join(tmp, "warmup")}
+        out["warmup_empty_cache_s"] = _wall(WARMUP_COMMAND, env)
+    out["import_heavy_modules"], out["import_s"] = _imported_heavy()
+    out["warm_runs"] = warm_runs
     return out
+
+
+def start_table(cs) -> str:
+    """The start-up table (issue 23): each row a whole process, from the repository root."""
+    heavy = ", ".join(cs["import_heavy_modules"]) or "none of " + ", ".join(HEAVY_MODULES)
+    return "\n".join([
+        "| start-up, whole process | numba cache | seconds |",
+        "|---|---|---|",
+        f"| `rollingtop portrait examples/fig5.toml -o fig5.png` | empty | "
+        f"{cs['portrait_empty_cache_s']:.1f} |",
+        f"| `rollingtop simulate examples/paper.toml --t-end 1` | empty | "
+        f"{cs['simulate_empty_cache_s']:.1f} |",
+        f"| then `rollingtop simulate examples/rough.toml --t-end 1` (compiles rough alone) | "
+        f"paper's model's | {cs['rough_after_paper_s']:.1f} |",
+        f"| `rollingtop warmup` (every model, one process each) | empty | "
+        f"{cs['warmup_empty_cache_s']:.1f} |",
+        f"| a short `simulate` (median of {cs['warm_runs']}) | warm | "
+        f"{cs['simulate_warm_cache_s']:.2f} |",
+        f"| `portrait` (median of {cs['warm_runs']}) | warm | {cs['portrait_warm_cache_s']:.2f} |",
+        f"| `import rollingtop` (loads {heavy}) | | {cs['import_s']:.2f} |",
+    ])  # fmt: skip
 
 
 def _err(entry) -> str:
@@ -366,14 +316,7 @@ def table(res) -> str:
     for pt in w3r["points"]:
         rows.append(f"| {pt['rtol']:.0e} | {pt['rollingtop_error']:.1e} | {pt['rollingtop_s']:.4f} | "
                     f"{pt['solve_ivp_error']:.1e} | {pt['solve_ivp_compiled_s']:.3f} |")  # fmt: skip
-    cs = res["cold_start"]
-    rows += ["", f"Cold start (import + compile): {cs['empty_cache_s']:.1f} s with an empty numba "
-             f"cache, {cs['warm_cache_s']:.1f} s with a warm one."]  # fmt: skip
-    if "simulate_empty_cache_s" in cs:
-        rows += ["", f"`rollingtop simulate examples/paper.toml --t-end 1 --json`, whole process: "
-                 f"{cs['simulate_empty_cache_s']:.1f} s with an empty numba cache (everything it "
-                 f"uses compiled), {cs['simulate_warm_cache_s']:.2f} s with a warm one (median of "
-                 f"5 processes)."]  # fmt: skip
+    rows += ["", start_table(res["cold_start"])]
     if res.get("C"):
         c = res["C"]
         where = (f"{len(c['ratios'])} paired rounds in {c['processes']} pinned processes"
@@ -476,9 +419,11 @@ def readme_block(res) -> str:
     numpy_rhs = w1r["solve_ivp_numpy_rhs"]["speedup_of_rollingtop"]  # paired with rollingtop
     rows.append(f"| SciPy solve_ivp DOP853, NumPy rhs (one run) | {numpy_rhs:.0f} |")
     w2r = res["W2"]
-    rows += ["", f"Cold start (import and compile, empty numba cache): {cs['empty_cache_s']:.0f} s; "
-             f"a short `rollingtop simulate` with a warm cache: {cs['simulate_warm_cache_s']:.2f} s "
-             f"(whole process). Ensemble of {w2r['n']} trajectories on 2 threads: "
+    rows += ["", f"First run, empty numba cache: `rollingtop simulate examples/paper.toml --t-end 1` "
+             f"{cs['simulate_empty_cache_s']:.0f} s, the README's portrait "
+             f"{cs['portrait_empty_cache_s']:.0f} s, `rollingtop warmup` "
+             f"{cs['warmup_empty_cache_s']:.0f} s; a short `simulate` with a warm cache: "
+             f"{cs['simulate_warm_cache_s']:.2f} s (whole processes). Ensemble of {w2r['n']} trajectories on 2 threads: "
              f"{100 * w2r['parallel_efficiency_2']:.0f} % parallel efficiency."]  # fmt: skip
     if res.get("atlas"):
         a = res["atlas"]

@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from run_benchmarks import ROOT, machine, median_time  # noqa: E402
+from _common import ROOT, machine, median_time  # noqa: E402
 
 BENCH = ROOT / "benchmarks"
 PAPER = ROOT / "examples" / "paper.toml"

@@ -1,41 +1,68 @@
-"""``rollingtop warmup``: compiles every kernel group once (:func:`rollingtop._warmup.warmup`),
-then prints one line per group and the total, or one JSON object."""
+"""``rollingtop warmup``: compiles the chosen models' kernels, one process per model
+(:func:`rollingtop._warmup.warmup`), then prints one line per model and the total, or one JSON
+object."""
 
 import json
 
 import pytest
 
+from rollingtop import _warmup
+from rollingtop.contact import MODELS
+
 from .test_cli import run_cli
 
 
-def test_warmup_json_names_every_group(capsys):
-    code, out, err = run_cli(capsys, "warmup", "--json")
-    assert code == 0 and err == ""
-    assert out.count("\n") == 1
+def test_warmup_json_names_each_model_and_its_groups(capsys):
+    """One model, in this process (already compiled by the suite: fast)."""
+    code, out, err = run_cli(capsys, "warmup", "--model", "meridian", "--processes", "1", "--json")
+    assert code == 0
+    assert err.startswith("rollingtop: compiling the kernels of 1 model (meridian)")
     data = json.loads(out)
-    assert set(data) == {"groups", "total_s"}
-    assert data["groups"] and all(s >= 0 for s in data["groups"].values())
-    assert data["total_s"] == pytest.approx(sum(data["groups"].values()))
+    assert set(data) == {"models", "total_s"}
+    groups = data["models"]["meridian"]
+    assert set(groups) == {*_warmup.GROUPS, "total_s"}
+    assert all(s >= 0 for s in groups.values())
+    assert groups["total_s"] == pytest.approx(sum(groups[g] for g in _warmup.GROUPS))
 
 
-def test_warmup_prints_a_line_per_group_and_the_total(capsys, monkeypatch):
-    import rollingtop._warmup as module
-
+def test_warmup_prints_a_line_per_model_and_the_total(capsys, monkeypatch):
     told = []
 
-    def warmup(progress=None):
-        for name in ("integrator", "ensemble"):
-            if progress is not None:
-                progress(name)
-            told.append(name)
-        return {"integrator": 12.5, "ensemble": 3.25}
+    def warmup(models, processes=None, progress=None):
+        out = {}
+        for i, name in enumerate(models):
+            out[name] = {"integrator": 10.0 + i, "ensemble": 2.5}
+            progress(name, out[name])
+            told.append((name, processes))
+        return out
 
-    monkeypatch.setattr(module, "warmup", warmup)
-    code, out, err = run_cli(capsys, "warmup")
-    assert code == 0 and err == ""
-    assert out.splitlines() == [
-        "integrator     12.50 s",
-        "ensemble        3.25 s",
-        "total          15.75 s",
-    ]
-    assert told == ["integrator", "ensemble"]
+    monkeypatch.setattr(_warmup, "warmup", warmup)
+    code, out, err = run_cli(capsys, "warmup", "--model", "smooth", "--model", "rough",
+                             "--processes", "2")  # fmt: skip
+    assert code == 0
+    lines = out.splitlines()
+    assert lines[:2] == ["smooth          12.50 s", "rough           13.50 s"]
+    assert lines[2].startswith("total") and lines[2].endswith("s (wall)")
+    assert told == [("smooth", 2), ("rough", 2)]
+
+
+def test_warmup_defaults_to_every_model(capsys, monkeypatch):
+    seen = []
+    monkeypatch.setattr(_warmup, "warmup",
+                        lambda models, processes=None, progress=None: seen.extend(models) or {})  # fmt: skip
+    code, _, err = run_cli(capsys, "warmup")
+    assert code == 0 and seen == list(MODELS)
+    assert f"the kernels of {len(MODELS)} models" in err
+
+
+def test_warmup_refuses_an_unknown_model(capsys):
+    code, out, err = run_cli(capsys, "warmup", "--model", "glue")
+    assert code == 2 and out == ""
+    assert "glue" in err and err.count("\n") == 1
+
+
+def test_warmup_runs_models_in_separate_processes():
+    """Two models, two processes (spawned: each compiles or loads from the suite's cache)."""
+    seconds = _warmup.warmup(["smooth", "rough"], processes=2)
+    assert list(seconds) == ["smooth", "rough"]
+    assert all(set(g) == set(_warmup.GROUPS) for g in seconds.values())

@@ -17,8 +17,8 @@ from rollingtop.devices import (
     skate_layout,
     tau_slip,
 )
-from rollingtop.dynamics import _kernel
 from rollingtop.scenario import load_scenario
+from tests import kernels as _kernel
 
 from .conftest import EXAMPLES
 
@@ -178,7 +178,7 @@ def test_the_pairs_shell_angle_is_its_own_spin_integrated():
     from scipy.integrate import solve_ivp
 
     from rollingtop import SphericalTop, initial_state, simulate
-    from rollingtop.dynamics import _kernel
+    from tests import kernels as _kernel
 
     body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I3=0.5, shell_mass=0.2,
                         shell_inertia=0.2 * 2 / 3)  # fmt: skip

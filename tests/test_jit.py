@@ -26,7 +26,16 @@ def _raiser_in(filename):
 NUMBA_CACHING = os.path.join("site-packages", "numba", "core", "caching.py")
 
 
-def test_a_failed_cache_save_is_retried_and_reported_once(monkeypatch):
+@pytest.fixture
+def disabled(monkeypatch):
+    """Record :func:`rollingtop._jit.disable_caching` instead of switching this test process's
+    caches off (the rest of the suite needs them)."""
+    told = []
+    monkeypatch.setattr(_jit, "disable_caching", lambda: told.append(1))
+    return told
+
+
+def test_a_failed_cache_save_is_retried_and_reported_once(monkeypatch, disabled):
     monkeypatch.setattr(_jit, "_warned", False)
     fail = _raiser_in(NUMBA_CACHING)
     calls = []
@@ -42,11 +51,12 @@ def test_a_failed_cache_save_is_retried_and_reported_once(monkeypatch):
         assert _jit.call(compiled, 21) == 42
         assert _jit.call(compiled, 1) == 2
     assert len(calls) == 4
+    assert len(disabled) == 2  # each failure switches the caches off (the first one does it)
     assert [type(w.message) for w in caught] == [_jit.CacheNotSaved]
     assert "/c/k.nbc" in str(caught[0].message) and "File too large" in str(caught[0].message)
 
 
-def test_other_os_errors_propagate(monkeypatch):
+def test_other_os_errors_propagate(monkeypatch, disabled):
     monkeypatch.setattr(_jit, "_warned", False)
     fail = _raiser_in(os.path.join("somewhere", "else.py"))
 
@@ -55,9 +65,10 @@ def test_other_os_errors_propagate(monkeypatch):
 
     with pytest.raises(OSError, match="File too large"):
         _jit.call(compiled)
+    assert not disabled
 
 
-def test_a_bounded_number_of_retries(monkeypatch):
+def test_a_bounded_number_of_retries(monkeypatch, disabled):
     monkeypatch.setattr(_jit, "_warned", True)
     fail = _raiser_in(NUMBA_CACHING)
     calls = []
@@ -71,10 +82,32 @@ def test_a_bounded_number_of_retries(monkeypatch):
     assert len(calls) == _jit.MAX_SAVE_FAILURES + 1
 
 
-@pytest.mark.slow
+def test_disable_caching_switches_every_dispatcher_to_no_cache():
+    """In a fresh process: every dispatcher made by the decorators, before and after the call,
+    holds numba's NullCache, and the announcement says that every run compiles."""
+    script = (
+        "from numba.core.caching import NullCache\n"
+        "from rollingtop import _compiled, _jit\n"
+        "before = _compiled.for_model('smooth').dynamics.rhs\n"
+        "_jit.disable_caching()\n"
+        "after = _compiled.for_model('rough').dynamics.rhs\n"
+        "assert _jit.caching_disabled()\n"
+        "assert all(isinstance(d._cache, NullCache) for d in _jit._DISPATCHERS)\n"
+        "assert isinstance(before._cache, NullCache) and isinstance(after._cache, NullCache)\n"
+        "print(_compiled.message('rough', 'integrator'))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "numba cannot save its cache: every run compiles them" in proc.stdout
+
+
 def test_simulate_runs_when_numba_cannot_save_its_cache(tmp_path):
     """A real process under a file-size limit with an empty numba cache: every save fails
-    (``EFBIG``); the command still succeeds, with one warning line."""
+    (``EFBIG``); the command still succeeds, with the compile notice and one warning line, and
+    costs at most one more compilation than a cold run (the caches are switched off at the first
+    failure: before, each cached function of the chain cost one more compilation of its caller,
+    two minutes in all). The paper's model alone is compiled."""
     script = (
         "import resource, signal, sys, runpy\n"
         "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
@@ -88,4 +121,36 @@ def test_simulate_runs_when_numba_cannot_save_its_cache(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout)["t_end"] == 0.1
     lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and "compiled kernels not saved" in lines[0]
+    assert len(lines) == 2, proc.stderr
+    assert lines[0].startswith("rollingtop: compiling the meridian model's integrator kernels")
+    assert "compiled kernels not saved" in lines[1]
+
+
+def test_compiling_one_model_compiles_no_other(tmp_path):
+    """A fresh process with an empty numba cache compiles one model's right-hand side: numba's
+    cache then holds entries of that model's package and of the shared modules only, and no
+    other model's package was even imported."""
+    script = (
+        "import sys, numpy as np\n"
+        "from rollingtop import _compiled\n"
+        "from rollingtop._jit import call\n"
+        "from rollingtop.dynamics._kernel import new_workspace\n"
+        "from rollingtop.dynamics._layout import WARMUP_PARAMS\n"
+        "y = np.zeros(18); y[6:15] = (1, 0, 0, 0, 0.8, -0.6, 0, 0.6, 0.8)\n"
+        "k = _compiled.for_model('rough')\n"
+        "call(k.dynamics.rhs, k._dispatch.CODES[0], np.array(WARMUP_PARAMS), y, np.empty(18),"
+        " call(new_workspace))\n"
+        "print(sorted(m for m in sys.modules if m.startswith('rollingtop._compiled.')))\n"
+    )
+    cache = tmp_path / "cache"
+    env = os.environ | {"NUMBA_CACHE_DIR": str(cache)}
+    proc = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    imported = {m.split(".")[2] for m in eval(proc.stdout)}
+    assert imported == {"rough"}
+    # numba's user cache folder: one sub-folder per source folder, named after it
+    folders = {p.parent.name.rsplit("_", 1)[0] for p in cache.rglob("*.nbi")}
+    assert "rough" in folders
+    others = {"meridian", "smooth", "parallel", "rubber", "shell_rotor"}
+    assert not folders & others, folders

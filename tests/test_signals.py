@@ -62,8 +62,8 @@ def cpu_seconds(pid: int) -> float:
 @pytest.fixture(scope="module")
 def startup_cpu(tmp_path_factory):
     """CPU seconds of a whole short run of each command (the kernels' cache warmed first)."""
-    compile_kernels()
-    compile_ensemble()
+    compile_kernels("meridian")
+    compile_ensemble("meridian")
     cost = {}
     for name, args in COMMANDS.items():
         before = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -36,21 +36,33 @@ njit: Any = _numba_njit
 BASE_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy", "fastmath": {"contract"}}
 
 
+#: Every dispatcher made by the decorators below (their caches are switched off together when
+#: numba cannot save them, :func:`call`).
+_DISPATCHERS: list[Any] = []
+
+
+def _registered(dispatcher: Any) -> Any:
+    _DISPATCHERS.append(dispatcher)
+    if _caching_off:
+        _disable_cache(dispatcher)
+    return dispatcher
+
+
 def kernel(func: F) -> F:
     """Compile ``func`` as a stage kernel: no reference counting, no allocation."""
-    return cast(F, njit(**BASE_OPTIONS, _nrt=False)(func))
+    return cast(F, _registered(njit(**BASE_OPTIONS, _nrt=False)(func)))
 
 
 def inline(func: F) -> F:
     """Compile ``func`` as a helper inlined into every compiled caller."""
-    return cast(F, njit(**BASE_OPTIONS, inline="always")(func))
+    return cast(F, _registered(njit(**BASE_OPTIONS, inline="always")(func)))
 
 
 def compiled(**options: Any) -> Callable[[F], F]:
     """Compile a function that may allocate, with :data:`BASE_OPTIONS` and ``options``."""
 
     def decorate(func: F) -> F:
-        return cast(F, njit(**{**BASE_OPTIONS, **options})(func))
+        return cast(F, _registered(njit(**{**BASE_OPTIONS, **options})(func)))
 
     return decorate
 
@@ -60,10 +72,33 @@ class CacheNotSaved(UserWarning):
     permissions): the run goes on with the kernel compiled in memory."""
 
 
-#: Most failed cache saves tolerated in one :func:`call` (each repetition compiles at least one
-#: more function, which numba keeps in memory; the package has fewer compiled functions).
-MAX_SAVE_FAILURES = 200
+#: Most failed cache saves tolerated in one :func:`call`: after the first, every cache of the
+#: package is switched off, so a second failure would come from somewhere else.
+MAX_SAVE_FAILURES = 3
 _warned = False
+_caching_off = False
+
+
+def _disable_cache(dispatcher: Any) -> None:
+    # numba's own "no cache" object, the one a dispatcher without ``cache=True`` holds
+    from numba.core.caching import NullCache
+
+    dispatcher._cache = NullCache()
+
+
+def disable_caching() -> None:
+    """Stop saving (and loading) compiled kernels to numba's on-disk cache in this process: every
+    dispatcher of the package, those made from now on included."""
+    global _caching_off
+    _caching_off = True
+    for dispatcher in _DISPATCHERS:
+        _disable_cache(dispatcher)
+
+
+def caching_disabled() -> bool:
+    """Whether :func:`disable_caching` was called (numba could not save its cache)."""
+    return _caching_off
+
 
 R = TypeVar("R")
 
@@ -85,10 +120,13 @@ def call(func: Callable[..., R], *args: Any) -> R:
     numba compiles a function on first use, registers the machine code in memory, and only then
     saves it to its cache. An ``OSError`` from that save (``ENOSPC``, ``EFBIG`` under
     ``ulimit -f``, ``EACCES``) escapes from the call that triggered the compilation, although the
-    code is ready: every command would fail on a full disk. numba has no option for this, so the
-    call is repeated here (numba then finds the code in memory, or compiles the next function of
-    the chain), and the failure is reported once, as a :class:`CacheNotSaved` warning. Only
-    supported behaviour is relied on: the exception, and the function kept in memory.
+    code is ready: every command would fail on a full disk. numba has no option for this. So on
+    the first such failure every cache of the package is switched off (:func:`disable_caching`:
+    each dispatcher gets numba's ``NullCache``, what a function compiled without ``cache=True``
+    has) and the call is repeated: the functions already compiled are kept in memory, the rest
+    compile without trying to save. Repeating the call without that cost one more compilation of
+    the caller per cached function of the chain (minutes). The failure is reported once, as a
+    :class:`CacheNotSaved` warning.
     """
     global _warned
     for _ in range(MAX_SAVE_FAILURES):
@@ -97,6 +135,7 @@ def call(func: Callable[..., R], *args: Any) -> R:
         except OSError as exc:
             if not _from_numba_cache(exc):
                 raise
+            disable_caching()
             if not _warned:
                 _warned = True
                 where = exc.filename or "numba's cache folder"

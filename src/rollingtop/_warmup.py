@@ -1,9 +1,12 @@
-"""Compile every kernel once, ahead of the first command that needs it.
+"""Compile the kernels of some or all contact models once, ahead of the first command that needs
+them.
 
-The kernels are compiled by numba on first use and kept in numba's on-disk cache
+Each model's kernels are compiled by numba on first use and kept in numba's on-disk cache
 (``cache=True``: ``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR`` when set), so only the
-first run after an installation pays for the compilation (about half a minute on two cores).
-:func:`warmup` pays it up front: for a container image, a cluster's workers, or before timing.
+first run after an installation pays for a model's compilation, and only for the models it runs
+(:mod:`rollingtop._compiled`). :func:`warmup` pays it up front, for a container image, a
+cluster's workers, or before timing: one process per model, in parallel, since each model's
+kernels are independent (their own source files, their own cache entries).
 
 numba invalidates a cached function when its own source file changes, not when a function it
 calls from another file does; installing rollingtop rewrites every file, so an installation never
@@ -14,41 +17,80 @@ after editing a kernel. Nothing here deletes files.
 
 from __future__ import annotations
 
+import concurrent.futures
+import multiprocessing
+import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
-#: The groups compiled by :func:`warmup`, in order, with what each serves.
+from rollingtop.contact import MODELS, get_model
+
+#: The groups compiled for each model by :func:`warmup`, in order, with what each serves.
 GROUPS = {
-    "integrator": "the DOP853 stepper, right-hand sides and projections of every model kernel",
+    "integrator": "the right-hand side, projection, diagnostics and DOP853 stepper",
     "ensemble": "the parallel ensemble kernel",
 }
 
 
-def warmup(progress: Callable[[str], None] | None = None) -> dict[str, float]:
-    """Compile (or load from numba's cache) every compiled kernel of the package.
-
-    Parameters
-    ----------
-    progress : callable, optional
-        Called with the name of each group (:data:`GROUPS`) before it is compiled.
-
-    Returns
-    -------
-    dict of str to float
-        Seconds taken by each group; 0 for a group already compiled in this process.
-    """
+def warm_model(model: str) -> dict[str, float]:
+    """Compile (or load) ``model``'s groups of kernels (:data:`GROUPS`) in this process; the
+    seconds each took."""
     from rollingtop.integrate.driver import compile_kernels
     from rollingtop.integrate.ensemble import compile_ensemble
 
-    steps: dict[str, Callable[[], float]] = {
+    steps: dict[str, Callable[[str], float]] = {
         "integrator": compile_kernels,
         "ensemble": compile_ensemble,
     }
     seconds = {}
     for name, step in steps.items():
-        if progress is not None:
-            progress(name)
         start = time.perf_counter()
-        step()
+        step(model)
         seconds[name] = time.perf_counter() - start
     return seconds
+
+
+def warmup(
+    models: Sequence[str] | None = None,
+    *,
+    processes: int | None = None,
+    progress: Callable[[str, dict[str, float]], None] | None = None,
+) -> dict[str, dict[str, float]]:
+    """Compile (or load from numba's cache) the kernels of ``models`` (default: every registered
+    model), one process per model, ``processes`` at a time (default: the CPUs).
+
+    Parameters
+    ----------
+    models : sequence of str, optional
+        Names of registered models (:data:`rollingtop.contact.MODELS`).
+    processes : int, optional
+        Models compiled at once; 1 compiles them one after the other in this process.
+    progress : callable, optional
+        ``progress(model, seconds)`` as each model finishes.
+
+    Returns
+    -------
+    dict of str to dict of str to float
+        For each model, the seconds each group took (:data:`GROUPS`); 0 for a group already
+        compiled in the process that ran it.
+    """
+    names = [get_model(m).name for m in (MODELS if models is None else models)]
+    names = list(dict.fromkeys(names))
+    workers = max(1, min(len(names), processes or os.cpu_count() or 1))
+    out: dict[str, dict[str, float]] = {}
+    if workers == 1:
+        for name in names:
+            out[name] = warm_model(name)
+            if progress is not None:
+                progress(name, out[name])
+        return out
+    # spawn: a fresh interpreter per worker (no fork of a process holding numba's threads)
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
+        futures = {pool.submit(warm_model, name): name for name in names}
+        for future in concurrent.futures.as_completed(futures):
+            name = futures[future]
+            out[name] = future.result()
+            if progress is not None:
+                progress(name, out[name])
+    return {name: out[name] for name in names}

@@ -16,11 +16,12 @@ from typing import Any, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rollingtop._compiled import for_code
 from rollingtop._errors import ContactLostWarning, InitialStateError
 from rollingtop._jit import call
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, models_for
-from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.start import InitialConditions
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals, project_state
@@ -88,8 +89,8 @@ def _given_state(
         raise InitialStateError(f"state must be {N_STATE} finite numbers, got shape {y.shape}")
     if model.slot_value is not None:  # the model's own velocity must agree with v
         projected = y.copy()
-        call(_kernel.project, model.kernel_code(body, y), body.params, projected,
-             call(_kernel.new_workspace))  # fmt: skip
+        code = model.kernel_code(body, y)
+        call(for_code(code).dynamics.project, code, body.params, projected, call(new_workspace))
         gap = float(np.max(np.abs(projected[0:3] - y[0:3])))
         if gap > UNIT_TOLERANCE * max(1.0, float(np.max(np.abs(y[0:6])))):
             raise InitialStateError(

@@ -12,13 +12,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rollingtop._compiled import for_code
 from rollingtop._jit import call
 from rollingtop._json import finite_or_none
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, kernel_by_code
-from rollingtop.dynamics import _kernel
 from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.integrate.driver import StepReactions
@@ -170,7 +170,8 @@ class Trajectory(NetCDFOutput):
     @functools.cached_property
     def _diagnostics(self) -> FloatArray:
         out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
-        call(_kernel.diagnostics, self._code, self.body.params, np.ascontiguousarray(self.y), out)
+        dynamics = for_code(self._code).dynamics
+        call(dynamics.diagnostics, self._code, self.body.params, np.ascontiguousarray(self.y), out)
         return out
 
     @property

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from rollingtop import IntegrationError, ScenarioError, SphericalTop, initial_state
+from rollingtop._compiled import for_code
 from rollingtop.chaos import _tangent as tg
 from rollingtop.chaos import chaos_indicators, indicator_map, level_states
 from rollingtop.chaos.lyapunov import initial_tangent
@@ -44,17 +45,19 @@ def paper_state():
 def _tangent_after(body, model, y0, d0, t_end):
     """delta(t_end) of the compiled tangent dynamics (un-renormalised) and its start."""
     code = model.kernel_code(body, y0)
+    tangent = for_code(code).tangent
     p = body.params
     ws = new_workspace()
     z = np.zeros(tg.N_AUG)
     z[: tg.N_STATE], z[tg.DELTA : tg.N_ERR] = y0, d0
     scratch = np.zeros((4, tg.N_STATE))
-    tg.project_tangent(code, p, z[: tg.N_STATE], z[tg.DELTA : tg.N_ERR], scratch[2], scratch[3], ws)
+    tangent.project_tangent(code, p, z[: tg.N_STATE], z[tg.DELTA : tg.N_ERR], scratch[2],
+                            scratch[3], ws)  # fmt: skip
     start = z[tg.DELTA : tg.N_ERR].copy()
     ctrl = np.array([0.0, 1e-3, 1e-12, 1e-14, 0.0])
     fz = np.zeros(tg.N_AUG)
-    tg.aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
-    status = tg.advance(code, p, z, fz, ctrl, np.zeros(3, dtype=np.int64), t_end,
+    tangent.aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
+    status = tangent.advance(code, p, z, fz, ctrl, np.zeros(3, dtype=np.int64), t_end,
                         np.zeros((16, tg.N_AUG)), np.zeros(tg.N_AUG), np.zeros(tg.N_AUG),
                         scratch, ws, 0.0)  # fmt: skip
     assert status == 0

@@ -13,11 +13,12 @@ import numpy as np
 import pytest
 
 from rollingtop import InitialStateError, SphericalTop, initial_state
-from rollingtop.contact import KERNELS, MODELS, _codegen, _dispatch, kernel_by_code
-from rollingtop.dynamics import _kernel
+from rollingtop._compiled import _codegen, for_model
+from rollingtop.contact import KERNELS, MODELS, kernel_by_code
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
 from rollingtop.integrate.driver import integrate
+from tests import kernels as _kernel
 
 from ..conftest import admissible_omega
 
@@ -73,11 +74,14 @@ def _max_drift(values):
     return float(np.max(np.abs(v - v[0])) / max(1.0, abs(v[0])))
 
 
-def test_the_dispatch_is_generated_from_the_registry():
-    """Adding a model is one module plus one registry line, then the generator: the committed
-    dispatch must be what the generator writes from the registry."""
-    assert _codegen.TARGET.read_text() == _codegen.source(), (
-        "src/rollingtop/contact/_dispatch.py is stale: run python -m rollingtop.contact._codegen"
+def test_the_compiled_packages_are_generated_from_the_registry_and_the_template():
+    """Adding a model is one module plus one registry line, then the generator: every committed
+    file of the models' compiled packages must be what the generator writes from the registry
+    and the template, and no package of an unregistered model may remain."""
+    stale = [str(path) for path, text in _codegen.sources().items()
+             if not path.exists() or path.read_text() != text]  # fmt: skip
+    assert not stale and not _codegen.stale_packages(), (
+        f"stale generated files {stale}: run python -m rollingtop._compiled._codegen"
     )
 
 
@@ -91,9 +95,10 @@ def test_the_compiled_dispatch_agrees_with_the_model(kernel):
     assert model.kernels[0].code == model.code and kernel in model.kernels
     y = _state(SYMMETRIC, model)
     J, bias, dirs, _, _ = _kernel.new_workspace()
-    assert _dispatch.rows(kernel.code, SYMMETRIC.params, y, J, bias, dirs) == len(model.constraints)
-    assert _dispatch.carries_direction(kernel.code) == kernel.carries_direction
-    assert _dispatch.rows(len(KERNELS), SYMMETRIC.params, y, J, bias, dirs) == -1  # unknown
+    dispatch = for_model(model)._dispatch
+    assert kernel.code in dispatch.CODES and dispatch.CODES == tuple(k.code for k in model.kernels)
+    assert dispatch.rows(kernel.code, SYMMETRIC.params, y, J, bias, dirs) == len(model.constraints)
+    assert dispatch.carries_direction(kernel.code) == kernel.carries_direction
 
 
 @model_names

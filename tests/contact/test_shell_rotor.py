@@ -13,9 +13,9 @@ from scipy.integrate import solve_ivp
 
 from rollingtop import RollingTopError, ScenarioError, SphericalTop, initial_state, simulate
 from rollingtop.contact import MODELS
-from rollingtop.dynamics import _kernel
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.scenario import Scenario
+from tests import kernels as _kernel
 
 from ..conftest import EXAMPLES
 from ..dynamics import reference

@@ -6,8 +6,8 @@ from scipy.integrate import solve_ivp
 
 from rollingtop import SphericalTop, initial_state, simulate
 from rollingtop.contact import KERNELS, get_model, kernel_by_code
-from rollingtop.dynamics import _kernel
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
+from tests import kernels as _kernel
 
 from ..conftest import FREE, GAMMA0, OMEGA0, PAPER_BODY, admissible_omega
 from . import reference

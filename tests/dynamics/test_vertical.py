@@ -25,11 +25,12 @@ import sympy as sp
 
 from rollingtop import InitialStateError, SphericalTop, initial_state
 from rollingtop.contact import get_model, meridian
-from rollingtop.dynamics import _kernel, integrals
+from rollingtop.dynamics import integrals
 from rollingtop.dynamics.integrals import reduced_components
 from rollingtop.dynamics.state import constraint_residuals, project_state
 from rollingtop.integrate import integrate
 from rollingtop.reduction import LevelSet
+from tests import kernels as _kernel
 
 from ..conftest import PAPER_BODY
 

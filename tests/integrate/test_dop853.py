@@ -9,11 +9,11 @@ from scipy.optimize import brentq
 
 from rollingtop import ContactLostWarning, IntegrationError, SphericalTop, simulate
 from rollingtop.contact import get_model
-from rollingtop.dynamics import _kernel
 from rollingtop.integrate import integrate
 from rollingtop.integrate._dop853_stages import stage
 from rollingtop.integrate._dop853_tableau import N_STAGES_EXTENDED
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
+from tests import kernels as _kernel
 
 from ..conftest import GAMMA0, OMEGA0, PAPER_BODY
 from ..dynamics import reference

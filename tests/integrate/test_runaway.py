@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from rollingtop import IntegrationError, SphericalTop, initial_state, simulate
+from rollingtop._compiled import for_code
 from rollingtop.contact import get_model
 from rollingtop.integrate import _dop853 as dop
 from rollingtop.integrate import integrate
@@ -120,10 +121,11 @@ def test_stepper_stops_on_a_nan_or_underflowing_step(h):
     t_eval = np.array([1.0, 50.0])
     w = _workspace(t_eval.size)
     y, f = y0.copy(), np.zeros_like(y0)
-    ctrl, counts, track = dop.start(0, body.params, y, f, t_eval, 1e-10, 1e-12, 0, w["out"],
+    stepper = for_code(0).stepper
+    ctrl, counts, track = stepper.start(0, body.params, y, f, t_eval, 1e-10, 1e-12, 0, w["out"],
                                     w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
     ctrl[dop.H_ABS] = h
-    status = dop.run(0, body.params, y, f, ctrl, counts, track, t_eval, w["out"],
+    status = stepper.run(0, body.params, y, f, ctrl, counts, track, t_eval, w["out"],
                      np.zeros(2, dtype=np.int64), np.zeros(1), np.zeros((1, y.size)), 10**6,
                      w["K"], w["ynew"], w["ytmp"], w["y_old"], w["Fd"], w["ws"])  # fmt: skip
     assert status == dop.STEP_TOO_SMALL and counts[dop.STEPS] == 0

@@ -9,11 +9,11 @@ import sympy as sp
 
 from rollingtop import SphericalTop, initial_state, simulate
 from rollingtop.contact import MODELS
-from rollingtop.dynamics import _kernel
 from rollingtop.symbolic import check, rhs_function
 from rollingtop.symbolic import shell_rotor as P
 from rollingtop.symbolic.claims import Claim
 from rollingtop.symbolic.equations import SYMBOLS as S
+from tests import kernels as _kernel
 
 AGREE_RTOL = 1e-12  # derived accelerations vs the compiled kernel, relative to max |y'|
 LIMIT_EPS = 1e-8  # ms, Js = LIMIT_EPS * (their random values): the numerical limit

@@ -9,10 +9,10 @@ import pytest
 import sympy as sp
 
 from rollingtop.contact import MODELS
-from rollingtop.dynamics import _kernel
 from rollingtop.symbolic import check, claims_for, discover_linear_integrals, rhs_function, verify
 from rollingtop.symbolic.claims import Claim, _integrals, s_sym, theta_sym
 from rollingtop.symbolic.equations import SYMBOLS
+from tests import kernels as _kernel
 
 from ..dynamics.test_kernel import random_body, random_state
 from ..test_cli import run_cli

@@ -11,7 +11,7 @@ The divergence is the Riemannian one of the manifold ``M`` of constraint-consist
 the coordinates ``(v, w, alpha, beta, gamma)`` (Euclidean metric of ``R^15``, induced on ``M``):
 ``div_M f = sum_j (b_j, Df b_j)`` over an orthonormal basis ``b_j`` of the tangent space
 ``T_y M``. The basis comes from the linearised projection of the integrator
-(:func:`rollingtop.dynamics._kernel.project`) applied to the unit vectors, ``Df b`` from central
+(the model's compiled ``project``) applied to the unit vectors, ``Df b`` from central
 differences of the compiled right-hand side. Another metric changes ``div_M f`` by a total
 time derivative, not its time average. The horizontal position does not act on the motion and is
 left out; the carried azimuth ``psi_nu`` follows the axis azimuth in every perturbation (it is
@@ -30,13 +30,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import for_code
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.chaos.lyapunov import check_options, check_state
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.integrate.driver import integrate
 
@@ -78,9 +79,9 @@ def _project(code: int, p: FloatArray, y: FloatArray, psi_offset: float, ws: Any
     """Project ``y`` onto ``M`` in place, the carried azimuth kept at ``psi_offset`` from the
     axis azimuth of the projected frame (the integrator's projection orthonormalises the frame
     but, for a model that carries its direction always, leaves ``psi_nu`` as it is)."""
-    call(_kernel.project, code, p, y, ws)
+    call(for_code(code).dynamics.project, code, p, y, ws)
     y[17] = _azimuth(y) + psi_offset
-    call(_kernel.project, code, p, y, ws)
+    call(for_code(code).dynamics.project, code, p, y, ws)
 
 
 def _offset(y: FloatArray) -> float:
@@ -124,7 +125,7 @@ def manifold_divergence(body: SphericalTop, model: str | ContactModel, y: ArrayL
     _refuse_own_inertia(model)
     y = check_state(body, model, y)
     code = model.kernel_code(body, y)
-    return _divergence(code, body.params, y, call(_kernel.new_workspace))
+    return _divergence(code, body.params, y, call(new_workspace))
 
 
 def _divergence(code: int, p: FloatArray, y: FloatArray, ws: Any) -> float:
@@ -133,8 +134,9 @@ def _divergence(code: int, p: FloatArray, y: FloatArray, ws: Any) -> float:
     f1, f2 = np.empty(N_STATE), np.empty(N_STATE)
     total = 0.0
     for b in basis.T:
-        call(_kernel.rhs, code, p, _moved(y, b, e), f1, ws)
-        call(_kernel.rhs, code, p, _moved(y, b, -e), f2, ws)
+        rhs = for_code(code).dynamics.rhs
+        call(rhs, code, p, _moved(y, b, e), f1, ws)
+        call(rhs, code, p, _moved(y, b, -e), f2, ws)
         total += float(b @ (f1[:NCOORD] - f2[:NCOORD])) / (2.0 * e)
     return total
 
@@ -205,7 +207,7 @@ def phase_volume(
     code = model.kernel_code(body, y0)
     t = np.linspace(0.0, float(t_end), int(samples))
     traj = integrate(code, body.params, y0, t, rtol=rtol, atol=atol_)
-    ws = call(_kernel.new_workspace)
+    ws = call(new_workspace)
     div = np.array([_divergence(code, body.params, y, ws) for y in traj.y])
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (div[1:] + div[:-1]) * np.diff(t))])
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -8,7 +8,7 @@ subset ``hold``. A sample is drawn in two steps:
    is singular, and, for models with a vertical tolerance, within ``1e-3`` of the vertical), and
    the fixed frame's ``alpha`` uniform among the horizontal directions.
 2. **Velocities**: ``u = (v, w)`` in the model's constraint subspace at that orientation
-   (``J u = 0``, :func:`rollingtop.dynamics._kernel.constraint_rows`), with coordinates ``c`` in
+   (``J u = 0``, the model's compiled ``constraint_rows``), with coordinates ``c`` in
    an orthonormal basis of it. Every integral but the energy is linear in ``u`` for the models
    of the registry; their values fix ``c`` up to the null space ``N`` of their (numerical)
    Jacobian: ``c = c_p + x n`` with ``c_p`` the least-squares solution and ``n`` a random unit
@@ -33,12 +33,13 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import for_code
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import initial_state
@@ -110,8 +111,9 @@ def _orientation(
 
 def _velocity_basis(body: SphericalTop, model: ContactModel, y: FloatArray) -> FloatArray:
     """Orthonormal basis of the constraint subspace ``J u = 0`` at ``y``, shape (d, 6)."""
-    J, bias, dirs, _, _ = call(_kernel.new_workspace)
-    nc = call(_kernel.constraint_rows, model.kernel_code(body, y), body.params, y, J, bias, dirs)
+    J, bias, dirs, _, _ = call(new_workspace)
+    code = model.kernel_code(body, y)
+    nc = call(for_code(code).dynamics.constraint_rows, code, body.params, y, J, bias, dirs)
     if nc == 0:
         return np.eye(6)
     _, sv, vt = np.linalg.svd(J[:nc])

@@ -27,18 +27,19 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import compiling, for_code
 from rollingtop._errors import IntegrationError, ScenarioError
 from rollingtop._jit import call
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._tangent import REACHED_VERTICAL, run_indicators
+from rollingtop.chaos._tangent import REACHED_VERTICAL
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
 from rollingtop.integrate._dop853 import FINISHED, STATUS_NAMES
-from rollingtop.integrate.driver import _raise_for_status, compile_kernels
+from rollingtop.integrate.driver import _raise_for_status
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -177,7 +178,7 @@ class ChaosIndicators(NetCDFOutput):
         )
 
 
-_indicators_compiled = False
+_indicators_compiled: set[str] = set()
 
 
 def _compile_indicators(
@@ -186,15 +187,17 @@ def _compile_indicators(
 ) -> float:  # fmt: skip
     """Compile (or load) the tangent kernel apart from a timed run, by a run of one tiny step;
     seconds spent, 0 after the first call in a process (its types never change)."""
-    global _indicators_compiled
-    if _indicators_compiled:
+    kernels = for_code(code)
+    if kernels.MODEL in _indicators_compiled:
         return 0.0
     import time
 
     start = time.perf_counter()
-    call(run_indicators, code, p, y0.copy(), d0.copy(), np.array([1e-9]), float(rtol), atol, 1,
-         np.full((1, 3), np.nan), np.full((1, N_STATE), np.nan), np.zeros(4), stop)  # fmt: skip
-    _indicators_compiled = True
+    with compiling(kernels.MODEL, "chaos"):
+        call(kernels.tangent.run_indicators, code, p, y0.copy(), d0.copy(), np.array([1e-9]),
+             float(rtol), atol, 1, np.full((1, 3), np.nan), np.full((1, N_STATE), np.nan),
+             np.zeros(4), stop)  # fmt: skip
+    _indicators_compiled.add(kernels.MODEL)
     return time.perf_counter() - start
 
 
@@ -251,10 +254,10 @@ def chaos_indicators(
     import time
 
     stop = vertical_stop(model)
-    compiled = compile_kernels() + _compile_indicators(code, body.params, y0, d0, rtol, atol, stop)
+    compiled = _compile_indicators(code, body.params, y0, d0, rtol, atol, stop)
     start = time.perf_counter()
-    call(run_indicators, code, body.params, y0, d0, t, float(rtol), atol, int(max_steps), out,
-         states, stats, stop)  # fmt: skip
+    call(for_code(code).tangent.run_indicators, code, body.params, y0, d0, t, float(rtol), atol,
+         int(max_steps), out, states, stats, stop)  # fmt: skip
     wall = time.perf_counter() - start
     status = int(stats[0])
     if status != FINISHED:

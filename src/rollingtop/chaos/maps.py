@@ -8,16 +8,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import compiling, for_code
 from rollingtop._errors import ScenarioError
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._kernels import indicator_batch
 from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos._tangent import STATUS_NAMES
 from rollingtop.chaos.lyapunov import check_options, check_state, initial_tangent, vertical_stop
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics._layout import N_STATE
-from rollingtop.integrate.driver import compile_kernels
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -34,11 +33,13 @@ def _chunk(
     t: FloatArray, rtol: float, atol: float, max_steps: int, s_stop: float, threads: int | None,
 ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
     """One batch (a Dask task, or the whole map in-process): outputs ``(out, stats)``."""
-    compile_kernels()
     out = np.full((len(states), t.size, 3), np.nan)
     stats = np.zeros((len(states), 4))
-    run_threaded(indicator_batch, (codes, params, states, tangents, t, rtol, atol, max_steps,
-                                   out, stats, s_stop), threads)  # fmt: skip
+    kernels = for_code(int(codes[0]))  # one model: its own compiled batch
+    with compiling(kernels.MODEL, "chaos"):
+        run_threaded(kernels.chaos.indicator_batch, (codes, params, states, tangents, t, rtol,
+                                                     atol, max_steps, out, stats, s_stop),
+                     threads)  # fmt: skip
     return out, stats
 
 

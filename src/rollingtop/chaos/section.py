@@ -6,7 +6,7 @@ positive), where ``tau = e3 x gamma / s`` (``docs/model.md``, "Reduced variables
 the minima of ``gamma3``: the lowest inclinations of the axis, reached once per nutation. The
 event function is the stepper's ``W_TAU`` (``s w_tau = (w, e3 x gamma)``,
 :mod:`rollingtop.dynamics._events`), located on the 7th-order dense output of each step by
-bisection (:func:`rollingtop.integrate._dop853_dense.event_root`, 60 halvings) and the state
+bisection (:func:`rollingtop._compiled._template.dense.event_root`, 60 halvings) and the state
 there projected onto the constraints.
 
 **The plane** of the points is ``(gamma3, w_n)``, ``w_n = (w, n)``, ``n = -(gamma1, gamma2, 0)
@@ -37,10 +37,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rollingtop._compiled import compiling, for_model
 from rollingtop._errors import InitialStateError, ScenarioError
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._kernels import SECTION_STATS, section_batch
+from rollingtop.chaos._kernels import SECTION_STATS
 from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.contact import ContactModel, get_model
@@ -48,7 +49,6 @@ from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import reduced_components
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
 from rollingtop.integrate._dop853 import STATUS_NAMES
-from rollingtop.integrate.driver import compile_kernels
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -167,13 +167,13 @@ def poincare_section(
     if K * crossings > MAX_POINTS:
         raise ScenarioError(f"{K} trajectories x {crossings} crossings exceeds {MAX_POINTS}")
     codes = np.array([model.kernel_code(body, y) for y in Y0], dtype=np.int64)
-    compile_kernels()
     ev_t = np.full((K, crossings), np.nan)
     ev_y = np.full((K, crossings, N_STATE), np.nan)
     stats = np.zeros((K, len(SECTION_STATS)))
-    wall, used = run_threaded(section_batch, (codes, body.params, Y0, float(t_max), float(rtol),
-                                              float(atol), int(max_steps), ev_t, ev_y, stats),
-                              threads)  # fmt: skip
+    with compiling(model, "chaos"):
+        wall, used = run_threaded(for_model(model).chaos.section_batch,
+                                  (codes, body.params, Y0, float(t_max), float(rtol), float(atol),
+                                   int(max_steps), ev_t, ev_y, stats), threads)  # fmt: skip
     found = stats[:, 1].astype(int)
     mask = np.arange(crossings)[None, :] >= found[:, None]
     ev_t[mask] = np.nan

@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from rollingtop._signals import handle_signals
+from rollingtop.cli._compile_notice import compile_notices
 from rollingtop.cli._errors import reported
 from rollingtop.cli._output import warnings_as_lines
 
@@ -41,3 +42,4 @@ def cli(ctx: click.Context) -> None:
         click.echo(ctx.get_help())
         ctx.exit()
     ctx.with_resource(warnings_as_lines())
+    ctx.with_resource(compile_notices())

@@ -1,7 +1,8 @@
 """Closed forms of the constrained equations for the contact row ``(vp, gamma) = 0`` and, if
 present, one more contact row ``(vp, n) = 0`` (the smooth and meridian models): the same
-equations as the general path (:func:`rollingtop.dynamics._kernel.rhs_rows`), written out in
-scalars (a 1x1 or 2x2 solve), several times faster. The tests hold them to the general path."""
+equations as the general path (:func:`rollingtop._compiled._template.dynamics.rhs_rows`),
+written out in scalars (a 1x1 or 2x2 solve), several times faster. The tests hold them to the
+general path."""
 
 from __future__ import annotations
 
@@ -73,8 +74,8 @@ def rhs_contact(
 def project_contact(
     p: FloatArray, y: FloatArray, two: bool, n1: float, n2: float, n3: float
 ) -> None:
-    """The velocity projection (:func:`rollingtop.dynamics._kernel.project`) for the normal row
-    and, if ``two``, the row along ``n`` (the rows of :func:`rhs_contact`; a 1x1 or 2x2
+    """The velocity projection (:func:`rollingtop._compiled._template.dynamics.project`) for the
+    normal row and, if ``two``, the row along ``n`` (the rows of :func:`rhs_contact`; a 1x1 or 2x2
     solve)."""
     R, m, a3, I1, I2, I3 = p[0], p[1], p[3], p[4], p[5], p[6]
     im, i1, i2, i3 = 1.0 / m, 1.0 / I1, 1.0 / I2, 1.0 / I3

@@ -109,7 +109,8 @@ def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: 
 
 @inline
 def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
-    """Closed form of the velocity projection (:func:`rollingtop.dynamics._kernel.project`):
+    """Closed form of the velocity projection
+    (:func:`rollingtop._compiled._template.dynamics.project`):
     ``lambda = A^-1 vp``, ``v <- v - lambda / m``, ``w <- w - I^-1 (r x lambda)``."""
     R, m, a3 = p[0], p[1], p[3]
     g1, g2, g3 = y[12], y[13], y[14]

@@ -117,7 +117,8 @@ def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: 
 
 @inline
 def project_velocity(p: FloatArray, y: FloatArray, variant: int) -> None:
-    """Closed form of the velocity projection (:func:`rollingtop.dynamics._kernel.project`):
+    """Closed form of the velocity projection
+    (:func:`rollingtop._compiled._template.dynamics.project`):
     ``(lambda, mu) = A^-1 (vp, (w, gamma))``, ``v <- v - lambda / m``,
     ``w <- w - I^-1 (r x lambda + mu gamma)``."""
     R, m, a3 = p[0], p[1], p[3]

@@ -227,7 +227,7 @@ def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: 
     :func:`rollingtop.dynamics._kernel.reaction`: the contact force along the body axes."""
     vd1, vd2, vd3, wd1, wd2, wd3, dd, l1, l2, l3 = accelerations(p, y)
     dy[0], dy[1], dy[2], dy[3], dy[4], dy[5] = vd1, vd2, vd3, wd1, wd2, wd3
-    dy[DELTA] = dd  # after the kinematics (rollingtop.dynamics._kernel.rhs)
+    dy[DELTA] = dd  # after the kinematics (rollingtop._compiled._template.dynamics.rhs)
     dirs, lam = ws[2], ws[4]
     for k in range(3):
         for c in range(3):

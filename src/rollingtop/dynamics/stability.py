@@ -29,13 +29,14 @@ from typing import Any
 
 import numpy as np
 
+from rollingtop._compiled import for_code
 from rollingtop._errors import RollingTopError
 from rollingtop._jit import call
 from rollingtop._numdiff import central_jacobian
 from rollingtop._types import ComplexArray, FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 
 __all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]
@@ -78,16 +79,17 @@ def _generic_eigenvalues(
     x0[8] = float(pole)
     code = model.kernel_code(body, _state(x0))
     p = body.params
-    ws = call(_kernel.new_workspace)
+    ws = call(new_workspace)
+    dynamics = for_code(code).dynamics
 
     def rhs(x: FloatArray) -> FloatArray:
         dy = np.zeros(N_STATE)
-        call(_kernel.rhs, code, p, _state(x), dy, ws)
+        call(dynamics.rhs, code, p, _state(x), dy, ws)
         return np.concatenate([dy[0:6], dy[12:15]])
 
     def constraints(x: FloatArray) -> FloatArray:
         J, bias, dirs = np.zeros((4, 6)), np.zeros(4), np.zeros((4, 3))
-        nc = call(_kernel.constraint_rows, code, p, _state(x), J, bias, dirs)
+        nc = call(dynamics.constraint_rows, code, p, _state(x), J, bias, dirs)
         return np.concatenate([[x[6:9] @ x[6:9] - 1.0], J[:nc] @ x[0:6]])
 
     G = central_jacobian(constraints, x0)

@@ -8,12 +8,13 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import compiling, for_code
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics import _kernel
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
 
 __all__ = ["initial_state", "constraint_residuals", "project_state", "UNIT_TOLERANCE"]
@@ -109,8 +110,9 @@ def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: Array
     """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
     model = get_model(model)
     state = np.asarray(y, dtype=float)
-    J, bias, dirs, _, _ = call(_kernel.new_workspace)
-    nc = call(_kernel.constraint_rows, model.code, body.params, state, J, bias, dirs)
+    J, bias, dirs, _, _ = call(new_workspace)
+    nc = call(for_code(model.code).dynamics.constraint_rows, model.code, body.params, state, J,
+              bias, dirs)  # fmt: skip
     residuals: FloatArray = J[:nc] @ state[:6]
     return residuals
 
@@ -238,7 +240,9 @@ def initial_state(
         y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
     if model.slot_value is not None:
         y[17] = model.slot_value(body, y)
-    call(_kernel.project, _start_code(body, model, y), body.params, y, call(_kernel.new_workspace))
+    code = _start_code(body, model, y)
+    with compiling(model, "integrator"):  # the projection: a model's first compiled kernel
+        call(for_code(code).dynamics.project, code, body.params, y, call(new_workspace))
     return y
 
 
@@ -284,9 +288,12 @@ def project_state(
         y[9:12] = np.cross(gamma, y[6:9])
     if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
         y[17] = model.vertical_direction(y[3:6], y[6:9], y[9:12], y[17])
-    ws = call(_kernel.new_workspace)
-    if model.slot_value is not None:  # the rows' projection of (v, w), then the model's slot
-        call(_kernel.project_velocity_rows, _start_code(body, model, y), body.params, y, ws)
-        y[17] = model.slot_value(body, y)
-    call(_kernel.project, _start_code(body, model, y), body.params, y, ws)
+    ws = call(new_workspace)
+    code = _start_code(body, model, y)
+    dynamics = for_code(code).dynamics
+    with compiling(model, "integrator"):
+        if model.slot_value is not None:  # the rows' projection of (v, w), then the model's slot
+            call(dynamics.project_velocity_rows, code, body.params, y, ws)
+            y[17] = model.slot_value(body, y)
+        call(dynamics.project, code, body.params, y, ws)
     return y

@@ -10,12 +10,13 @@ from typing import TypedDict
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import compiling, for_code, for_model
 from rollingtop._errors import IntegrationError
 from rollingtop._jit import call
 from rollingtop._types import FloatArray, IntArray, Workspace
-from rollingtop.contact import KERNELS
-from rollingtop.dynamics import _kernel
+from rollingtop.contact import DEFAULT_MODEL, ContactModel, get_model, kernel_by_code
 from rollingtop.dynamics._events import EVENTS
+from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop.integrate import _dop853 as dop
 
@@ -26,7 +27,8 @@ __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
 #: :mod:`rollingtop._signals`). Resuming does not change the step sequence.
 PROGRESS_CHUNK = 20_000
 
-_compile_time: float | None = None
+#: Seconds each model's integrator took to compile or load in this process.
+_compiled: dict[str, float] = {}
 
 
 class StepReactions(TypedDict, total=False):
@@ -98,31 +100,36 @@ def _workspace(n_samples: int) -> _Work:
         ytmp=np.zeros(N_STATE),
         y_old=np.zeros(N_STATE),
         Fd=np.zeros((7, N_STATE)),
-        ws=call(_kernel.new_workspace),
+        ws=call(new_workspace),
         out=np.full((n_samples, N_STATE), np.nan),
     )
 
 
-def compile_kernels() -> float:
-    """Compile (or load from numba's cache) the integrator's kernels; returns the seconds spent.
+def compile_kernels(model: str | ContactModel = DEFAULT_MODEL) -> float:
+    """Compile (or load from numba's cache) ``model``'s integrator kernels -- its projection,
+    stepper (with and without events) and diagnostics -- and no other model's; returns the
+    seconds spent.
 
-    Only the first call in a process does work; later calls return 0.
+    Only the first call for a model in a process does work; later calls return 0. When numba
+    compiles (its cache holds nothing for them yet) the compiled core's notifier says so first
+    (:func:`rollingtop._compiled.compiling`).
     """
-    global _compile_time
-    if _compile_time is not None:
+    name = get_model(model).name
+    if name in _compiled:
         return 0.0
     start = time.perf_counter()
     p = np.array(WARMUP_PARAMS)
     y = np.zeros(N_STATE)
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
-    for code in (k.code for k in KERNELS):
-        yy = y.copy()
-        call(_kernel.project, code, p, yy, call(_kernel.new_workspace))
-        _run_compiled(code, p, yy, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
-        call(_kernel.diagnostics, code, p, yy[None, :].copy(), np.zeros((1, 8)))
-    _compile_time = time.perf_counter() - start
-    return _compile_time
+    kernels = for_model(name)
+    code = kernels._dispatch.CODES[0]
+    with compiling(name, "integrator"):
+        call(kernels.dynamics.project, code, p, y, call(new_workspace))
+        _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
+        call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
+    _compiled[name] = time.perf_counter() - start
+    return _compiled[name]
 
 
 def _run_compiled(
@@ -138,6 +145,7 @@ def _run_compiled(
 ) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
     n = t_eval.shape[0]
     w = _workspace(n)
+    stepper = for_code(code).stepper
     ev_code, ev_direction, capacity = event
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
@@ -145,7 +153,7 @@ def _run_compiled(
     ev_y = np.empty((capacity, N_STATE))
     y = y0.copy()
     f = np.zeros(N_STATE)
-    ctrl, counts, track = call(dop.start, code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
+    ctrl, counts, track = call(stepper.start, code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
                                     w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
     t_end = float(t_eval[-1])
     start = time.perf_counter()
@@ -154,7 +162,7 @@ def _run_compiled(
         if max_steps is not None:
             budget = min(budget, max_steps - int(counts[dop.STEPS]))
         status = call(
-            dop.run,
+            stepper.run,
             code,
             p,
             y,
@@ -192,7 +200,8 @@ def _run_compiled(
 
 
 def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
-    """:class:`IntegrationError` (one line) for a status of ``dop.run`` that ends a run early."""
+    """:class:`IntegrationError` (one line) for a status of the stepper's ``run`` that ends a run
+    early."""
     t, h = float(ctrl[dop.T]), float(ctrl[dop.H_ABS])
     if status == dop.STEP_TOO_SMALL and np.isnan(h):
         raise IntegrationError(
@@ -291,7 +300,7 @@ def integrate(
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
     event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
-    compile_s = compile_kernels()
+    compile_s = compile_kernels(kernel_by_code(int(code)).model)
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
         params,

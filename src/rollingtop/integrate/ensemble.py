@@ -18,19 +18,16 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from typing import Any, cast
 
 import numba
 import numpy as np
-from numba import prange, types
-from numba.extending import intrinsic
 from numpy.typing import ArrayLike
 
-from rollingtop._jit import call, compiled
-from rollingtop._types import FloatArray, IntArray
-from rollingtop.dynamics._kernel import new_workspace
+from rollingtop._compiled import compiling, for_model
+from rollingtop._jit import call
+from rollingtop._types import FloatArray
+from rollingtop.contact import DEFAULT_MODEL, KERNELS, ContactModel, get_model
 from rollingtop.dynamics._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
-from rollingtop.integrate import _dop853 as dop
 
 __all__ = ["integrate_batch", "compile_ensemble"]
 
@@ -40,122 +37,29 @@ BATCH = 256
 #: contiguous block per thread up front; trajectories differ in cost (a grid of initial states
 #: runs from cheap to dear), so small chunks taken on demand keep every core busy to the end.
 CHUNK = 4
-#: Accepted steps of a trajectory between two looks at the stop flag (about a millisecond).
-STOP_POLL_STEPS = 1000
 #: Seconds the calling thread waits for the worker at a time (its signal handlers run between).
 WAIT_SLICE = 0.05
 
-
-@intrinsic
-def _read_flag_intrinsic(typingctx: Any, flag: types.Type) -> Any:
-    """``flag[0]`` of an int64 array, by an atomic (relaxed) load: another thread sets it while
-    a compiled loop runs, and a plain load could be hoisted out of that loop by the compiler.
-
-    The arguments are numba's typing context and the argument's numba type; the result is the
-    signature and the code generator (``None``: not an int64 array)."""
-    if not (isinstance(flag, types.Array) and flag.dtype == types.int64):
-        return None
-
-    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
-        array = context.make_array(signature.args[0])(context, builder, args[0])
-        return builder.load_atomic(array.data, "monotonic", 8)
-
-    return types.int64(flag), codegen
+_compiled: set[str] = set()
 
 
-#: What :func:`_read_flag_intrinsic` is in compiled code. numba's stubs type an intrinsic's call
-#: with its typing function's parameters (the typing context included) and as never returning.
-_read_flag = cast(Callable[[IntArray], int], _read_flag_intrinsic)
-
-
-@compiled()
-def _integrate_one(
-    code: int,
-    p: FloatArray,
-    y0: FloatArray,
-    t_eval: FloatArray,
-    rtol: float,
-    atol: float,
-    max_steps: int,
-    out: FloatArray,
-    final: FloatArray,
-    stats: FloatArray,
-    stop: IntArray,
-) -> None:
-    """Integrate one trajectory; ``out`` (len(t_eval), 18) samples, ``final`` (18,) state,
-    ``stats`` (6,): status (``dop.FINISHED``, a failure code, ``dop.BUDGET_EXHAUSTED`` for
-    ``max_steps`` accepted steps, ``dop.INTERRUPTED`` when ``stop[0]`` was set), steps,
-    rejected, rhs evaluations, min normal force, max friction ratio."""
-    n = N_STATE
-    K = np.zeros((16, n))
-    ynew = np.zeros(n)
-    ytmp = np.zeros(n)
-    y_old = np.zeros(n)
-    Fd = np.zeros((7, n))
-    ws = new_workspace()
-    y = y0.copy()
-    f = np.zeros(n)
-    ctrl, counts, track = dop.start(code, p, y, f, t_eval, rtol, atol, 0, out, ytmp, ynew, ws)
-    ev_spec = np.zeros(2, dtype=np.int64)
-    ev_t = np.zeros(1)
-    ev_y = np.zeros((1, n))
-    while True:
-        if _read_flag(stop) != 0:
-            status = dop.INTERRUPTED
-            break
-        budget = min(STOP_POLL_STEPS, max_steps - counts[dop.STEPS])
-        status = dop.run(code, p, y, f, ctrl, counts, track, t_eval, out, ev_spec, ev_t, ev_y,
-                         budget, K, ynew, ytmp, y_old, Fd, ws)  # fmt: skip
-        if status != dop.BUDGET_EXHAUSTED or counts[dop.STEPS] >= max_steps:
-            break
-    for i in range(n):
-        final[i] = y[i]
-    stats[0] = status
-    stats[1] = counts[dop.STEPS]
-    stats[2] = counts[dop.REJECTED]
-    stats[3] = counts[dop.NFEV]
-    stats[4] = track[dop.MIN_NORMAL]
-    stats[5] = track[dop.MAX_RATIO]
-
-
-@compiled(parallel=True, nogil=True)
-def _batch(
-    codes: IntArray,
-    P: FloatArray,
-    Y0: FloatArray,
-    t_eval: FloatArray,
-    rtol: float,
-    atol: float,
-    max_steps: int,
-    out: FloatArray,
-    final: FloatArray,
-    stats: FloatArray,
-    stop: IntArray,
-) -> None:
-    for k in prange(Y0.shape[0]):
-        if _read_flag(stop) != 0:
-            stats[k, 0] = dop.INTERRUPTED
-        else:
-            _integrate_one(codes[k], P[k], Y0[k], t_eval, rtol, atol, max_steps, out[k],
-                           final[k], stats[k], stop)  # fmt: skip
-
-
-_compiled = False
-
-
-def compile_ensemble() -> float:
-    """Compile (or load from the cache) the parallel kernel; seconds spent (0 when done)."""
-    global _compiled
-    if _compiled:
+def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL) -> float:
+    """Compile (or load from the cache) ``model``'s parallel kernel, and no other model's;
+    seconds spent (0 when done in this process)."""
+    name = get_model(model).name
+    if name in _compiled:
         return 0.0
     start = time.perf_counter()
     y = np.zeros((1, N_STATE))
     y[0, 6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
     P = np.array([WARMUP_PARAMS])
-    call(_batch, np.zeros(1, dtype=np.int64), P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
-           np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
-           np.zeros(1, dtype=np.int64))  # fmt: skip
-    _compiled = True
+    kernels = for_model(name)
+    codes = np.full(1, kernels._dispatch.CODES[0], dtype=np.int64)
+    with compiling(name, "ensemble"):
+        call(kernels.ensemble.batch, codes, P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
+             np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
+             np.zeros(1, dtype=np.int64))  # fmt: skip
+    _compiled.add(name)
     return time.perf_counter() - start
 
 
@@ -176,7 +80,8 @@ def integrate_batch(
     Parameters
     ----------
     codes : ndarray of int, shape (N,)
-        Kernel code of each trajectory.
+        Kernel code of each trajectory. Trajectories of several models are run model by model,
+        each by its own compiled kernel (:func:`compile_ensemble` compiles it first).
     params : ndarray, shape (N, 9)
         Body parameters of each trajectory.
     states : ndarray, shape (N, 18)
@@ -215,6 +120,10 @@ def integrate_batch(
     if params.shape != (N, N_PARAMS) or codes.shape != (N,):  # the kernels do not check reads
         raise ValueError(f"params must have shape ({N}, {N_PARAMS}) and codes ({N},), got "
                          f"{params.shape} and {codes.shape}")  # fmt: skip
+    if N and (codes.min() < 0 or codes.max() >= len(KERNELS)):
+        bad = codes[(codes < 0) | (codes >= len(KERNELS))][0]
+        raise ValueError(f"unknown kernel code {bad} (known: 0 to {len(KERNELS) - 1})")
+    models = np.array([k.model for k in KERNELS])[codes]
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     out = np.full((N, t_eval.size, N_STATE), np.nan)
     final = np.full((N, N_STATE), np.nan)
@@ -230,17 +139,30 @@ def integrate_batch(
     done = [0]  # trajectories finished, written by the worker
     failure: list[BaseException] = []
 
+    # model by model, each by its own compiled kernel (compiled here, in the calling thread)
+    groups = [(for_model(name).ensemble.batch, np.flatnonzero(models == name))
+              for name in dict.fromkeys(models)]  # fmt: skip
+    for name in dict.fromkeys(models):
+        compile_ensemble(name)
+
     def work() -> None:
         try:
             numba.set_num_threads(n_threads)
-            for lo in range(0, N, step):
-                hi = min(N, lo + step)
-                with numba.parallel_chunksize(CHUNK):
-                    call(_batch, codes[lo:hi], params[lo:hi], states[lo:hi], t_eval, rtol, atol,
-                           max_steps, out[lo:hi], final[lo:hi], stats[lo:hi], stop)  # fmt: skip
-                if stop[0]:
-                    return
-                done[0] = hi
+            for batch, idx in groups:
+                contiguous = idx.size == idx[-1] - idx[0] + 1
+                for lo in range(0, idx.size, step):
+                    hi = min(idx.size, lo + step)
+                    rows = slice(idx[lo], idx[hi - 1] + 1) if contiguous else idx[lo:hi]
+                    # a slice is a view the kernel writes into; fancy indexing is a copy
+                    part = out[rows], final[rows], stats[rows]
+                    with numba.parallel_chunksize(CHUNK):
+                        call(batch, codes[rows], params[rows], states[rows], t_eval, rtol, atol,
+                             max_steps, *part, stop)  # fmt: skip
+                    if not contiguous:
+                        out[rows], final[rows], stats[rows] = part
+                    if stop[0]:
+                        return
+                    done[0] += hi - lo
         except BaseException as exc:  # pragma: no cover - re-raised in the calling thread
             failure.append(exc)
 

@@ -21,9 +21,9 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from rollingtop._compiled import compiling, for_model
 from rollingtop._jit import call
 from rollingtop.contact.meridian import MODEL
-from rollingtop.dynamics import _kernel
 from rollingtop.reduction import (
     LevelSet,
     LevelSetError,
@@ -93,8 +93,9 @@ def _normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatA
             h = float(level.energy(theta, ww))
             states.append(state_from_level(level, h, gg, branch=1 if ww >= 0 else -1))
     Y = np.ascontiguousarray(states)
-    out = np.empty((len(Y), 8))
-    call(_kernel.diagnostics, MODEL.code, level.body.params, Y, out)
+    out = np.empty((len(Y), 2))
+    with compiling(MODEL, "dynamics"):
+        call(for_model(MODEL).dynamics.contact_forces, MODEL.code, level.body.params, Y, out)
     return out[:, 0].reshape(len(g3), len(w)).T
 
 

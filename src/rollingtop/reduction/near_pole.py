@@ -109,9 +109,9 @@ def friction_needed(
 
 def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[float, float]:
     """:func:`friction_needed` on the canonical level and orbit (``canonical_orbit``)."""
+    from rollingtop._compiled import compiling, for_model
     from rollingtop._jit import call
     from rollingtop.contact.meridian import MODEL
-    from rollingtop.dynamics import _kernel
     from rollingtop.reduction.variables import state_from_level
 
     t1, t2 = o.theta_min, o.theta_max
@@ -130,8 +130,9 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[flo
             hh = max(h, float(lv.U(theta)))  # round-off at the turning points
             states.append(state_from_level(lv, hh, 0.0, theta=float(theta), branch=branch))
     Y = np.ascontiguousarray(states)
-    out = np.zeros((Y.shape[0], 8))
-    call(_kernel.diagnostics, MODEL.code, lv.body.params, Y, out)
+    out = np.zeros((Y.shape[0], 2))
+    with compiling(MODEL, "dynamics"):
+        call(for_model(MODEL).dynamics.contact_forces, MODEL.code, lv.body.params, Y, out)
     N, F = out[:, 0], out[:, 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(N > 0, np.abs(F) / N, np.inf)

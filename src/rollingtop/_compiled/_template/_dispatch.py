@@ -1,0 +1,57 @@
+"""What each model's compiled dispatch provides: the template's stand-in, never compiled.
+
+The generator (:mod:`rollingtop._compiled._codegen`) writes one ``_dispatch`` module per contact
+model with these names and signatures, each calling the model module's own functions
+(:mod:`rollingtop.contact`, whose package docstring lists them) with the kernel's variant: the
+code minus the model's first code where the model has variants, the constant 0 otherwise.
+"""
+
+from __future__ import annotations
+
+from rollingtop._types import FloatArray, Workspace
+
+#: Whether the model has closed-form accelerations (``accel``); if not, the right-hand side is
+#: the general path (rows and a Cholesky solve). Imported by name as a global constant: numba
+#: prunes the branch not taken before typing (not for an attribute of a module), so a model with
+#: a closed form never compiles the general path into its stepper.
+CLOSED_ACCEL = True
+#: Whether the model has a closed-form velocity projection (``project_velocity``).
+CLOSED_PROJECTION = True
+#: The model's kernel codes (its own, then its variants').
+CODES: tuple[int, ...] = ()
+
+
+def _template() -> NotImplementedError:
+    return NotImplementedError("the template's dispatch is never compiled (see the module)")
+
+
+def rows(
+    code: int, p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray
+) -> int:
+    """The constraint rows of kernel ``code``, their bias and force directions; their number."""
+    raise _template()
+
+
+def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) -> int:
+    """Closed-form accelerations of kernel ``code`` into ``dy[:6]``; the number of rows."""
+    raise _template()
+
+
+def project_velocity(code: int, p: FloatArray, y: FloatArray) -> None:
+    """Closed-form velocity projection of kernel ``code``, in place."""
+    raise _template()
+
+
+def direction_rate(code: int, p: FloatArray, y: FloatArray) -> float:
+    """``psi_nu'`` under kernel ``code`` (0 unless it carries a constraint direction)."""
+    raise _template()
+
+
+def sync_direction(code: int, y: FloatArray) -> None:
+    """Re-synchronise ``psi_nu`` with the axis azimuth after a step, as kernel ``code`` does."""
+    raise _template()
+
+
+def carries_direction(code: int) -> bool:
+    """Whether kernel ``code`` carries its constraint direction in ``psi_nu``."""
+    raise _template()

@@ -1,0 +1,153 @@
+"""Compiled batches of one contact model: Poincare crossings of many trajectories, and the chaos
+indicators of many initial states, in parallel (numba ``prange``; one stepper with its own work
+arrays per trajectory). Their constants: :mod:`rollingtop.chaos._kernels`."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import prange
+
+from rollingtop._compiled._template.dynamics import project, rhs
+from rollingtop._compiled._template.events import event_value
+from rollingtop._compiled._template.stepper import run, start
+from rollingtop._compiled._template.tangent import run_indicators
+from rollingtop._jit import compiled, kernel
+from rollingtop._types import FloatArray, IntArray, Workspace
+from rollingtop.chaos._kernels import POLISH_DT, POLISH_ITERATIONS
+from rollingtop.dynamics._events import W_TAU
+from rollingtop.dynamics._kernel import new_workspace
+from rollingtop.dynamics._layout import N_STATE
+from rollingtop.integrate import _dop853 as dop
+from rollingtop.integrate._flags import STOP_POLL_STEPS, read_flag
+
+
+@kernel
+def polish_crossing(
+    code: int, p: FloatArray, y: FloatArray, f: FloatArray, ytmp: FloatArray, ws: Workspace
+) -> float:
+    """Newton corrections ``dt = -g / g'`` of a crossing ``y`` located on the dense output
+    (in place, along the flow ``y += dt y'``, then projected), so that the state lies on the
+    section to round-off; returns the total time shift. The bisection leaves ``|g|`` at the
+    interpolant's error (``~rtol``); the shift is of that size, and the state's own error (the
+    integration's) is unchanged."""
+    shift = 0.0
+    for _ in range(POLISH_ITERATIONS):
+        g = event_value(W_TAU, code, y)
+        rhs(code, p, y, f, ws)
+        for i in range(N_STATE):
+            ytmp[i] = y[i] + POLISH_DT * f[i]
+        g1 = event_value(W_TAU, code, ytmp)
+        for i in range(N_STATE):
+            ytmp[i] = y[i] - POLISH_DT * f[i]
+        g2 = event_value(W_TAU, code, ytmp)
+        dg = (g1 - g2) / (2.0 * POLISH_DT)
+        if g == 0.0 or dg == 0.0:
+            break
+        dt = -g / dg
+        for i in range(N_STATE):
+            y[i] += dt * f[i]
+        project(code, p, y, ws)
+        shift += dt
+    return shift
+
+
+@compiled()
+def section_one(
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    t_max: float,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    ev_t: FloatArray,
+    ev_y: FloatArray,
+    stats: FloatArray,
+    stop: IntArray,
+) -> None:
+    """Upward zeros of the ``W_TAU`` event along one trajectory until ``len(ev_t)`` are found,
+    ``t_max`` is reached or ``max_steps`` steps are taken. ``stats``: :data:`SECTION_STATS`."""
+    n = N_STATE
+    K = np.zeros((16, n))
+    ynew = np.zeros(n)
+    ytmp = np.zeros(n)
+    y_old = np.zeros(n)
+    Fd = np.zeros((7, n))
+    ws = new_workspace()
+    y = y0.copy()
+    f = np.zeros(n)
+    t_eval = np.array([0.0, t_max])
+    out = np.zeros((2, n))
+    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, W_TAU, out, ytmp, ynew, ws)
+    ev_spec = np.array([W_TAU, 1], dtype=np.int64)
+    wanted = ev_t.shape[0]
+    while True:
+        if read_flag(stop) != 0:
+            status = dop.INTERRUPTED
+            break
+        budget = min(STOP_POLL_STEPS // 10, max_steps - counts[dop.STEPS])
+        status = run(code, p, y, f, ctrl, counts, track, t_eval, out, ev_spec, ev_t, ev_y,
+                         budget, K, ynew, ytmp, y_old, Fd, ws)  # fmt: skip
+        if counts[dop.N_EVENTS] >= wanted:
+            status = dop.FINISHED
+            break
+        if status != dop.BUDGET_EXHAUSTED or counts[dop.STEPS] >= max_steps:
+            break
+    for m in range(min(counts[dop.N_EVENTS], wanted)):
+        ev_t[m] += polish_crossing(code, p, ev_y[m], f, ytmp, ws)
+    stats[0] = status
+    stats[1] = min(counts[dop.N_EVENTS], wanted)
+    stats[2] = counts[dop.STEPS]
+    stats[3] = ctrl[dop.T]
+    stats[4] = track[dop.MIN_NORMAL]
+
+
+@compiled(parallel=True, nogil=True)
+def section_batch(
+    codes: IntArray,
+    p: FloatArray,
+    Y0: FloatArray,
+    t_max: float,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    ev_t: FloatArray,
+    ev_y: FloatArray,
+    stats: FloatArray,
+    stop: IntArray,
+) -> None:
+    """:func:`section_one` for every row of ``Y0`` (shape (K, 18)); ``ev_t`` (K, N) and
+    ``ev_y`` (K, N, 18) receive the crossings, ``stats`` (K, 5)."""
+    for k in prange(Y0.shape[0]):
+        if read_flag(stop) != 0:
+            stats[k, 0] = dop.INTERRUPTED
+        else:
+            section_one(codes[k], p, Y0[k], t_max, rtol, atol, max_steps, ev_t[k], ev_y[k],
+                         stats[k], stop)  # fmt: skip
+
+
+@compiled(parallel=True, nogil=True)
+def indicator_batch(
+    codes: IntArray,
+    p: FloatArray,
+    Y0: FloatArray,
+    D0: FloatArray,
+    t_samples: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    out: FloatArray,
+    stats: FloatArray,
+    s_stop: float,
+    stop: IntArray,
+) -> None:
+    """:func:`.tangent.run_indicators` for every row of ``Y0`` with tangent
+    ``D0`` (both (K, 18)); ``out`` (K, n, 3), ``stats`` (K, 4). A trajectory not yet started
+    when ``stop[0]`` is set is marked ``INTERRUPTED``."""
+    states = np.zeros((0, N_STATE))
+    for k in prange(Y0.shape[0]):
+        if read_flag(stop) != 0:
+            stats[k, 0] = dop.INTERRUPTED
+        else:
+            run_indicators(codes[k], p, Y0[k], D0[k], t_samples, rtol, atol, max_steps, out[k],
+                           states, stats[k], s_stop)  # fmt: skip
