@@ -34,8 +34,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._atlas_cells import BODY_KEYS, LEVEL_KEYS, classify_cells
-from rollingtop._atlas_store import (
+from rollingtop._checks import short_repr
+from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._types import FloatArray
+from rollingtop.atlas._cells import BODY_KEYS, LEVEL_KEYS, classify_cells
+from rollingtop.atlas._store import (
     _dataset,
     _load_partial,
     _partial_folder,
@@ -43,9 +46,6 @@ from rollingtop._atlas_store import (
     _write,
     check_atlas_output,
 )
-from rollingtop._checks import short_repr
-from rollingtop._errors import RollingTopError, ScenarioError
-from rollingtop._types import FloatArray
 from rollingtop.io import read_input_text, write_bytes_atomic
 
 if TYPE_CHECKING:
