@@ -24,7 +24,8 @@ of a chunk of cells, one Dask task), :mod:`._spec` (the spec and its validation)
 """
 
 from rollingtop.atlas._cells import BODY_KEYS, FIELDS, LEVEL_KEYS, MAX_CENTRES, classify_cells
-from rollingtop.atlas._run import (
+from rollingtop.atlas._run import atlas, classify_in_process
+from rollingtop.atlas._spec import (
     ATLAS_VERSION,
     AXIS_KEYS,
     DEFAULT_CHUNK,
@@ -34,9 +35,7 @@ from rollingtop.atlas._run import (
     STATUS,
     AtlasError,
     AtlasSpec,
-    atlas,
     atlas_spec_from_dict,
-    classify_in_process,
     load_atlas_spec,
 )
 from rollingtop.atlas._store import check_atlas_output
