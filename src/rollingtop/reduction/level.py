@@ -33,7 +33,7 @@ from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
 
-__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real"]
+__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real", "near_north"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
@@ -351,3 +351,9 @@ class LevelSet:
             "both": " (no spin: both poles)",
         }[self.pole]
         return f"M3 = {self.M3:g}, C1 = {self.C1:g}, C2 = {self.C2:g}{pole}"
+
+
+def near_north(level: LevelSet) -> bool:
+    """A level that is no pole case and lies nearer ``C1 = -M3`` than ``C1 = M3``: computed on
+    its mirror image (:meth:`LevelSet.mirrored`)."""
+    return level.pole is None and abs(level.M3 + level.C1) < abs(level.M3 - level.C1)
