@@ -130,6 +130,13 @@ class ContactModel:
         linearisation at the vertical spin, for a model whose equations are singular at the
         vertical (the meridian model: its constraint direction is undefined there). ``None``: the
         generic linearisation in ``(v, w, gamma)`` on the constraint manifold applies.
+    vertical_through_reduction : bool
+        Whether the vertical spin is analysed through the reduction instead (the meridian
+        model, singular at the vertical, with :attr:`has_reduction`): the eigenvalues are those
+        of the reduced motion at the pole of the pole level
+        (:func:`rollingtop.reduction.level.pole_eigenvalues`), which
+        :mod:`rollingtop.dynamics.stability` computes. A declaration only: the contact package
+        never imports the reduction.
     carries_direction : bool
         Whether the model's own kernel carries its constraint direction in the state's
         ``psi_nu`` (the ``parallel`` model, whose direction ``tau`` is undefined at the vertical
@@ -206,6 +213,7 @@ class ContactModel:
     select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
     vertical_spin: Callable[[SphericalTop, int], float] | None = None
     vertical_eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
+    vertical_through_reduction: bool = False
     carries_direction: bool = False
     determined_through_vertical: bool = True
     spin_directions: Callable[[Any], dict[str, Any]] | None = None

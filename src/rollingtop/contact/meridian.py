@@ -58,7 +58,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rollingtop._jit import inline, kernel
-from rollingtop._types import ComplexArray, Float6, FloatArray, Workspace
+from rollingtop._types import Float6, FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import contact_row, normal_row, sync_azimuth
@@ -336,8 +336,9 @@ def _vertical_spin(body: SphericalTop, pole: int) -> float:
     ``q1 = M3 tan(theta/2)``, ``P = M3 ((R - a) tan(theta/2) + a theta)`` and
     ``m g a cos(theta)`` to second order). Stable for ``U'' > 0``:
     ``w3 > 2 I1 sqrt(m g a / (I1 + m l^2)) / I3``; every spin when ``a <= 0``. The constraint
-    direction is undefined at the vertical, so this (and :func:`_vertical_eigenvalues`) comes
-    from the reduction rather than from a linearisation in ``(v, w, gamma)``.
+    direction is undefined at the vertical, so this (and the eigenvalues,
+    :attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`) comes from the reduction
+    rather than from a linearisation in ``(v, w, gamma)``.
     """
     a = pole * body.a3
     if a <= 0.0:
@@ -349,24 +350,6 @@ def _vertical_spin(body: SphericalTop, pole: int) -> float:
         * math.sqrt(body.m * body.g * a / (body.I1 + body.m * height * height))
         / body.I3
     )
-
-
-def _vertical_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
-    """Eigenvalues of the reduced linearisation at the vertical spin: ``+-sqrt(-U''/rho)`` at
-    the pole of the pole level ``(M3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north,
-    the value of ``F6`` at the vertical spin); the other directions are integrals (0)."""
-    from rollingtop.reduction.level import LevelSet
-
-    if not body.symmetric:
-        raise ValueError("the meridian model's vertical spin is analysed through the reduction: "
-                         "it needs a dynamically symmetric body (I1 = I2)")  # fmt: skip
-    M3 = body.I3 * omega3
-    C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3
-    level = LevelSet(body, M3, pole * M3, C2)
-    theta = 0.0 if pole > 0 else math.pi
-    lam2 = -float(level.d2U(theta)) / float(level.rho(theta))
-    root = np.sqrt(complex(lam2))
-    return np.array([root, -root, 0.0, 0.0], dtype=complex)
 
 
 MODEL = ContactModel(
@@ -385,7 +368,7 @@ MODEL = ContactModel(
     variants=VARIANTS,
     select_variant=select_variant,
     vertical_spin=_vertical_spin,
-    vertical_eigenvalues=_vertical_eigenvalues,
+    vertical_through_reduction=True,
     has_reduction=True,
     colour="#1f77b4",
     devices=("roller", "shell", "skates"),

@@ -15,8 +15,11 @@ restricted to the null space of the constraints' Jacobian, whose eigenvalues are
 imaginary or zero for a stable spin.
 
 A model whose constraint is singular at the vertical supplies its own eigenvalues
-(:attr:`~rollingtop.contact.ContactModel.vertical_eigenvalues`: the meridian model, through the
-reduction on the pole level). A model may also give a closed form of the threshold
+(:attr:`~rollingtop.contact.ContactModel.vertical_eigenvalues`), or declares that they come from
+the reduction (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`: the meridian
+model, whose eigenvalues are those of the reduced motion on the pole level,
+:func:`rollingtop.reduction.level.pole_eigenvalues`; computed here, so that the contact package
+never imports the reduction). A model may also give a closed form of the threshold
 (:attr:`~rollingtop.contact.ContactModel.vertical_spin`), which is reported beside the one found
 from the eigenvalues.
 """
@@ -25,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -38,6 +42,7 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics._layout import N_STATE
+from rollingtop.reduction.level import pole_eigenvalues
 
 __all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]
 
@@ -150,12 +155,26 @@ def vertical_spin_eigenvalues(
         raise StabilityError(f"omega3 = {omega3!r} must be finite")
     if omega3 != 0.0:
         _require_vertical_spin(model)
-    if model.vertical_eigenvalues is not None:
+    own = (partial(_reduced_eigenvalues, model) if model.vertical_through_reduction
+           else model.vertical_eigenvalues)  # fmt: skip
+    if own is not None:
         try:
-            return model.vertical_eigenvalues(body, float(omega3), POLES[pole])
+            return own(body, float(omega3), POLES[pole])
         except ValueError as exc:
             raise StabilityError(str(exc)) from None
     return _generic_eigenvalues(model, body, float(omega3), POLES[pole])
+
+
+def _reduced_eigenvalues(
+    model: ContactModel, body: SphericalTop, omega3: float, pole: int
+) -> ComplexArray:
+    """The eigenvalues of a model analysed through the reduction
+    (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`): those of the reduced
+    motion at the pole of the pole level. A ValueError for a body the reduction cannot take."""
+    if not body.symmetric:
+        raise ValueError(f"the {model.name} model's vertical spin is analysed through the "
+                         "reduction: it needs a dynamically symmetric body (I1 = I2)")  # fmt: skip
+    return pole_eigenvalues(body, omega3, pole)
 
 
 def _unstable(eigenvalues: ComplexArray) -> bool:

@@ -5,7 +5,8 @@
 - :mod:`.level`: level sets ``(M3, C1, C2)`` and the effective potential ``U``.
 - :mod:`.steady`: steady motions (critical points of ``U``).
 - :mod:`.orbits`: orbits on ``(M3, C1, C2, h)``, turning points, periods; the quadrature of
-  the time along an orbit is the private :mod:`._quadrature`.
+  the time along an orbit is the private :mod:`._quadrature`, and :class:`~.orbits.Orbit` with
+  its turning points (shared with :mod:`.no_spin`) the private :mod:`._orbit`.
 - :mod:`.no_spin`, :mod:`.near_pole`: the no-spin level and levels near a pole level.
 """
 

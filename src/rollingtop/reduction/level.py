@@ -33,7 +33,7 @@ from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
 
-__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real"]
+__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real", "near_north", "pole_eigenvalues"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
@@ -351,3 +351,25 @@ class LevelSet:
             "both": " (no spin: both poles)",
         }[self.pole]
         return f"M3 = {self.M3:g}, C1 = {self.C1:g}, C2 = {self.C2:g}{pole}"
+
+
+def near_north(level: LevelSet) -> bool:
+    """A level that is no pole case and lies nearer ``C1 = -M3`` than ``C1 = M3``: computed on
+    its mirror image (:meth:`LevelSet.mirrored`)."""
+    return level.pole is None and abs(level.M3 + level.C1) < abs(level.M3 - level.C1)
+
+
+def pole_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
+    """Eigenvalues of the reduced linearisation at the vertical spin ``omega3`` on the pole
+    ``pole`` (+1 south, ``gamma3 = 1``; -1 north): ``+-sqrt(-U''/rho)`` at the pole of the pole
+    level ``(M3 = I3 omega3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north, the value
+    of ``F6`` at the vertical spin); the other directions are integrals (0). The meridian model's
+    vertical spin (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`,
+    :mod:`rollingtop.dynamics.stability`); ``body`` must be dynamically symmetric."""
+    M3 = body.I3 * omega3
+    C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3
+    level = LevelSet(body, M3, pole * M3, C2)
+    theta = 0.0 if pole > 0 else math.pi
+    lam2 = -float(level.d2U(theta)) / float(level.rho(theta))
+    root = np.sqrt(complex(lam2))
+    return np.array([root, -root, 0.0, 0.0], dtype=complex)

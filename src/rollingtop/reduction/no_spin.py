@@ -25,6 +25,12 @@ import math
 
 import numpy as np
 
+from rollingtop.reduction._orbit import (
+    SEPARATRIX_TOLERANCE,
+    STEADY_TOLERANCE,
+    Orbit,
+    turning_point,
+)
 from rollingtop.reduction._quadrature import (
     PERIOD_RTOL,
     FloatArray,
@@ -34,12 +40,6 @@ from rollingtop.reduction._quadrature import (
     time_density,
 )
 from rollingtop.reduction.level import LevelSet, LevelSetError
-from rollingtop.reduction.orbits import (
-    SEPARATRIX_TOLERANCE,
-    STEADY_TOLERANCE,
-    Orbit,
-    turning_point,
-)
 from rollingtop.reduction.steady import steady_motion
 
 __all__ = ["no_spin_orbits", "rolling_over_period"]

@@ -20,88 +20,23 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, replace
-from typing import Any
+from dataclasses import replace
 
 import numpy as np
-from scipy.optimize import brentq
 
-from rollingtop._json import json_ready
+from rollingtop.reduction._orbit import (
+    SEPARATRIX_TOLERANCE,
+    STEADY_TOLERANCE,
+    Orbit,
+    turning_point,
+)
 from rollingtop.reduction._quadrature import PERIOD_RTOL, WALL_RATIO, half_integral, period
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
+from rollingtop.reduction.no_spin import no_spin_orbits
 from rollingtop.reduction.steady import SteadyMotion, critical_points, steady_motion
 
 __all__ = ["Orbit", "orbits", "period", "half_integral", "canonical_orbit", "near_north"]
 __all__ += ["PERIOD_RTOL", "WALL_RATIO", "SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE"]
-
-#: ``|h - U(saddle)|`` below this (relative to the scale of ``U``) is on the separatrix.
-SEPARATRIX_TOLERANCE = 1e-10
-#: ``h - U_min`` below this (relative) is the steady motion itself.
-STEADY_TOLERANCE = 1e-13
-
-
-@dataclass(frozen=True)
-class Orbit:
-    """One connected component of the level set ``(M3, C1, C2, h)``.
-
-    Attributes
-    ----------
-    gamma3_min, gamma3_max : float
-        Range of ``gamma3`` on the orbit (a pole passage reaches ``+-1``).
-    theta_min, theta_max : float
-        Turning points in the signed nutation angle (``gamma3 = cos theta``).
-    period : float
-        Period of ``gamma3(t)`` (``inf`` on a separatrix).
-    period_error : float
-        Estimated absolute error of ``period``.
-    kind : {"periodic", "steady", "separatrix"}
-    pole_passage : bool
-        The orbit passes through the pole (pole cases only).
-    w_tau_max : float
-        Largest ``|w_tau|`` on the orbit.
-    note : str
-        Plain-language remark (near separatrix, pole passage, ...), or empty.
-    pole_distance : float
-        Distance in ``theta`` of the orbit's nearer end from its pole, to full relative
-        precision (``theta_max = pi - pole_distance`` near the north pole rounds it): the width
-        of the gap next to the pole on a level near a pole level; NaN in a pole case.
-    """
-
-    gamma3_min: float
-    gamma3_max: float
-    theta_min: float
-    theta_max: float
-    period: float
-    period_error: float
-    kind: str
-    pole_passage: bool
-    w_tau_max: float
-    note: str = ""
-    pole_distance: float = math.nan
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (non-finite values become ``None``)."""
-        return json_ready(asdict(self))
-
-    @property
-    def start_theta(self) -> float:
-        """The canonical turning point to start the orbit from: ``theta_max`` (the lowest
-        ``gamma3``) when it lies on the branch ``0 < theta < pi``, else ``theta_min`` (the other
-        side of a pole passage); ``w_tau = 0`` there."""
-        return self.theta_max if 0 < self.theta_max < math.pi else self.theta_min
-
-    @property
-    def rolls_over(self) -> bool:
-        """``theta`` runs round the whole circle (no spin, above the upright pole's energy):
-        the orbit has no turning points and ``theta_min``, ``theta_max`` are a full turn apart."""
-        return self.theta_max - self.theta_min >= 2 * math.pi * (1 - 1e-12)
-
-
-def turning_point(level: LevelSet, h: float, a: float, b: float) -> float:
-    """The root of ``h = U(theta)`` in ``[a, b]`` (``U - h`` of opposite signs at the ends)."""
-    # xtol tiny: the root is found to a relative 4 ulps also next to a pole (theta ~ 1e-12)
-    root: float = brentq(lambda t: h - level.U(t), a, b, xtol=1e-300, rtol=8.9e-16, maxiter=500)
-    return root
 
 
 def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
@@ -136,19 +71,11 @@ def orbits(level: LevelSet, h: float) -> list[Orbit]:
         raise LevelSetError(f"level h = {h!r} must be a finite number")
     h = float(h)
     if level.pole == "both":
-        from rollingtop.reduction.no_spin import no_spin_orbits
-
         return no_spin_orbits(level, h)
     if near_north(level):
         mirrored = [_mirror(o) for o in _orbits(level.mirrored(), h)]
         return sorted(mirrored, key=lambda o: (o.gamma3_min, o.theta_min))
     return _orbits(level, h)
-
-
-def near_north(level: LevelSet) -> bool:
-    """A level that is no pole case and lies nearer ``C1 = -M3`` than ``C1 = M3``: computed on
-    its mirror image (:meth:`LevelSet.mirrored`)."""
-    return level.pole is None and abs(level.M3 + level.C1) < abs(level.M3 - level.C1)
 
 
 def _mirror(o: Orbit) -> Orbit:

@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 
 from rollingtop._json import json_ready
 from rollingtop._numdiff import DIFF_STEP, central_jacobian
-from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.level import LevelSet, near_north
 
 __all__ = ["SteadyMotion", "steady_motions", "critical_points"]
 
@@ -204,8 +204,6 @@ def steady_motions(level: LevelSet) -> list[SteadyMotion]:
     In a pole case the list may include motions on the negative-``s`` branch (after a pole
     passage); their ``theta`` lies outside ``(0, pi)``.
     """
-    from rollingtop.reduction.orbits import near_north
-
     if near_north(level):  # computed on the mirror image, where theta ~ 0 keeps its precision
         motions = [_mirror(m) for m in steady_motions(level.mirrored())]
     else:

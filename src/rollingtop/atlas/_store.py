@@ -17,12 +17,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rollingtop._errors import RollingTopError
+from rollingtop.atlas._spec import AtlasError, AtlasSpec
 from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
 
 if TYPE_CHECKING:
     import xarray as xr
 
-    from rollingtop.atlas import AtlasSpec
 
 #: Largest chunk along each dimension of a Zarr store.
 ZARR_CHUNK = 64
@@ -42,7 +42,7 @@ def _load_partial(folder: Path, digest: str) -> dict[int, dict[str, np.ndarray]]
     except (OSError, ValueError):
         saved = {}
     if saved.get("digest") != digest:
-        raise _atlas_error(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
+        raise AtlasError(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
                          "remove it to start over")  # fmt: skip
     done = {}
     for f in folder.glob("chunk-*.npz"):
@@ -121,16 +121,10 @@ def check_atlas_output(output: str | os.PathLike[str]) -> Path:
     path = Path(output)
     if path.suffix.lower() == ".zarr" and path.is_dir():
         if not any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs")):
-            raise _atlas_error(f"cannot write {str(path)!r}: a folder that is not a Zarr store "
+            raise AtlasError(f"cannot write {str(path)!r}: a folder that is not a Zarr store "
                              "is in the way")  # fmt: skip
         return path
     try:
         return check_output_path(path, SUFFIXES)
     except RollingTopError as exc:
-        raise _atlas_error(str(exc)) from None
-
-
-def _atlas_error(message: str) -> RollingTopError:
-    from rollingtop.atlas import AtlasError
-
-    return AtlasError(message)
+        raise AtlasError(str(exc)) from None

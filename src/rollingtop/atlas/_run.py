@@ -1,0 +1,207 @@
+"""The run of the parameter atlas (:mod:`rollingtop.atlas`) on Dask: the cluster, the chunks
+submitted as tasks and collected as they finish (each saved at once, so that a run resumes), and
+the same Dataset computed in process."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from rollingtop._checks import short_repr
+from rollingtop._errors import RollingTopError
+from rollingtop._types import FloatArray
+from rollingtop.atlas._cells import classify_cells
+from rollingtop.atlas._spec import DEFAULT_CHUNK, MAX_WORKERS_PER_CORE, AtlasError, AtlasSpec
+from rollingtop.atlas._store import (
+    _dataset,
+    _load_partial,
+    _partial_folder,
+    _save_chunk,
+    _write,
+    check_atlas_output,
+)
+from rollingtop.io import write_bytes_atomic
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from distributed import Client
+
+__all__ = ["atlas", "classify_in_process"]
+
+
+@contextlib.contextmanager
+def _client(client: Client | None, workers: int | None, scheduler: str | None) -> Iterator[Client]:
+    """The given client; else one connected to ``scheduler``; else an embedded local cluster of
+    ``workers`` processes (default: the cores), closed at the end."""
+    if client is not None:
+        yield client
+        return
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            remote = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise AtlasError(f"cannot reach the Dask scheduler at {short_repr(scheduler)}: "
+                             f"{why}") from None  # fmt: skip
+        try:
+            yield remote
+        finally:
+            remote.close()
+        return
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=50)  # fmt: skip
+    try:
+        local = Client(cluster)
+        try:
+            yield local
+        finally:
+            local.close()
+    finally:
+        cluster.close()
+
+
+def atlas(
+    spec: AtlasSpec,
+    output: str | os.PathLike[str] | None = None,
+    *,
+    client: Client | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    chunk: int = DEFAULT_CHUNK,
+    progress: Callable[[int, int], None] | None = None,
+) -> xr.Dataset:
+    """Classify every cell of ``spec`` on Dask; write ``output`` (``.nc`` or ``.zarr``) if given.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    output : path, optional
+        Where to write the Dataset. With an output the run is resumable: finished chunks are
+        kept in ``OUTPUT.partial/`` until the output is written.
+    client : distributed.Client, optional
+        Run on this client's cluster (not closed here).
+    workers : int, optional
+        Worker processes of the embedded local cluster (default: the cores); ignored with
+        ``client`` or ``scheduler``.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:port``).
+    chunk : int
+        Cells per task.
+    progress : callable, optional
+        ``progress(done_cells, total_cells)``.
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per axis (in the spec's order), coordinates the axis values; the
+        variables of :func:`classify_cells`.
+    """
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+        raise AtlasError(f"chunk = {short_repr(chunk)} must be an integer >= 1")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):  # fmt: skip
+        raise AtlasError(f"workers = {short_repr(workers)} must be an integer >= 1")
+    cores = os.cpu_count() or 1
+    if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
+        raise AtlasError(f"workers = {workers} is more than {MAX_WORKERS_PER_CORE} per core "
+                         f"({cores} cores) for the local cluster; use a scheduler to go "
+                         "wide")  # fmt: skip
+    out_path = None if output is None else check_atlas_output(output)
+    cells = spec.cells()
+    names = tuple(spec.axes)
+    starts = list(range(0, spec.size, chunk))
+    digest = spec.digest(chunk)
+    folder = None if out_path is None else _partial_folder(out_path)
+    done = {} if folder is None else _load_partial(folder, digest)
+    created = False
+    if folder is not None and not folder.exists():
+        folder.mkdir()
+        created = True
+        write_bytes_atomic(folder / "spec.json", json.dumps({"digest": digest}).encode())
+    try:
+        _compute(spec, cells, names, starts, chunk, done, folder, client, workers, scheduler,
+                 progress)  # fmt: skip
+    except BaseException:
+        if created and folder is not None and not any(folder.glob("chunk-*.npz")):
+            shutil.rmtree(folder, ignore_errors=True)  # nothing saved: leave no trace
+        raise
+    ds = _dataset(spec, done)
+    if out_path is not None and folder is not None:
+        _write(ds, out_path)
+        shutil.rmtree(folder, ignore_errors=True)
+    return ds
+
+
+def _compute(
+    spec: AtlasSpec,
+    cells: FloatArray,
+    names: tuple[str, ...],
+    starts: list[int],
+    chunk: int,
+    done: dict[int, dict[str, np.ndarray]],
+    folder: Path | None,
+    client: Client | None,
+    workers: int | None,
+    scheduler: str | None,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Submit the chunks not in ``done`` and collect them into it (saving each at once)."""
+    finished = sum(min(chunk, spec.size - starts[k]) for k in done)
+    if progress is not None:
+        progress(finished, spec.size)
+    todo = [k for k in range(len(starts)) if k not in done]
+    if todo:
+        with _client(client, workers, scheduler) as c:
+            futures = {c.submit(classify_cells, spec.fixed, names,
+                                cells[starts[k] : starts[k] + chunk], pure=False): k
+                       for k in todo}  # fmt: skip
+            try:
+                _collect(futures, done, folder, spec.size, finished, progress)
+            except BaseException:
+                c.cancel(list(futures))  # stop what is still queued before the cluster goes
+                raise
+
+
+def _collect(
+    futures: dict[Any, int],
+    done: dict[int, dict[str, np.ndarray]],
+    folder: Path | None,
+    total: int,
+    finished: int,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Collect the chunks as they finish, saving each at once. A task that failed on a worker
+    (a lost worker, an error) is reported as one :class:`AtlasError`."""
+    from distributed import as_completed
+
+    for fut in as_completed(futures):
+        k = futures[fut]
+        try:
+            result = fut.result()
+        except RollingTopError:
+            raise
+        except Exception as exc:
+            raise AtlasError(f"a Dask task failed ({type(exc).__name__}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else ''}); the chunks "
+                             "finished so far are kept: run again to resume") from None  # fmt: skip
+        done[k] = result
+        if folder is not None:
+            _save_chunk(folder, k, result)
+        finished += len(result["status"])
+        if progress is not None:
+            progress(finished, total)
+
+
+def classify_in_process(spec: AtlasSpec) -> xr.Dataset:
+    """The same Dataset computed in this process, without Dask (small atlases, tests)."""
+    return _dataset(spec, {0: classify_cells(spec.fixed, tuple(spec.axes), spec.cells())})

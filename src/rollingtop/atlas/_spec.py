@@ -1,0 +1,174 @@
+"""The atlas's spec (:mod:`rollingtop.atlas`): its axes and fixed values read from a scenario
+file with an ``[axes]`` table and validated, the constants of a run, and the atlas's error."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rollingtop._checks import short_repr
+from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._types import FloatArray
+from rollingtop.atlas._cells import BODY_KEYS, LEVEL_KEYS
+from rollingtop.io import read_input_text
+
+__all__ = ["AtlasError", "AtlasSpec", "atlas_spec_from_dict", "load_atlas_spec"]
+
+AXIS_KEYS = BODY_KEYS + LEVEL_KEYS
+#: Largest number of cells of one atlas.
+MAX_CELLS = 10_000_000
+#: Cells per Dask task (a chunk, and a file of the partial folder).
+DEFAULT_CHUNK = 200
+#: Bumped when the classification changes: partial results of another version are not reused.
+ATLAS_VERSION = 1
+#: Status of a cell.
+STATUS = {
+    0: "classified",
+    1: "inadmissible body",
+    2: "pole level (C1 = +-M3)",
+    3: "level too large",
+}
+#: Most worker processes per core of the embedded local cluster.
+MAX_WORKERS_PER_CORE = 4
+MAX_SPEC_BYTES = 1_000_000
+
+
+class AtlasError(RollingTopError):
+    """A bad atlas spec, output, or cluster."""
+
+
+@dataclass(frozen=True)
+class AtlasSpec:
+    """A validated atlas spec.
+
+    Attributes
+    ----------
+    fixed : dict of str to float
+        Every key of :data:`AXIS_KEYS` with its fixed value (the first axis value for keys on
+        an axis).
+    axes : dict of str to ndarray
+        The axes, in order (the Dataset's dimensions).
+    """
+
+    fixed: dict[str, float]
+    axes: dict[str, FloatArray]
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(v) for v in self.axes.values())
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape))
+
+    def digest(self, chunk: int) -> str:
+        """What a partial result must match to be reused."""
+        axes = {k: v.tolist() for k, v in self.axes.items()}
+        text = json.dumps({"version": ATLAS_VERSION, "fixed": self.fixed, "chunk": chunk,
+                           "axes": axes}, sort_keys=True)  # fmt: skip
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def cells(self) -> FloatArray:
+        """Every cell's axis values, shape (size, n_axes), in C order of the axes."""
+        grids = np.meshgrid(*self.axes.values(), indexing="ij")
+        return np.stack([g.ravel() for g in grids], axis=1)
+
+
+def _axis(key: str, value: object) -> FloatArray:
+    try:
+        return _axis_values(key, value)
+    except ScenarioError as exc:  # a value that is not a finite number (rollingtop._checks)
+        raise AtlasError(str(exc)) from None
+
+
+def _axis_values(key: str, value: object) -> FloatArray:
+    from rollingtop._checks import number
+
+    where = f"axes.{key}"
+    if isinstance(value, list):
+        if not value:
+            raise AtlasError(f"{where} is empty")
+        out = np.array([number("axes", key, v) for v in value], dtype=float)
+    elif isinstance(value, dict):
+        unknown = set(value) - {"start", "stop", "num"}
+        if unknown or {"start", "stop", "num"} - set(value):
+            raise AtlasError(f"{where} must be a list or {{start, stop, num}}, got "
+                             f"{short_repr(value)}")  # fmt: skip
+        num = int(number("axes", f"{key}.num", value["num"], integer=True))
+        if num < 1:
+            raise AtlasError(f"{where}.num = {num} must be >= 1")
+        if num > MAX_CELLS:
+            raise AtlasError(f"{where}.num = {num} is more than {MAX_CELLS} values")
+        start = number("axes", f"{key}.start", value["start"])
+        stop = number("axes", f"{key}.stop", value["stop"])
+        out = np.linspace(start, stop, num)
+    else:
+        raise AtlasError(f"{where} must be a list of numbers or {{start, stop, num}}, got "
+                         f"{short_repr(value)}")  # fmt: skip
+    if not np.all(np.isfinite(out)):
+        raise AtlasError(f"{where} has non-finite values")
+    return out
+
+
+def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
+    """Validate a parsed spec (module docstring)."""
+    from rollingtop.scenario import Scenario
+
+    data = dict(data)
+    axes_t = data.pop("axes", None)
+    if not isinstance(axes_t, dict) or not axes_t:
+        raise AtlasError("missing or empty table [axes] (keys: " + ", ".join(AXIS_KEYS) + ")")
+    for key in axes_t:
+        if key not in AXIS_KEYS:
+            raise AtlasError(f"unknown axis {short_repr(key)} (allowed: {', '.join(AXIS_KEYS)})")
+    axes = {key: _axis(key, value) for key, value in axes_t.items()}
+    size = int(np.prod([len(v) for v in axes.values()], dtype=float))
+    if size > MAX_CELLS:
+        raise AtlasError(f"the atlas has {size} cells, more than {MAX_CELLS}")
+    # the fixed values: the scenario's, with each axis at its first value
+    level_t = dict(data.get("level", {})) if isinstance(data.get("level", {}), dict) else {}
+    for key in LEVEL_KEYS:
+        if key in axes:
+            level_t[key] = float(axes[key][0])
+    missing = [k for k in LEVEL_KEYS if k not in level_t]
+    if missing:
+        raise AtlasError(f"[level] or [axes] must give {', '.join(missing)}")
+    level_t = {k: v for k, v in level_t.items() if k in LEVEL_KEYS}
+    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    for key in BODY_KEYS:
+        if key in axes:
+            body_t[key] = float(axes[key][0])
+    data["body"], data["level"] = body_t, level_t
+    data.pop("initial", None)
+    sc = Scenario.from_dict(data)
+    if not sc.model.has_reduction:
+        raise AtlasError(f"the atlas classifies the reduction of the meridian model, not model "
+                         f"{sc.model.name!r}")  # fmt: skip
+    if not sc.body.symmetric:
+        raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
+                         f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
+    fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
+    fixed.update({k: float(level_t[k]) for k in LEVEL_KEYS})
+    return AtlasSpec(fixed, axes)
+
+
+def load_atlas_spec(path: str | os.PathLike[str]) -> AtlasSpec:
+    """Read and validate an atlas spec (a TOML scenario file with an ``[axes]`` table)."""
+    path = Path(path)
+    text = read_input_text(path, "atlas spec", MAX_SPEC_BYTES, ScenarioError)
+    try:
+        data = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError, ValueError) as exc:
+        raise AtlasError(f"{path}: invalid TOML: {exc}") from None
+    try:
+        return atlas_spec_from_dict(data)
+    except RollingTopError as exc:
+        raise AtlasError(f"{path}: {exc}") from None
