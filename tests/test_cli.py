@@ -313,3 +313,29 @@ def test_model_choices_come_from_the_registry(capsys):
 
     code, out, _ = run_cli(capsys, "simulate", "--help")
     assert code == 0 and f"[{'|'.join(MODELS)}]" in out
+
+
+def test_simulate_relates_the_level_h_to_the_energy(capsys):
+    """Fig. 5's scenario gives [level] h = 4: the report prints h beside the energy it implies,
+    E = h + M3^2/(2 I3) + m g R = 4 + 1 + 1 = 6 (docs/model.md), which the integrated energy
+    integral confirms; a level of the initial state is labelled so; a model without the
+    reduction has none."""
+    fig5 = str(EXAMPLES / "fig5.toml")
+    code, out, err = run_cli(capsys, "simulate", fig5, "--t-end", "0.5")
+    assert code == 0, err
+    assert ("level of [level]: h = 4 (M3 = 1, C1 = 0.5, C2 = -2); energy = h + M3^2/(2 I3) "
+            "+ m g R = 4 + 1 + 1 = 6") in out.splitlines()  # fmt: skip
+    code, out, err = run_cli(capsys, "simulate", fig5, "--t-end", "0.5", "--json")
+    summary = json.loads(out)
+    assert summary["level"] == {"M3": 1.0, "C1": 0.5, "C2": -2.0, "h": 4.0, "energy": 6.0,
+                                "spin_energy": 1.0, "mgR": 1.0, "source": "[level]"}  # fmt: skip
+    assert summary["integrals"]["energy"]["initial"] == pytest.approx(6.0, abs=1e-12)
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "paper.toml"), "--t-end", "0.5",
+                             "--json")  # fmt: skip
+    level = json.loads(out)["level"]
+    assert level["source"] == "initial state" and level["h"] == pytest.approx(0.4849, abs=1e-12)
+    assert level["energy"] == pytest.approx(json.loads(out)["integrals"]["energy"]["initial"],
+                                             abs=1e-12)  # fmt: skip
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "rough.toml"), "--t-end", "0.5",
+                             "--json")  # fmt: skip
+    assert code == 0 and "level" not in json.loads(out)
