@@ -142,9 +142,15 @@ def status(label: str) -> Iterator[Callable[[str], None] | None]:
         yield lambda what: spinner.update(f"{label} {what}")
 
 
-def console() -> Console:
-    """Console on stdout; when stdout is not a terminal, wide enough that no table is cut."""
+#: Width of the console on stdout when it is not a terminal (a pipe, a file), unless a command
+#: asks for another: wide enough that no table is cut.
+PIPED_WIDTH = 160
+
+
+def console(piped_width: int = PIPED_WIDTH) -> Console:
+    """Console on stdout; when stdout is not a terminal, ``piped_width`` columns wide (a table
+    wider than that wraps its cells)."""
     from rich.console import Console
 
     stdout = Console()
-    return stdout if stdout.is_terminal else Console(width=160)
+    return stdout if stdout.is_terminal else Console(width=piped_width)
