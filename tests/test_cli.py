@@ -356,7 +356,7 @@ def test_verify_table_fits_100_columns_when_piped(capsys, monkeypatch):
         ClaimResult("lagrange integral not conserved", "rubber", "proved",
                     "exact evaluation: nonzero (-0.123457) at a random rational point", 0.2),
     ]  # fmt: skip
-    monkeypatch.setattr(rollingtop.symbolic, "verify", lambda models: results)
+    monkeypatch.setattr(rollingtop.symbolic, "verify", lambda models, progress=None: results)
     code, out, err = run_cli(capsys, "verify")
     assert code == 0 and err == ""
     lines = out.splitlines()

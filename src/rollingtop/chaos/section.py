@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -106,6 +106,7 @@ def poincare_section(
     t_max: float = math.inf,
     max_steps: int = 10**7,
     threads: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> xr.Dataset:
     """Crossings of the section ``w_tau = 0`` (upward) by trajectories on one level set.
 
@@ -133,6 +134,9 @@ def poincare_section(
         ... or after this many accepted steps.
     threads : int, optional
         Threads (default: numba's, all cores).
+    progress : callable, optional
+        ``progress(found, K * crossings)``: the crossings found so far by all trajectories,
+        called every ``WAIT_SLICE`` (0.05 s) while they run and once at the end.
 
     Returns
     -------
@@ -171,10 +175,18 @@ def poincare_section(
     ev_t = np.full((K, crossings), np.nan)
     ev_y = np.full((K, crossings, N_STATE), np.nan)
     stats = np.zeros((K, len(SECTION_STATS)))
+    poll = None
+    if progress is not None:
+        # the kernel writes each crossing's time into ev_t (NaN until then) as it finds it
+        def poll() -> None:
+            progress(int(np.count_nonzero(~np.isnan(ev_t))), ev_t.size)
+
     wall, used = run_threaded(section_batch, (codes, body.params, Y0, float(t_max), float(rtol),
                                               float(atol), int(max_steps), ev_t, ev_y, stats),
-                              threads)  # fmt: skip
+                              threads, poll)  # fmt: skip
     found = stats[:, 1].astype(int)
+    if progress is not None:
+        progress(int(found.sum()), ev_t.size)
     mask = np.arange(crossings)[None, :] >= found[:, None]
     ev_t[mask] = np.nan
     ev_y[mask] = np.nan

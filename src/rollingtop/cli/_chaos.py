@@ -107,14 +107,12 @@ def section(
         check_output_path(netcdf, (".nc",))
     sc = load_scenario(scenario).with_overrides(rtol=rtol, atol=atol)
     y0 = sc.require_state()
-    with _output.status("section:") as show:
-        if show is not None:
-            show(f"{trajectories} trajectories x {crossings} crossings")
+    with _output.counting("crossings found", trajectories * crossings) as progress:
         ds = poincare_section(sc.body, sc.model, y0, crossings=crossings,
                               trajectories=trajectories, hold=_hold(hold), seed=seed,
                               t_max=math.inf if t_max is None else t_max,
-                              rtol=sc.integration.rtol,
-                              atol=sc.integration.resolved_atol)  # fmt: skip
+                              rtol=sc.integration.rtol, atol=sc.integration.resolved_atol,
+                              progress=progress)  # fmt: skip
     from rollingtop.plot.section import section_figure
 
     save_figure(section_figure(ds), output)

@@ -115,9 +115,10 @@ def timing(total: float) -> Iterator[Callable[[float], None] | None]:
 
 
 @contextlib.contextmanager
-def counting(label: str, total: int) -> Iterator[Callable[[int, int], None] | None]:
+def counting(label: str, total: int | None) -> Iterator[Callable[[int, int], None] | None]:
     """``progress(done, total)`` drawing a bar of items done (``12/40``) on a terminal, else
-    ``None`` (as long as the block runs)."""
+    ``None`` (as long as the block runs). ``total`` may be ``None`` until the first call
+    says it."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
     stderr = _terminal_stderr()
@@ -127,7 +128,7 @@ def counting(label: str, total: int) -> Iterator[Callable[[int, int], None] | No
     with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), console=stderr,
                   transient=True) as bar:  # fmt: skip
         task = bar.add_task(label, total=total)
-        yield lambda done, n: bar.update(task, completed=done)
+        yield lambda done, n: bar.update(task, completed=done, total=n)
 
 
 @contextlib.contextmanager

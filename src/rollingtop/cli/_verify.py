@@ -80,7 +80,8 @@ def verify(ctx: click.Context, models: tuple[ContactModel, ...], as_json: bool) 
         from rollingtop.symbolic import verify as run_claims
     except ImportError as exc:  # pragma: no cover - sympy missing
         raise BadInput(f"verify needs sympy ({exc}): pip install rollingtop[symbolic]") from None
-    results = run_claims(tuple(m.name for m in models) or tuple(MODELS))
+    with _output.counting("claims decided", None) as progress:
+        results = run_claims(tuple(m.name for m in models) or tuple(MODELS), progress=progress)
     if as_json:
         click.echo(json.dumps({"claims": [r.to_dict() for r in results]}))
     else:
