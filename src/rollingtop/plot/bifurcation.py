@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 from matplotlib import colormaps
+from matplotlib.axes import Axes
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
@@ -70,7 +71,7 @@ def _orbit_curves(level: LevelSet, h: float) -> list[tuple[np.ndarray, np.ndarra
     return curves
 
 
-def _thumbnail(ax, diagram: BifurcationDiagram, k: int, colour: Any) -> None:  # type: ignore[no-untyped-def]
+def _thumbnail(ax: Axes, diagram: BifurcationDiagram, k: int, colour: Any) -> None:
     """The level curve ``h`` of region ``k``'s representative level in ``(gamma3, w_tau)``,
     each orbit closed, the axes fitted to the orbits, on the region's colour."""
     region = diagram.regions[k]
