@@ -313,3 +313,58 @@ def test_model_choices_come_from_the_registry(capsys):
 
     code, out, _ = run_cli(capsys, "simulate", "--help")
     assert code == 0 and f"[{'|'.join(MODELS)}]" in out
+
+
+def test_simulate_relates_the_level_h_to_the_energy(capsys):
+    """Fig. 5's scenario gives [level] h = 4: the report prints h beside the energy it implies,
+    E = h + M3^2/(2 I3) + m g R = 4 + 1 + 1 = 6 (docs/model.md), which the integrated energy
+    integral confirms; a level of the initial state is labelled so; a model without the
+    reduction has none."""
+    fig5 = str(EXAMPLES / "fig5.toml")
+    code, out, err = run_cli(capsys, "simulate", fig5, "--t-end", "0.5")
+    assert code == 0, err
+    assert ("level of [level]: h = 4 (M3 = 1, C1 = 0.5, C2 = -2); energy = h + M3^2/(2 I3) "
+            "+ m g R = 4 + 1 + 1 = 6") in out.splitlines()  # fmt: skip
+    code, out, err = run_cli(capsys, "simulate", fig5, "--t-end", "0.5", "--json")
+    summary = json.loads(out)
+    assert summary["level"] == {"M3": 1.0, "C1": 0.5, "C2": -2.0, "h": 4.0, "energy": 6.0,
+                                "spin_energy": 1.0, "mgR": 1.0, "source": "[level]"}  # fmt: skip
+    assert summary["integrals"]["energy"]["initial"] == pytest.approx(6.0, abs=1e-12)
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "paper.toml"), "--t-end", "0.5",
+                             "--json")  # fmt: skip
+    level = json.loads(out)["level"]
+    assert level["source"] == "initial state" and level["h"] == pytest.approx(0.4849, abs=1e-12)
+    assert level["energy"] == pytest.approx(json.loads(out)["integrals"]["energy"]["initial"],
+                                             abs=1e-12)  # fmt: skip
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "rough.toml"), "--t-end", "0.5",
+                             "--json")  # fmt: skip
+    assert code == 0 and "level" not in json.loads(out)
+
+
+def test_verify_table_fits_100_columns_when_piped(capsys, monkeypatch):
+    """Piped (capsys is no terminal), the verify table is at most 100 columns wide (it was
+    about 160): the long claims wrap, the methods are shortened and explained below it."""
+    import rollingtop.symbolic
+    from rollingtop.symbolic import ClaimResult
+
+    results = [
+        ClaimResult("reduced system (3.3): gamma3' follows from the full equations", "meridian",
+                    "proved", "exact simplification", 0.01),
+        ClaimResult("pair's system for (u', lambda) regular: det = I3 rho_pair N (I1 I3 m R^2 "
+                    "s^2 rho at ms = Js = 0)", "shell-rotor", "proved",
+                    "exact evaluation at 4 random rational points", 12.5),
+        ClaimResult("lagrange integral not conserved", "rubber", "proved",
+                    "exact evaluation: nonzero (-0.123457) at a random rational point", 0.2),
+    ]  # fmt: skip
+    monkeypatch.setattr(rollingtop.symbolic, "verify", lambda models, progress=None: results)
+    code, out, err = run_cli(capsys, "verify")
+    assert code == 0 and err == ""
+    lines = out.splitlines()
+    assert max(len(line) for line in lines) == 100
+    rows = [[cell.strip() for cell in line.split("│")[2:6]] for line in lines if "proved" in line]
+    assert rows == [["meridian", "proved", "simplified", "0.01"],
+                    ["shell-rotor", "proved", "4 random points", "12.50"],
+                    ["rubber", "proved", "nonzero (-0.123457) at a point", "0.20"]]  # fmt: skip
+    assert "N random points = evaluated in rational" in out
+    code, out, err = run_cli(capsys, "verify", "--json")
+    assert json.loads(out)["claims"][1]["method"] == "exact evaluation at 4 random rational points"

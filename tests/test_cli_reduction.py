@@ -30,6 +30,7 @@ def test_orbits_json_uses_h_from_level_and_option(capsys, paper_body):
     code, out, _ = run_cli(capsys, "orbits", FIG5, "--json")
     data = json.loads(out)
     assert code == 0 and data["level"]["h"] == 4.0
+    assert data["level"]["energy"] == 6.0  # h + M3^2/(2 I3) + m g R = 4 + 1 + 1
     assert len(data["orbits"]) == 2
     assert data["orbits"][0]["gamma3_min"] < data["orbits"][1]["gamma3_min"]
     code, out, _ = run_cli(capsys, "orbits", FIG5, "--h", "5.0", "--json")

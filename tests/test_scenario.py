@@ -239,3 +239,17 @@ def test_samples_bounded_by_memory(monkeypatch, tmp_path):
     assert sc.with_overrides(samples=fits).integration.samples == fits
     with pytest.raises(ScenarioError, match="needs about .* of memory"):
         sc.with_overrides(samples=fits + 1)
+
+
+def test_documented_model_lists_name_every_registered_model():
+    """A ``model = ...  # a | b | ...`` comment in an example or the scenario guide lists every
+    registered model, in the registry's order (paper.toml once listed three of six)."""
+    listed = {}
+    for path in [*EXAMPLES.glob("*.toml"), EXAMPLES.parent / "docs" / "guide" / "scenarios.md"]:
+        for line in path.read_text().splitlines():
+            if line.startswith("model =") and "|" in line:
+                names = line.split("#", 1)[1].split("(")[0]
+                listed[path.name] = [n.strip() for n in names.split("|")]
+    assert set(listed) == {"paper.toml", "scenarios.md"}
+    for names in listed.values():
+        assert names == list(MODELS)

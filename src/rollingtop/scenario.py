@@ -231,6 +231,28 @@ class Scenario:
 
         return reduced_energy(self.body, self.require_state())
 
+    def level_summary(self) -> dict[str, Any] | None:
+        """The level of the scenario's motion and the energy it implies, where the model has
+        the reduction, the body is dynamically symmetric and there is a motion; else ``None``.
+
+        Returns
+        -------
+        dict or None
+            ``M3, C1, C2, h`` (:meth:`level_integrals`, :meth:`level_h`), ``energy = h +
+            spin_energy + mgR`` (:func:`~rollingtop.reduction.start.level_energy`), ``source``
+            (``"[level]"`` where it gives ``h``, else ``"initial state"``).
+        """
+        if not (self.model.has_reduction and self.body.symmetric) or self.y0 is None:
+            return None
+        from rollingtop.reduction.start import level_energy
+
+        M3, C1, C2 = self.level_integrals()
+        h, given = self.level_h(), self.level is not None and self.level.h is not None
+        return {"M3": M3, "C1": C1, "C2": C2, "h": h, "energy": level_energy(self.body, M3, h),
+                "spin_energy": M3 * M3 / (2.0 * self.body.I3),
+                "mgR": self.body.m * self.body.g * self.body.R,
+                "source": "[level]" if given else "initial state"}  # fmt: skip
+
     def with_overrides(self, **overrides: Any) -> Scenario:
         """A copy with integration options (``t_end, rtol, atol, samples, max_steps``) or the
         contact ``model`` (a name or a :class:`ContactModel`) replaced. ``None`` values are

@@ -110,3 +110,45 @@ def test_section_reports_the_motions_that_would_leave_the_plane(capsys, tmp_path
         sampled = float(np.min(run.normal_force))
         assert sampled == pytest.approx(f, abs=0.02)
         assert (sampled < 0) == (f < 0)
+
+
+def test_section_names_the_trajectories_that_stop_early(capsys, tmp_path):
+    """Each trajectory stopped before its crossings is named, with its initial values, the
+    crossings it found, where it stopped and why; one trajectory is "1 trajectory"."""
+    fig = tmp_path / "s.png"
+    args = ["section", CHAOTIC, "-o", str(fig), "--trajectories", "1", "--t-max", "60"]
+    code, out, err = run_cli(capsys, *args, "--crossings", "14", "--json")
+    assert code == 0, err
+    (stopped,) = json.loads(out)["stopped_early"]
+    # measured: the scenario's own state crosses 13 times before t = 60
+    assert stopped == {"trajectory": 0, "crossings": 13, "t_last": 60.0, "status": 0,
+                       "reason": "t_max reached", "gamma": [0.6, 0.0, 0.8],
+                       "omega": [0.2, 0.6, 0.3]}  # fmt: skip
+    code, out, err = run_cli(capsys, *args, "--crossings", "14")
+    assert code == 0, err
+    assert out.splitlines()[1:3] == [
+        "1 trajectory stopped before 14 crossings:",
+        "  trajectory 0 (gamma = [0.6, 0, 0.8], omega = [0.2, 0.6, 0.3]): 13 crossings, "
+        "stopped at t = 60: t_max reached",
+    ]
+    code, out, err = run_cli(capsys, *args, "--crossings", "13")
+    assert code == 0 and "stopped before" not in out
+
+
+def test_stopped_lines_count_and_cut():
+    """Plural and singular, and at most MAX_NAMED trajectories named (the rest counted)."""
+    from rollingtop.cli._chaos import MAX_NAMED, _stopped_lines
+
+    one = {"trajectory": 4, "crossings": 1, "t_last": 2.5, "status": 1,
+           "reason": "max_steps reached", "gamma": [0.0, 0.6, 0.8],
+           "omega": [1.0, 0.0, 0.0]}  # fmt: skip
+    assert _stopped_lines([], 1) == []
+    assert _stopped_lines([one], 1) == [
+        "1 trajectory stopped before 1 crossing:",
+        "  trajectory 4 (gamma = [0, 0.6, 0.8], omega = [1, 0, 0]): 1 crossing, stopped at "
+        "t = 2.5: max_steps reached",
+    ]
+    lines = _stopped_lines([one] * (MAX_NAMED + 3), 1000)
+    assert lines[0] == f"{MAX_NAMED + 3} trajectories stopped before 1000 crossings:"
+    assert len(lines) == MAX_NAMED + 2
+    assert lines[-1] == "  ... and 3 more (--json lists every one)"

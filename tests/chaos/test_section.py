@@ -164,6 +164,26 @@ def test_chaotic_section_fills_an_area_and_writes_netcdf(chaotic):
     assert len(netcdf_bytes(ds)) > 0
 
 
+def test_trajectories_stopped_early_name_the_stepper_status(paper_state):
+    """A trajectory out of steps is listed with the stepper's status name; one that reached
+    t_max with fewer crossings, as such; a complete one not at all."""
+    from rollingtop.chaos.section import section_summary
+
+    states = np.array([paper_state, paper_state])
+    ds = poincare_section(PAPER, "meridian", states, crossings=5, max_steps=3)
+    summary = section_summary(ds)
+    assert summary["incomplete"] == 2
+    first = summary["stopped_early"][0]
+    assert (first["trajectory"], first["status"], first["reason"]) == (0, 1, "max_steps reached")
+    np.testing.assert_array_equal(first["gamma"], paper_state[12:15])
+    np.testing.assert_array_equal(first["omega"], paper_state[3:6])
+    assert first["crossings"] == int(ds["n_crossings"][0]) < 5
+    ds = poincare_section(PAPER, "meridian", states, crossings=5, t_max=1.0)
+    assert {s["reason"] for s in section_summary(ds)["stopped_early"]} == {"t_max reached"}
+    ds = poincare_section(PAPER, "meridian", states, crossings=2)
+    assert section_summary(ds)["stopped_early"] == []
+
+
 def test_section_refuses_bad_input(paper_state):
     with pytest.raises(ScenarioError, match="crossings"):
         poincare_section(PAPER, "meridian", paper_state, crossings=0)

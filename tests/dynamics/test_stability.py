@@ -209,6 +209,40 @@ def test_cli_stability_json(capsys):
     assert len(summary["eigenvalues"]["south"]) == 4
 
 
+def test_cli_stability_other_model_and_every_model(capsys):
+    """--model NAME answers for that model; --model all for every model that takes the body
+    (rollingtop.contact.models_for), a model without a vertical-spin answer with its reason."""
+    from rollingtop.contact import models_for
+
+    paper = str(EXAMPLES / "paper.toml")
+    code, out, err = run_cli(capsys, "stability", paper, "--model", "rough", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["model"] == "rough"
+    assert summary["vertical_spin"][0]["omega3_critical"] == pytest.approx(0.48573398, abs=1e-8)
+    code, out, err = run_cli(capsys, "stability", paper, "--model", "all", "--json")
+    assert code == 0, err
+    every = json.loads(out)["models"]
+    assert [s["model"] for s in every] == [m.name for m in models_for(PAPER)]
+    assert [s["model"] for s in every] == ["meridian", "smooth", "rough", "parallel", "rubber"]
+    south = {s["model"]: s["vertical_spin"][0]["omega3_critical"]
+             for s in every if "vertical_spin" in s}  # fmt: skip
+    # the README's rates: 0.31 (meridian), 0.69 (smooth), 0.49 (rough)
+    assert south == pytest.approx({"meridian": 0.30881101, "smooth": 0.69282032,
+                                   "rough": 0.48573398}, abs=1e-8)  # fmt: skip
+    refused = {s["model"]: s["refused"] for s in every if "refused" in s}
+    assert set(refused) == {"parallel", "rubber"}
+    assert "has no vertical spin" in refused["rubber"]
+    code, out, err = run_cli(capsys, "stability", paper, "--model", "all")
+    assert code == 0 and err == ""
+    rows = [line for line in out.splitlines() if "south" in line and "│" in line]
+    assert [row.split("│")[1].strip() for row in rows] == ["meridian", "smooth", "rough"]
+    assert "rubber: model 'rubber' has no vertical spin" in out
+    code, out, err = run_cli(capsys, "stability", paper, "--model", "frob")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "unknown contact model 'frob'" in err and "or all" in err
+
+
 def test_cli_stability_errors(capsys, tmp_path):
     path = tmp_path / "s.toml"
     path.write_text(scenario_text(body="R = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\n"

@@ -33,10 +33,15 @@ def thread_count(threads: int | None) -> int:
 
 
 def run_threaded(
-    batch: Callable[..., None], args: tuple[Any, ...], threads: int | None
+    batch: Callable[..., None],
+    args: tuple[Any, ...],
+    threads: int | None,
+    poll: Callable[[], None] | None = None,
 ) -> tuple[float, int]:
     """Call the compiled ``batch(*args, stop)`` in a worker thread; returns the seconds it took
-    and the threads used. ``stop`` is an int64 flag array the kernel polls."""
+    and the threads used. ``stop`` is an int64 flag array the kernel polls; ``poll()``, if
+    given, is called in the calling thread after each wait of ``WAIT_SLICE`` seconds (to report
+    progress from what the kernel has written so far)."""
     stop: IntArray = np.zeros(1, dtype=np.int64)
     n_threads = thread_count(threads)
     failure: list[BaseException] = []
@@ -55,6 +60,8 @@ def run_threaded(
     try:
         while worker.is_alive():
             worker.join(WAIT_SLICE)
+            if poll is not None:
+                poll()
     except BaseException:
         stop[0] = 1
         worker.join()

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -45,15 +45,15 @@ from rollingtop.chaos._kernels import SECTION_STATS
 from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._layout import N_STATE, state_components
+from rollingtop.dynamics._layout import GAMMA, N_STATE, W, state_components
 from rollingtop.dynamics.integrals import reduced_components
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
-from rollingtop.integrate._dop853 import STATUS_NAMES
+from rollingtop.integrate._dop853 import FINISHED, STATUS_NAMES
 
 if TYPE_CHECKING:
     import xarray as xr
 
-__all__ = ["STATE_COMPONENTS", "poincare_section"]
+__all__ = ["STATE_COMPONENTS", "poincare_section", "section_summary", "stopped_early"]
 
 #: Names of the state components (the ``state`` coordinate of the datasets).
 STATE_COMPONENTS = state_components()
@@ -106,6 +106,7 @@ def poincare_section(
     t_max: float = math.inf,
     max_steps: int = 10**7,
     threads: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> xr.Dataset:
     """Crossings of the section ``w_tau = 0`` (upward) by trajectories on one level set.
 
@@ -133,6 +134,9 @@ def poincare_section(
         ... or after this many accepted steps.
     threads : int, optional
         Threads (default: numba's, all cores).
+    progress : callable, optional
+        ``progress(found, K * crossings)``: the crossings found so far by all trajectories,
+        called every ``WAIT_SLICE`` (0.05 s) while they run and once at the end.
 
     Returns
     -------
@@ -170,11 +174,19 @@ def poincare_section(
     ev_t = np.full((K, crossings), np.nan)
     ev_y = np.full((K, crossings, N_STATE), np.nan)
     stats = np.zeros((K, len(SECTION_STATS)))
+    poll = None
+    if progress is not None:
+        # the kernel writes each crossing's time into ev_t (NaN until then) as it finds it
+        def poll() -> None:
+            progress(int(np.count_nonzero(~np.isnan(ev_t))), ev_t.size)
+
     with compiling(model, "chaos"):
         wall, used = run_threaded(for_model(model).chaos.section_batch,
                                   (codes, body.params, Y0, float(t_max), float(rtol), float(atol),
-                                   int(max_steps), ev_t, ev_y, stats), threads)  # fmt: skip
+                                   int(max_steps), ev_t, ev_y, stats), threads, poll)  # fmt: skip
     found = stats[:, 1].astype(int)
+    if progress is not None:
+        progress(int(found.sum()), ev_t.size)
     mask = np.arange(crossings)[None, :] >= found[:, None]
     ev_t[mask] = np.nan
     ev_y[mask] = np.nan
@@ -209,8 +221,39 @@ def poincare_section(
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def stopped_early(ds: xr.Dataset) -> list[dict[str, Any]]:
+    """The trajectories of a section that stopped before the asked number of crossings.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A section (:func:`poincare_section`).
+
+    Returns
+    -------
+    list of dict
+        One per such trajectory, in order: ``trajectory`` (its index), ``crossings`` (found),
+        ``t_last``, ``status`` (the stepper's code) and ``reason``: the stepper's status name
+        (``"max_steps reached"``, ...), or ``"t_max reached"`` where the stepper finished at
+        ``t_max``; ``gamma`` and ``omega``, the body-frame initial values.
+    """
+    names = json.loads(ds.attrs["status_names"])
+    found = ds["n_crossings"].values
+    out = []
+    for k in np.flatnonzero(found < ds.attrs["crossings"]):
+        status = int(ds["status"].values[k])
+        y0 = ds["initial_state"].values[k]
+        reason = "t_max reached" if status == FINISHED else names.get(str(status), str(status))
+        out.append({"trajectory": int(k), "crossings": int(found[k]),
+                    "t_last": float(ds["t_last"].values[k]), "status": status, "reason": reason,
+                    "gamma": [float(x) for x in y0[GAMMA]],
+                    "omega": [float(x) for x in y0[W]]})  # fmt: skip
+    return out
+
+
 def section_summary(ds: xr.Dataset) -> dict[str, Any]:
-    """JSON-ready summary of a section (``rollingtop section --json``)."""
+    """JSON-ready summary of a section (``rollingtop section --json``): ``incomplete`` counts
+    the trajectories that stopped early, ``stopped_early`` names them (:func:`stopped_early`)."""
     w_tau = np.abs(ds["w_tau"].values)
     ok = np.isfinite(w_tau)
     levels = {str(name)[6:]: [float(ds[name].min()), float(ds[name].max())]
@@ -221,6 +264,7 @@ def section_summary(ds: xr.Dataset) -> dict[str, Any]:
         "crossings_per_trajectory": int(ds.attrs["crossings"]),
         "crossings_found": int(ds["n_crossings"].sum()),
         "incomplete": int(np.sum(ds["n_crossings"].values < ds.attrs["crossings"])),
+        "stopped_early": stopped_early(ds),
         "max_abs_w_tau": float(w_tau[ok].max()) if ok.any() else None,
         "min_normal_force": float(ds["min_normal_force"].min()),
         "contact_lost": int(np.sum(ds["min_normal_force"].values < 0)),

@@ -7,7 +7,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._level`: ``equilibria``, ``orbits``, ``portrait`` (the reduction);
 - :mod:`._bifurcation`: ``bifurcation`` (the classification of the reduced motions);
 - :mod:`._rotation`: ``rotation`` (rotation numbers, classes of motion in absolute space);
-- :mod:`._stability`: ``stability`` (vertical spins, every model);
+- :mod:`._stability`: ``stability`` (vertical spins under one model or every one);
 - :mod:`._atlas`: ``atlas`` (the classification over a parameter grid, on Dask);
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;

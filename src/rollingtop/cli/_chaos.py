@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from typing import Any
 
 import click
 
@@ -29,6 +30,37 @@ def _hold(value: str | None) -> list[str] | None:
     if not names:
         raise BadInput(f"--hold {value!r}: give integral names separated by commas")
     return names
+
+
+#: Trajectories named one by one when some stop early (``--json`` lists every one).
+MAX_NAMED = 10
+
+
+def _count(n: int, one: str, many: str) -> str:
+    """``1 trajectory``, ``2 trajectories``."""
+    return f"{n} {one if n == 1 else many}"
+
+
+def _stopped_lines(stopped: list[dict[str, Any]], crossings: int) -> list[str]:
+    """The lines naming the trajectories that stopped before ``crossings`` crossings
+    (:func:`rollingtop.chaos.section.stopped_early`): a count, then one line each (index,
+    initial values, crossings found, where and why it stopped), at most :data:`MAX_NAMED`."""
+    if not stopped:
+        return []
+
+    def vec(x: list[float]) -> str:
+        return "[" + ", ".join(f"{v:.6g}" for v in x) + "]"
+
+    lines = [f"{_count(len(stopped), 'trajectory', 'trajectories')} stopped before "
+             f"{_count(crossings, 'crossing', 'crossings')}:"]  # fmt: skip
+    for s in stopped[:MAX_NAMED]:
+        found = _count(s["crossings"], "crossing", "crossings")
+        lines.append(f"  trajectory {s['trajectory']} (gamma = {vec(s['gamma'])}, omega = "
+                     f"{vec(s['omega'])}): {found}, stopped at t = {s['t_last']:.6g}: "
+                     f"{s['reason']}")  # fmt: skip
+    if len(stopped) > MAX_NAMED:
+        lines.append(f"  ... and {len(stopped) - MAX_NAMED} more (--json lists every one)")
+    return lines
 
 
 @click.command()
@@ -75,14 +107,12 @@ def section(
         check_output_path(netcdf, (".nc",))
     sc = load_scenario(scenario).with_overrides(rtol=rtol, atol=atol)
     y0 = sc.require_state()
-    with _output.status("section:") as show:
-        if show is not None:
-            show(f"{trajectories} trajectories x {crossings} crossings")
+    with _output.counting("crossings found", trajectories * crossings) as progress:
         ds = poincare_section(sc.body, sc.model, y0, crossings=crossings,
                               trajectories=trajectories, hold=_hold(hold), seed=seed,
                               t_max=math.inf if t_max is None else t_max,
-                              rtol=sc.integration.rtol,
-                              atol=sc.integration.resolved_atol)  # fmt: skip
+                              rtol=sc.integration.rtol, atol=sc.integration.resolved_atol,
+                              progress=progress)  # fmt: skip
     from rollingtop.plot.section import section_figure
 
     save_figure(section_figure(ds), output)
@@ -101,8 +131,8 @@ def section(
     click.echo(f"{found} crossings of {K} trajectories (model {summary['model']}, held: "
                f"{', '.join(summary['held'])}); max |w_tau| at the crossings "
                f"{summary['max_abs_w_tau']:.2g}")  # fmt: skip
-    if summary["incomplete"]:
-        click.echo(f"{summary['incomplete']} trajectories stopped before {crossings} crossings")
+    for line in _stopped_lines(summary["stopped_early"], crossings):
+        click.echo(line)
     click.echo(f"wrote {output}" + ("" if netcdf is None else f" and {netcdf}"))
 
 

@@ -73,7 +73,10 @@ def equilibria(scenario: str, as_json: bool) -> None:
 def _orbits_table(level: LevelSet, h: float, survey: Sequence[OrbitSurvey]) -> Table:
     from rich.table import Table
 
-    table = Table(title=f"orbits on {level.describe()}, h = {h:g}")
+    from rollingtop.reduction.start import level_energy
+
+    energy = level_energy(level.body, level.M3, h)
+    table = Table(title=f"orbits on {level.describe()}, h = {h:g} (energy {energy:g})")
     cols = ("gamma3_min", "gamma3_max", "period", "+-", "delta_psi", "motion", "circle / drift",
             "note")  # fmt: skip
     for col in cols:
@@ -120,7 +123,10 @@ def orbits(scenario: str, h: float | None, as_json: bool) -> None:
     survey = survey_orbits(level, h)
     if as_json:
         rows = [row.to_dict() for row in survey]
-        click.echo(json.dumps({"level": _level_json(level, h=h), "orbits": rows}))
+        from rollingtop.reduction.start import level_energy
+
+        energy = level_energy(level.body, level.M3, h)
+        click.echo(json.dumps({"level": _level_json(level, h=h, energy=energy), "orbits": rows}))
     else:
         _output.console().print(_orbits_table(level, h, survey))
 

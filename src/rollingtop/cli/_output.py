@@ -115,9 +115,10 @@ def timing(total: float) -> Iterator[Callable[[float], None] | None]:
 
 
 @contextlib.contextmanager
-def counting(label: str, total: int) -> Iterator[Callable[[int, int], None] | None]:
+def counting(label: str, total: int | None) -> Iterator[Callable[[int, int], None] | None]:
     """``progress(done, total)`` drawing a bar of items done (``12/40``) on a terminal, else
-    ``None`` (as long as the block runs)."""
+    ``None`` (as long as the block runs). ``total`` may be ``None`` until the first call
+    says it."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
     stderr = _terminal_stderr()
@@ -127,7 +128,7 @@ def counting(label: str, total: int) -> Iterator[Callable[[int, int], None] | No
     with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), console=stderr,
                   transient=True) as bar:  # fmt: skip
         task = bar.add_task(label, total=total)
-        yield lambda done, n: bar.update(task, completed=done)
+        yield lambda done, n: bar.update(task, completed=done, total=n)
 
 
 @contextlib.contextmanager
@@ -142,9 +143,15 @@ def status(label: str) -> Iterator[Callable[[str], None] | None]:
         yield lambda what: spinner.update(f"{label} {what}")
 
 
-def console() -> Console:
-    """Console on stdout; when stdout is not a terminal, wide enough that no table is cut."""
+#: Width of the console on stdout when it is not a terminal (a pipe, a file), unless a command
+#: asks for another: wide enough that no table is cut.
+PIPED_WIDTH = 160
+
+
+def console(piped_width: int = PIPED_WIDTH) -> Console:
+    """Console on stdout; when stdout is not a terminal, ``piped_width`` columns wide (a table
+    wider than that wraps its cells)."""
     from rich.console import Console
 
     stdout = Console()
-    return stdout if stdout.is_terminal else Console(width=160)
+    return stdout if stdout.is_terminal else Console(width=piped_width)

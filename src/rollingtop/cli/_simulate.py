@@ -55,9 +55,21 @@ def _integrals_table(summary: dict[str, Any]) -> Table:
     return table
 
 
+def _level_line(level: dict[str, Any]) -> str:
+    """The level of the motion and the energy it implies
+    (:meth:`rollingtop.scenario.Scenario.level_summary`), in one line."""
+    where = "of [level]" if level["source"] == "[level]" else "of the initial state"
+    C2 = "" if level["C2"] is None else f", C2 = {level['C2']:.10g}"
+    h, spin, mgR, energy = (f"{level[k]:.10g}" for k in ("h", "spin_energy", "mgR", "energy"))
+    return (f"level {where}: h = {h} (M3 = {level['M3']:.10g}, C1 = {level['C1']:.10g}{C2}); "
+            f"energy = h + M3^2/(2 I3) + m g R = {h} + {spin} + {mgR} = {energy}")  # fmt: skip
+
+
 def _print_report(summary: dict[str, Any]) -> None:
     console = _output.console()
     console.print(_integrals_table(summary))
+    if "level" in summary:
+        click.echo(_level_line(summary["level"]))
     c, r, s = summary["constraints"], summary["reactions"], summary["stats"]
     lost = r["contact_lost_at"]
     console.print(
@@ -119,6 +131,9 @@ def simulate(
     if output is not None:
         traj.save(output)
     summary = traj.summary()
+    level = sc.level_summary()
+    if level is not None:
+        summary["level"] = level
     if as_json:
         click.echo(json.dumps(summary))
     else:

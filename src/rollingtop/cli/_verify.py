@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import re
+from typing import TYPE_CHECKING
 
 import click
 
@@ -11,10 +13,54 @@ from rollingtop.cli._errors import BadInput
 from rollingtop.cli._options import ModelChoice, json_option
 from rollingtop.contact import MODELS, ContactModel
 
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from rollingtop.symbolic import ClaimResult
+
 __all__ = ["verify"]
 
 #: Exit status when a claim is not proved.
 EXIT_FAILED = 1
+#: Width of the table when stdout is not a terminal.
+PIPED_WIDTH = 100
+
+
+#: The methods' long names (:func:`rollingtop.symbolic.claims.decide`), shortened in the table.
+_SHORT_METHODS = (
+    (re.compile(r"^exact simplification$"), "simplified"),
+    (re.compile(r"^exact evaluation at (\d+) random rational points$"), r"\1 random points"),
+    (re.compile(r"^exact evaluation: (.*) at a random rational point$"), r"\1 at a point"),
+)
+#: Below the table: what the short methods stand for (``--json`` gives the long names).
+CAPTION = ("every method is exact: simplified = cancelled to zero; N random points = evaluated "
+           "in rational arithmetic at N random rational points; nonzero at a point = a rational "
+           "counterexample")  # fmt: skip
+
+
+def _short_method(method: str) -> str:
+    """``method`` in a few words (``exact evaluation at 4 random rational points``:
+    ``4 random points``); a method not known here unchanged."""
+    for pattern, short in _SHORT_METHODS:
+        if pattern.match(method):
+            return pattern.sub(short, method)
+    return method
+
+
+def _table(results: list[ClaimResult]) -> Table:
+    """The claims' table: the claim wraps (at word boundaries), the other columns do not."""
+    from rich.table import Table
+
+    table = Table(title="rollingtop verify", caption=CAPTION)
+    table.add_column("claim")
+    for col in ("model", "result", "method"):
+        table.add_column(col, no_wrap=True)
+    table.add_column("time (s)", justify="right", no_wrap=True)
+    for r in results:
+        colour = "green" if r.result == "proved" else "red"
+        table.add_row(r.name, r.model, f"[{colour}]{r.result}[/{colour}]",
+                      _short_method(r.method), f"{r.seconds:.2f}")  # fmt: skip
+    return table
 
 
 @click.command()
@@ -34,20 +80,11 @@ def verify(ctx: click.Context, models: tuple[ContactModel, ...], as_json: bool) 
         from rollingtop.symbolic import verify as run_claims
     except ImportError as exc:  # pragma: no cover - sympy missing
         raise BadInput(f"verify needs sympy ({exc}): pip install rollingtop[symbolic]") from None
-    results = run_claims(tuple(m.name for m in models) or tuple(MODELS))
+    with _output.counting("claims decided", None) as progress:
+        results = run_claims(tuple(m.name for m in models) or tuple(MODELS), progress=progress)
     if as_json:
         click.echo(json.dumps({"claims": [r.to_dict() for r in results]}))
     else:
-        from rich.table import Table
-
-        table = Table(title="rollingtop verify")
-        for col in ("claim", "model", "result", "method", "time (s)"):
-            table.add_column(col, justify="right" if col == "time (s)" else "left")
-        for r in results:
-            colour = "green" if r.result == "proved" else "red"
-            table.add_row(
-                r.name, r.model, f"[{colour}]{r.result}[/{colour}]", r.method, f"{r.seconds:.2f}"
-            )
-        _output.console().print(table)
+        _output.console(piped_width=PIPED_WIDTH).print(_table(results))
     if any(r.result != "proved" for r in results):
         ctx.exit(EXIT_FAILED)

@@ -5,11 +5,14 @@ region's phase portrait, and the number of steady motions over ``(C1, C2)``
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from matplotlib import colormaps
+from matplotlib.axes import Axes
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from rollingtop.reduction.bifurcation import BifurcationDiagram, SteadyCountMap
 from rollingtop.reduction.level import LevelSet
@@ -20,31 +23,79 @@ CENTRE_COLOUR = "#1f4e9c"
 SADDLE_COLOUR = "#c0392b"
 
 
-def _thumbnail(ax, diagram: BifurcationDiagram, k: int) -> None:  # type: ignore[no-untyped-def]
-    """The level curve ``h`` of region ``k``'s representative level in ``(gamma3, w_tau)``."""
+#: Points of the first sweep for the orbits of a level, and per orbit on its closed curve.
+SWEEP_POINTS = 4001
+ORBIT_POINTS = 400
+#: Margin around a thumbnail's orbits, as a fraction of their extent along each axis.
+THUMB_MARGIN = 0.08
+
+
+def _orbit_curves(level: LevelSet, h: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each orbit of ``level`` at energy ``h`` as ``(x, w)``: ``w = |w_tau| >= 0`` from one
+    turning point to the other (found by Brent's method, so ``w`` is 0 at both ends), the nodes
+    dense near them; ``x = gamma3``, or the signed angle ``theta`` on a pole level."""
+    from scipy.optimize import brentq
+
+    if level.pole is None:
+        xs = np.linspace(-1.0, 1.0, SWEEP_POINTS)[1:-1]
+
+        def theta(x: np.ndarray) -> np.ndarray:
+            return LevelSet.theta_of(x)
+    else:  # a pole level: the signed angle, in which orbits pass the pole regularly
+        xs = np.linspace(*level.theta_domain, SWEEP_POINTS)[1:-1]
+
+        def theta(x: np.ndarray) -> np.ndarray:
+            return x
+
+    def gap(x: np.ndarray) -> np.ndarray:
+        with np.errstate(over="ignore", invalid="ignore"):
+            th = theta(np.asarray(x, dtype=float))
+            return np.asarray(2.0 * (h - level.U(th)) / level.rho(th))
+
+    inside = np.nan_to_num(gap(xs), nan=-1.0) >= 0.0
+    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
+    starts = [0] * bool(inside[0]) + [int(i) + 1 for i in edges if not inside[i]]
+    stops = [int(i) for i in edges if inside[i]] + [len(xs) - 1] * bool(inside[-1])
+
+    def turning(a: float, b: float) -> float:
+        return float(brentq(lambda x: float(gap(x)), a, b, xtol=1e-14))
+
+    curves = []
+    for i0, i1 in zip(starts, stops, strict=True):
+        lo = turning(xs[i0 - 1], xs[i0]) if i0 > 0 else float(xs[i0])
+        hi = turning(xs[i1], xs[i1 + 1]) if i1 < len(xs) - 1 else float(xs[i1])
+        x = lo + (hi - lo) * (1.0 - np.cos(np.linspace(0.0, np.pi, ORBIT_POINTS))) / 2.0
+        w = np.sqrt(np.clip(gap(x), 0.0, None))
+        w[[0, -1]] = [0.0 if i0 > 0 else w[0], 0.0 if i1 < len(xs) - 1 else w[-1]]
+        curves.append((x, w))
+    return curves
+
+
+def _thumbnail(ax: Axes, diagram: BifurcationDiagram, k: int, colour: Any) -> None:
+    """The level curve ``h`` of region ``k``'s representative level in ``(gamma3, w_tau)``,
+    each orbit closed, the axes fitted to the orbits, on the region's colour."""
     region = diagram.regions[k]
     level = LevelSet(diagram.body, diagram.M3, diagram.C1, region.C2)
-    if level.pole is None:
-        g = np.linspace(-1.0, 1.0, 2001)[1:-1]
-        theta = LevelSet.theta_of(g)
-    else:  # a pole level: the signed angle, in which orbits pass the pole regularly
-        lo, hi = level.theta_domain
-        theta = np.linspace(lo, hi, 2001)[1:-1]
-        g = theta
-    with np.errstate(over="ignore", invalid="ignore"):
-        gap = 2.0 * (region.h - level.U(theta)) / level.rho(theta)
-    w = np.where(gap >= 0.0, np.sqrt(np.clip(gap, 0.0, None)), np.nan)
-    ax.plot(g, w, color=CENTRE_COLOUR, lw=1.2)
-    ax.plot(g, -w, color=CENTRE_COLOUR, lw=1.2)
-    ax.axhline(0.0, color="0.8", lw=0.5, zorder=0)
-    ax.set_xlim(g[0], g[-1])
-    top = np.nanmax(w) if np.isfinite(w).any() else 1.0
-    ax.set_ylim(-1.15 * top, 1.15 * top)
-    if level.pole is None:
-        ax.set_xticks([-1, 0, 1])
-    ax.set_yticks([])
-    ax.tick_params(labelsize=6, length=2, pad=1)
-    ax.set_title(f"{region.name}: {region.label}", fontsize=7, pad=2)
+    curves = _orbit_curves(level, region.h)
+    for x, w in curves:
+        ax.plot(np.r_[x, x[::-1]], np.r_[w, -w[::-1]], color=CENTRE_COLOUR, lw=1.3)
+    ax.axhline(0.0, color="0.6", lw=0.5, zorder=0)
+    ax.set_facecolor(colour)
+    if curves:
+        lo = min(float(x[0]) for x, _ in curves)
+        hi = max(float(x[-1]) for x, _ in curves)
+        top = max(float(np.max(w)) for _, w in curves) or 1.0
+        pad = THUMB_MARGIN * max(hi - lo, 1e-9)
+        if level.pole is None:
+            ax.set_xlim(max(lo - pad, -1.0), min(hi + pad, 1.0))
+        else:
+            ax.set_xlim(lo - pad, hi + pad)
+        ax.set_ylim(-(1.0 + 2 * THUMB_MARGIN) * top, (1.0 + 2 * THUMB_MARGIN) * top)
+    ax.xaxis.set_major_locator(MaxNLocator(3))
+    ax.yaxis.set_major_locator(MaxNLocator(3, symmetric=True))
+    ax.tick_params(labelsize=7, length=2, pad=1)
+    ax.set_title(f"{region.name}: {region.label}\nC2 = {region.C2:.3g}, h = {region.h:.3g}",
+                 fontsize=8, pad=3)  # fmt: skip
 
 
 def _on_pole_level(diagram: BifurcationDiagram) -> bool:
@@ -61,12 +112,13 @@ def bifurcation_figure(
     ``(gamma3, w_tau)`` beside it, and, if given, the steady-motion count over ``(C1, C2)``."""
     regions = diagram.regions
     n_thumb = max(len(regions), 1)
-    cols = 2 if n_thumb > 4 else 1
+    cols = 1 if n_thumb <= 2 else 2
     rows_t = math.ceil(n_thumb / cols)
     extra = 1 if count_map is not None else 0
-    fig = Figure(figsize=(7.0 + 2.2 * cols + 5.0 * extra, max(5.2, 1.5 * rows_t)))
-    grid = fig.add_gridspec(rows_t, 3 + cols + 2 * extra, wspace=0.9, hspace=0.8)
-    ax = fig.add_subplot(grid[:, :3])
+    fig = Figure(figsize=(5.6 + 2.7 * cols + 4.4 * extra, max(5.6, 2.8 * rows_t)),
+                 layout="constrained")  # fmt: skip
+    outer = fig.add_gridspec(1, 2 + extra, width_ratios=[5.6, 2.7 * cols] + [4.4] * extra)
+    ax = fig.add_subplot(outer[0, 0])
     cmap = ListedColormap([colormaps["Pastel1"](i % 9) for i in range(max(len(regions), 1))])
     shade = np.ma.masked_less(diagram.region_index, 0)
     ax.pcolormesh(diagram.C2_grid, diagram.h_grid, shade, cmap=cmap, shading="nearest",
@@ -99,14 +151,17 @@ def bifurcation_figure(
                  f"a3 = {b.a3:g}, I1 = {b.I1:g}, I3 = {b.I3:g}, m = {b.m:g}, g = {b.g:g})",
                  fontsize=9)  # fmt: skip
     ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
+    thumbs = outer[0, 1].subgridspec(rows_t, cols)
+    axis = "theta" if _on_pole_level(diagram) else "gamma3"
     for k in range(len(regions)):
-        sub = fig.add_subplot(grid[k % rows_t, 3 + k // rows_t])
-        _thumbnail(sub, diagram, k)
-        if k % rows_t == rows_t - 1 or k == len(regions) - 1:
-            axis = "gamma3" if diagram.regions and _on_pole_level(diagram) is False else "theta"
-            sub.set_xlabel(axis, fontsize=7, labelpad=1)
+        sub = fig.add_subplot(thumbs[k // cols, k % cols])
+        _thumbnail(sub, diagram, k, (*cmap(k)[:3], 0.35))
+        if k + cols >= len(regions):  # the lowest in its column
+            sub.set_xlabel(axis, fontsize=8, labelpad=1)
+        if k % cols == 0:
+            sub.set_ylabel("w_tau", fontsize=8, labelpad=1)
     if count_map is not None:
-        axc = fig.add_subplot(grid[:, 3 + cols :])
+        axc = fig.add_subplot(outer[0, 2])
         counts = np.ma.masked_less(count_map.count, 0)
         top = max(int(np.max(count_map.count)), 1)
         cm = ListedColormap([colormaps["Blues"](0.15 + 0.7 * i / max(top, 1))

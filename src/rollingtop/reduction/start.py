@@ -2,7 +2,8 @@
 started on a given level (paper Sec. 3; ``docs/model.md``, "One degree of freedom").
 
 - :func:`level_of_state`: the level set ``(M3, C1, C2)`` a state lies on.
-- :func:`reduced_energy`: its reduced energy ``h``.
+- :func:`reduced_energy`: its reduced energy ``h``; :func:`level_energy`: the full energy of a
+  level, ``E = h + M3^2 / (2 I3) + m g R``.
 - :func:`start_on_level`: a full state on ``(M3, C1, C2, h)``, by default at a turning point of
   the first orbit (how a scenario's ``[level]`` table with ``h`` starts a motion).
 """
@@ -20,7 +21,7 @@ from rollingtop.reduction.level import LevelSet
 from rollingtop.reduction.orbits import orbits
 from rollingtop.reduction.variables import reduced_integrals, state_from_level
 
-__all__ = ["level_of_state", "reduced_energy", "start_on_level"]
+__all__ = ["level_energy", "level_of_state", "reduced_energy", "start_on_level"]
 
 
 def level_of_state(body: SphericalTop, y: ArrayLike) -> LevelSet:
@@ -40,6 +41,29 @@ def level_of_state(body: SphericalTop, y: ArrayLike) -> LevelSet:
 def reduced_energy(body: SphericalTop, y: ArrayLike) -> float:
     """The reduced energy ``h = E - I3 w3^2/2 - m g R`` of the state ``y`` (shape (18,))."""
     return float(reduced_integrals(body, np.asarray(y, dtype=float))["h"])
+
+
+def level_energy(body: SphericalTop, M3: float, h: float) -> float:
+    """The energy ``E`` of the full system on a level with Lagrange integral ``M3`` and reduced
+    energy ``h``.
+
+    ``h = E - I3 w3^2/2 - m g R`` with ``w3 = M3 / I3`` (``docs/model.md``, "Reduced
+    variables"), so ``E = h + M3^2 / (2 I3) + m g R``: the reduction drops the spin's constant
+    kinetic energy and measures the height of the centre of mass from the sphere's centre.
+
+    Parameters
+    ----------
+    body : SphericalTop
+    M3 : float
+        Lagrange integral ``I3 w3``.
+    h : float
+        Reduced energy.
+
+    Returns
+    -------
+    float
+    """
+    return h + M3 * M3 / (2.0 * body.I3) + body.m * body.g * body.R
 
 
 def start_on_level(

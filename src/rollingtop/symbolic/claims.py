@@ -21,7 +21,7 @@ from __future__ import annotations
 import importlib
 import random
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from fractions import Fraction
 from typing import Any
@@ -290,17 +290,42 @@ def check(claim: Claim, seed: int = 1) -> ClaimResult:
                        time.perf_counter() - start)  # fmt: skip
 
 
-def verify(models: Sequence[str] = tuple(MODELS)) -> list[ClaimResult]:
+def verify(
+    models: Sequence[str] = tuple(MODELS),
+    progress: Callable[[int, int], None] | None = None,
+) -> list[ClaimResult]:
     """Check every claim of ``models`` (and the invariant measure of the reduced system with a
-    model that has a reduction)."""
-    results = []
-    for model in models:
-        for claim in claims_for(model):
-            results.append(check(claim))
-        if get_model(model).has_reduction:
+    model that has a reduction).
+
+    Parameters
+    ----------
+    models : sequence of str
+        Registered model names (default: all).
+    progress : callable, optional
+        ``progress(done, total)`` after each claim decided (``total``: the claims of all
+        ``models``).
+
+    Returns
+    -------
+    list of ClaimResult
+        In order: each model's claims (:func:`claims_for`), then its invariant measure.
+    """
+    plan = [(model, claims_for(model), get_model(model).has_reduction) for model in models]
+    total = sum(len(claims) + measure for _, claims, measure in plan)
+    results: list[ClaimResult] = []
+
+    def decided(result: ClaimResult) -> None:
+        results.append(result)
+        if progress is not None:
+            progress(len(results), total)
+
+    for model, claims, measure in plan:
+        for claim in claims:
+            decided(check(claim))
+        if measure:
             start = time.perf_counter()
             holds, method = invariant_measure_claim()
-            results.append(ClaimResult("invariant measure rho(gamma3) of the reduced system",
-                                       model, "proved" if holds else "failed", method,
-                                       time.perf_counter() - start))  # fmt: skip
+            decided(ClaimResult("invariant measure rho(gamma3) of the reduced system", model,
+                                "proved" if holds else "failed", method,
+                                time.perf_counter() - start))  # fmt: skip
     return results
