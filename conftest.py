@@ -17,7 +17,7 @@ import shutil
 from pathlib import Path
 
 #: Subpackages whose modules are compiled into the kernels.
-KERNEL_PACKAGES = ("_compiled", "chaos", "contact", "dynamics", "integrate")
+KERNEL_PACKAGES = ("_compiled", "contact")
 CACHE_ROOT = Path(__file__).resolve().parent / ".numba-cache"
 
 
@@ -29,7 +29,8 @@ def _digest() -> str:
     for package in KERNEL_PACKAGES:
         for path in sorted((root / package).rglob("*.py")):
             digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes())
-    digest.update(b"jit\0" + (root / "_jit.py").read_bytes())
+    for name in ("_jit.py", "_layout.py", "_types.py"):
+        digest.update(name.encode() + b"\0" + (root / name).read_bytes())
     return digest.hexdigest()[:16]
 
 

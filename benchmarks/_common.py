@@ -117,4 +117,3 @@ def machine() -> dict:
         "scipy": scipy.__version__,
         "numba": numba.__version__,
     }
-

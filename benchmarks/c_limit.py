@@ -242,10 +242,9 @@ def check_pieces(lib: ctypes.CDLL, sc: Any, code: int, n_states: int = 200) -> d
     ``n_states`` states along W1's first 50 time units (perturbed by 1e-3) with random stages:
     all 0 when the two round alike."""
     import rollingtop
-    from rollingtop._compiled import for_code
+    from rollingtop._compiled import _dop853_dense, _dop853_stages, for_code
+    from rollingtop._compiled._kernel import new_workspace, reaction
     from rollingtop._jit import call
-    from rollingtop.dynamics._kernel import new_workspace, reaction
-    from rollingtop.integrate import _dop853_dense, _dop853_stages
 
     kernels = for_code(code)  # the meridian model's compiled package
     p = np.ascontiguousarray(sc.body.params, dtype=float)

@@ -68,7 +68,7 @@ REF_RTOL, REF_ATOL = 1e-13, 1e-15
 # ----------------------------------------------------------------------------------------------
 
 N_P = 7
-_WS_SHAPES = ((4, 6), (4,), (4, 3), (4, 4), (4,))  # rollingtop.dynamics._kernel.new_workspace()
+_WS_SHAPES = ((4, 6), (4,), (4, 3), (4, 4), (4,))  # rollingtop._compiled._kernel.new_workspace()
 _WS_SIZE = sum(int(np.prod(s)) for s in _WS_SHAPES)
 I_COUNT = N_P + _WS_SIZE  # rhs evaluations (counting variants only)
 I_LAST_T = I_COUNT + 1  # t of the previous evaluation (numbalsoda: accepted-step detection)
@@ -85,7 +85,7 @@ def packed(p) -> np.ndarray:
 
 
 def _check_workspace_layout() -> None:
-    from rollingtop.dynamics._kernel import new_workspace
+    from rollingtop._compiled._kernel import new_workspace
 
     shapes = tuple(a.shape for a in new_workspace())
     if shapes != _WS_SHAPES:

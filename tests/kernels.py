@@ -2,7 +2,7 @@
 the code's own model (:func:`rollingtop._compiled.for_code`), as the library's callers do."""
 
 from rollingtop._compiled import for_code
-from rollingtop.dynamics._kernel import new_workspace, reaction
+from rollingtop._compiled._kernel import new_workspace, reaction
 
 __all__ = [
     "constraint_rows",

@@ -48,8 +48,12 @@ def test_warmup_prints_a_line_per_model_and_the_total(capsys, monkeypatch):
 
 def test_warmup_defaults_to_every_model(capsys, monkeypatch):
     seen = []
-    monkeypatch.setattr(_warmup, "warmup",
-                        lambda models, processes=None, progress=None: seen.extend(models) or {})  # fmt: skip
+
+    def warmup(models, processes=None, progress=None):
+        seen.extend(models)
+        return {}
+
+    monkeypatch.setattr(_warmup, "warmup", warmup)
     code, _, err = run_cli(capsys, "warmup")
     assert code == 0 and seen == list(MODELS)
     assert f"the kernels of {len(MODELS)} models" in err

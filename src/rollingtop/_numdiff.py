@@ -1,5 +1,5 @@
 """Jacobians by central differences, for the linearisations of steady motions
-(:mod:`rollingtop.dynamics.stability`, :func:`rollingtop.reduction.steady.linearised_eigenvalues`).
+(:mod:`rollingtop.stability`, :func:`rollingtop.reduction.steady.linearised_eigenvalues`).
 
 The right-hand sides differenced here are compiled kernels or closed forms that are not analytic
 in complex arguments (square roots of ``1 - gamma3^2``, numba), so the complex step does not

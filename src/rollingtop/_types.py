@@ -16,7 +16,7 @@ FloatArray: TypeAlias = NDArray[np.float64]
 IntArray: TypeAlias = NDArray[np.int64]
 ComplexArray: TypeAlias = NDArray[np.complex128]
 #: Work arrays ``(J, bias, dirs, A, lam)`` of the kernels, shapes ``(4, 6), (4,), (4, 3), (4, 4),
-#: (4,)`` (:func:`rollingtop.dynamics._kernel.new_workspace`).
+#: (4,)`` (:func:`rollingtop._compiled._kernel.new_workspace`).
 Workspace: TypeAlias = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
 #: Three scalars: the components of a vector.
 Float3: TypeAlias = tuple[float, float, float]

@@ -24,7 +24,7 @@ A model declares the devices that realise it (:attr:`rollingtop.contact.ContactM
 the meridian model all three, the ``shell-rotor`` pair its shell, whose spin is then the
 pair's own state variable); :func:`check_device` refuses the others. ``nu`` and
 ``tau`` are taken from the state's carried direction ``psi_nu``
-(``nu = cos(psi_nu) alpha + sin(psi_nu) beta``, :mod:`rollingtop.dynamics._layout`), which is
+(``nu = cos(psi_nu) alpha + sin(psi_nu) beta``, :mod:`rollingtop._layout`), which is
 regular through a pole passage, where ``sigma`` changes sign.
 """
 
@@ -36,10 +36,10 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 
 from rollingtop._errors import ContactModelError
+from rollingtop._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel
-from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 
 __all__ = [
     "DEVICES",

@@ -11,12 +11,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop._compiled._dop853 import STATUS_NAMES
 from rollingtop._errors import ScenarioError
+from rollingtop._layout import N_STATE, state_components
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, kernel_by_code
-from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.ensemble_tables import (
     MAX_TABLE_BYTES,
@@ -26,7 +27,6 @@ from rollingtop.ensemble_tables import (
     read_table,
     states_from_table,
 )
-from rollingtop.integrate._dop853 import STATUS_NAMES
 from rollingtop.integrate.driver import compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
 from rollingtop.scenario import (

@@ -14,9 +14,9 @@ from typing import TypeAlias
 import numpy as np
 
 from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray
 from rollingtop.contact import ContactModel
-from rollingtop.dynamics._layout import N_STATE
 from rollingtop.io import read_input_text
 from rollingtop.scenario import (
     InitialConditions,

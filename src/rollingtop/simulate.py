@@ -17,12 +17,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._compiled import for_code
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import ContactLostWarning, InitialStateError
 from rollingtop._jit import call
+from rollingtop._layout import N_STATE
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model, models_for
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
 from rollingtop.dynamics.start import InitialConditions
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals, project_state
 from rollingtop.integrate import integrate

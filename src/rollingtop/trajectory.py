@@ -15,11 +15,11 @@ import numpy as np
 from rollingtop._compiled import for_code
 from rollingtop._jit import call
 from rollingtop._json import finite_or_none
+from rollingtop._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, kernel_by_code
-from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.integrate.driver import StepReactions
 from rollingtop.io import check_output_path, write_bytes_atomic
@@ -66,7 +66,7 @@ class Trajectory(NetCDFOutput):
     t : ndarray, shape (n,)
     y : ndarray, shape (n, 18)
         States ``(v, w, alpha, beta, gamma, X, Y, psi_nu)``, body-frame vectors (see
-        :mod:`rollingtop.dynamics._layout`).
+        :mod:`rollingtop._layout`).
     rtol, atol : float
         Tolerances the motion was integrated with.
     stats : dict of str to float

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from rollingtop import ScenarioError, SphericalTop, initial_state
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop.chaos.divergence import (
     _moved,
     _project,
@@ -20,7 +21,6 @@ from rollingtop.chaos.divergence import (
     phase_volume,
 )
 from rollingtop.contact import get_model
-from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.integrate import integrate
 
 from ..conftest import FREE, GAMMA0, OMEGA0, PAPER_BODY

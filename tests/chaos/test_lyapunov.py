@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from rollingtop import IntegrationError, ScenarioError, SphericalTop, initial_state
+from rollingtop._compiled import _tangent as tg
 from rollingtop._compiled import for_code
-from rollingtop.chaos import _tangent as tg
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop.chaos import chaos_indicators, indicator_map, level_states
 from rollingtop.chaos.lyapunov import initial_tangent
-from rollingtop.dynamics._kernel import new_workspace
 from rollingtop.dynamics.state import project_state
 from rollingtop.integrate import integrate
 

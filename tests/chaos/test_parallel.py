@@ -83,8 +83,8 @@ def test_the_tangent_dynamics_stops_at_the_vertical_in_one_line():
     t = 8.6105): the flow has no derivative there; the indicators are refused past it, and a map
     marks the point with its status."""
     from rollingtop import IntegrationError
+    from rollingtop._compiled._tangent import REACHED_VERTICAL
     from rollingtop.chaos import indicator_map
-    from rollingtop.chaos._tangent import REACHED_VERTICAL
 
     from ..contact.test_parallel import BODY, _generic_state
 

@@ -8,10 +8,10 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from rollingtop import ContactLostWarning, IntegrationError, SphericalTop, simulate
+from rollingtop._compiled._dop853_stages import stage
+from rollingtop._compiled._dop853_tableau import N_STAGES_EXTENDED
 from rollingtop.contact import get_model
 from rollingtop.integrate import integrate
-from rollingtop.integrate._dop853_stages import stage
-from rollingtop.integrate._dop853_tableau import N_STAGES_EXTENDED
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
 from tests import kernels as _kernel
 
@@ -278,7 +278,7 @@ def test_a_short_parameter_vector_never_reaches_a_kernel():
     """The kernels read p without bounds checks: the shell-rotor kernel reads the shell's two
     entries, so the warm-up body and every vector handed to the integrators have all nine (a
     seven-entry warm-up vector made the first run of a process fail at random)."""
-    from rollingtop.dynamics._layout import N_PARAMS, WARMUP_PARAMS
+    from rollingtop._layout import N_PARAMS, WARMUP_PARAMS
     from rollingtop.integrate.ensemble import integrate_batch
 
     sc = scenario(t_end=1.0, rtol=1e-10)

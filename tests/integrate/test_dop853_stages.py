@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from rollingtop.integrate import _dop853_codegen
-from rollingtop.integrate._dop853_stages import scaled_errors, stage
-from rollingtop.integrate._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A, B
+from rollingtop._compiled import _dop853_codegen
+from rollingtop._compiled._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A, B
 
 # Each stage is a sum of at most 12 terms of size ~1 times coefficients up to ~44: a few ulps of
 # the largest term.

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from rollingtop import IntegrationError, SphericalTop, initial_state, simulate
+from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import for_code
 from rollingtop.contact import get_model
-from rollingtop.integrate import _dop853 as dop
 from rollingtop.integrate import integrate
 from rollingtop.integrate.driver import _workspace, compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch

@@ -1,7 +1,7 @@
 """Chaos indicators: the maximal Lyapunov exponent and MEGNO, for any contact model.
 
 Both come from one integration of the motion together with its tangent (variational) dynamics
-in compiled code (:mod:`rollingtop.chaos._tangent`: the tangent vector kept on the tangent space
+in compiled code (:mod:`rollingtop._compiled._tangent`: the tangent vector kept on the tangent space
 of the constraint manifold and renormalised after every step):
 
 - the **finite-time maximal Lyapunov exponent** ``lambda(t) = (1/t) sum ln |delta|`` over the
@@ -28,17 +28,17 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import compiling, for_code
+from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
+from rollingtop._compiled._tangent import REACHED_VERTICAL
 from rollingtop._errors import IntegrationError, ScenarioError
 from rollingtop._jit import call
+from rollingtop._layout import N_STATE, state_components
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._tangent import REACHED_VERTICAL
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._layout import N_STATE, state_components
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
-from rollingtop.integrate._dop853 import FINISHED, STATUS_NAMES
 from rollingtop.integrate.driver import _raise_for_status
 
 if TYPE_CHECKING:
@@ -228,7 +228,7 @@ def chaos_indicators(
         Equally spaced sample times in ``(0, t_end]`` (the integration's steps end on them).
     rtol, atol : float
         Tolerances (``atol`` default ``rtol / 100``); the tangent vector's error is held to
-        ``max(rtol, 1e-8)`` of its norm (:data:`rollingtop.chaos._tangent.TANGENT_TOL`).
+        ``max(rtol, 1e-8)`` of its norm (:data:`rollingtop._compiled._tangent.TANGENT_TOL`).
     tangent : array_like, shape (18,), optional
         Initial tangent vector (projected onto the tangent space; default
         :func:`initial_tangent`).

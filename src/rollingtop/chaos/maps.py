@@ -9,14 +9,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import compiling, for_code
+from rollingtop._compiled._tangent import STATUS_NAMES
 from rollingtop._errors import ScenarioError
+from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
 from rollingtop.chaos._parallel import run_threaded
-from rollingtop.chaos._tangent import STATUS_NAMES
 from rollingtop.chaos.lyapunov import check_options, check_state, initial_tangent, vertical_stop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._layout import N_STATE
 
 if TYPE_CHECKING:
     import xarray as xr

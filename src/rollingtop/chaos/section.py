@@ -5,7 +5,7 @@ positive), where ``tau = e3 x gamma / s`` (``docs/model.md``, "Reduced variables
 ``gamma3' = s w_tau`` (paper eq. 3.3, a kinematic identity that holds for every model), these are
 the minima of ``gamma3``: the lowest inclinations of the axis, reached once per nutation. The
 event function is the stepper's ``W_TAU`` (``s w_tau = (w, e3 x gamma)``,
-:mod:`rollingtop.dynamics._events`), located on the 7th-order dense output of each step by
+:mod:`rollingtop._compiled._events`), located on the 7th-order dense output of each step by
 bisection (:func:`rollingtop._compiled._template.dense.event_root`, 60 halvings) and the state
 there projected onto the constraints.
 
@@ -38,17 +38,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._compiled import compiling, for_model
+from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
+from rollingtop._compiled._section import SECTION_STATS
 from rollingtop._errors import InitialStateError, ScenarioError
+from rollingtop._layout import GAMMA, N_STATE, W, state_components
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._kernels import SECTION_STATS
 from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._layout import GAMMA, N_STATE, W, state_components
 from rollingtop.dynamics.integrals import reduced_components
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
-from rollingtop.integrate._dop853 import FINISHED, STATUS_NAMES
 
 if TYPE_CHECKING:
     import xarray as xr

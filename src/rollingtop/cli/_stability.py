@@ -52,7 +52,7 @@ def _pairs(values: Any) -> list[list[float]]:
 def _model_summary(body: SphericalTop, model: ContactModel, omega3: float | None) -> dict[str, Any]:
     """``{"model", "vertical_spin"[, "eigenvalues"]}`` of ``body`` under ``model``; raises the
     library's :class:`~rollingtop.StabilityError` where the model has no such answer."""
-    from rollingtop.dynamics.stability import vertical_spin_eigenvalues, vertical_spins
+    from rollingtop.stability import vertical_spin_eigenvalues, vertical_spins
 
     spins = vertical_spins(body, model)
     summary: dict[str, Any] = {"model": model.name,
@@ -69,7 +69,7 @@ def _every_model(body: SphericalTop, omega3: float | None) -> list[dict[str, Any
     (:func:`rollingtop.contact.models_for`); a model without an answer gives
     ``{"model", "refused": reason}``."""
     from rollingtop.contact import models_for
-    from rollingtop.dynamics.stability import StabilityError
+    from rollingtop.stability import StabilityError
 
     out = []
     for model in models_for(body):

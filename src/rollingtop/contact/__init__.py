@@ -13,10 +13,13 @@ reduction) and its compiled functions, all with the same signatures:
 - ``direction_rate(p, y, variant)`` and ``sync_direction(y, variant)`` (optional, for models with
   variants that carry a constraint direction in ``psi_nu``).
 
+The variant argument is the kernel's index among the model's kernels (0 its own); a model with
+variants receives it at run time, one without receives the constant 0.
+
 **Adding a model** is one module here plus one line in :data:`MODULES`, then
-``python -m rollingtop.contact._codegen`` rewrites the compiled dispatch
-(:mod:`rollingtop.contact._dispatch`, generated; a test fails while it is stale). The shared
-model battery (``tests/contact/test_models.py``) then runs for it.
+``python -m rollingtop._compiled._codegen`` writes the model's compiled package
+(:mod:`rollingtop._compiled`, generated; a test fails while it is stale). The shared model
+battery (``tests/contact/test_models.py``) then runs for it.
 """
 
 from __future__ import annotations
@@ -50,8 +53,11 @@ DEFAULT_MODEL: str = MODULES[0].MODEL.name
 def _kernels() -> tuple[Kernel, ...]:
     """Model by model in registry order, each model's own kernel then its variants: a model
     added at the end of :data:`MODULES` leaves every existing code as it was."""
-    pairs = [(m.MODEL.name, v) for m in MODULES for v in (None, *m.MODEL.variants)]
-    return tuple(Kernel(name, v, code) for code, (name, v) in enumerate(pairs))
+    pairs = [(m.MODEL, v) for m in MODULES for v in (None, *m.MODEL.variants)]
+    return tuple(
+        Kernel(model.name, v, code, v is not None or model.carries_direction)
+        for code, (model, v) in enumerate(pairs)
+    )
 
 
 #: Every compiled kernel, indexed by its code.

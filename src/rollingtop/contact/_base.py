@@ -48,21 +48,18 @@ class Kernel:
         (the meridian model's ``"south"`` and ``"north"`` pole cases: the direction's azimuth is
         the state's ``psi_nu``, see :mod:`rollingtop.contact.meridian`).
     code : int
-        Selector of this kernel in the compiled dispatch (:mod:`rollingtop.contact._dispatch`),
-        assigned by the registry (:mod:`rollingtop.contact`).
+        The kernel code, assigned by the registry (:mod:`rollingtop.contact`); the model's
+        compiled package (:mod:`rollingtop._compiled`) selects the variant by it.
+    carries_direction : bool
+        Whether the state's ``psi_nu`` is a carried constraint direction: a variant, or the
+        own kernel of a model that always carries it (:attr:`ContactModel.carries_direction`);
+        set by the registry.
     """
 
     model: str
     variant: str | None
     code: int
-
-    @property
-    def carries_direction(self) -> bool:
-        """Whether the state's ``psi_nu`` is a carried constraint direction: a variant, or the
-        own kernel of a model that always carries it (:attr:`ContactModel.carries_direction`)."""
-        from rollingtop.contact import get_model
-
-        return self.variant is not None or get_model(self.model).carries_direction
+    carries_direction: bool = False
 
 
 @dataclass(frozen=True)
@@ -124,7 +121,7 @@ class ContactModel:
         ``vertical_spin(body, pole) -> omega3``: closed form of the critical spin rate of the
         vertical spin on the pole ``pole`` (+1: ``gamma3 = 1``, the south pole on the plane; -1:
         north) for a dynamically symmetric body, above which it is linearly stable; 0 when every
-        spin rate is (:mod:`rollingtop.dynamics.stability`). ``None``: no closed form.
+        spin rate is (:mod:`rollingtop.stability`). ``None``: no closed form.
     vertical_eigenvalues : callable or None
         ``vertical_eigenvalues(body, omega3, pole) -> complex ndarray``: the eigenvalues of the
         linearisation at the vertical spin, for a model whose equations are singular at the
@@ -135,7 +132,7 @@ class ContactModel:
         model, singular at the vertical, with :attr:`has_reduction`): the eigenvalues are those
         of the reduced motion at the pole of the pole level
         (:func:`rollingtop.reduction.level.pole_eigenvalues`), which
-        :mod:`rollingtop.dynamics.stability` computes. A declaration only: the contact package
+        :mod:`rollingtop.stability` computes. A declaration only: the contact package
         never imports the reduction.
     carries_direction : bool
         Whether the model's own kernel carries its constraint direction in the state's
@@ -262,7 +259,7 @@ class ContactModel:
         """Whether the body can spin about a vertical symmetry axis (a pole on the plane,
         ``w = (0, 0, w3)``): no constraint of :attr:`spin_directions` has a vertical
         component at ``gamma = e3``. Rubber rolling forbids that spin, ``(w, gamma) = w3 = 0``
-        there, so its vertical spins (:mod:`rollingtop.dynamics.stability`) do not exist."""
+        there, so its vertical spins (:mod:`rollingtop.stability`) do not exist."""
         if self.spin_directions is None:
             return True
         e3 = np.array([0.0, 0.0, 1.0])

@@ -116,7 +116,7 @@ def _spin_rate(
     td3: float,
 ) -> Float3:  # fmt: skip
     """``w'`` under the rows ``(vp, gamma) = 0`` and ``(vp, t) = 0`` with ``t' = td``: the
-    2x2 multiplier system of :mod:`rollingtop.dynamics._kernel`, written out for the pole rate
+    2x2 multiplier system of :mod:`rollingtop._compiled._kernel`, written out for the pole rate
     (which needs ``w'`` at two trial rates, and is also used by :func:`rows`, where there is no
     workspace to run :func:`rollingtop.contact._closed.rhs_contact` in)."""
     w1, w2, w3 = y[3], y[4], y[5]
@@ -282,7 +282,7 @@ def _symbolic_velocity(gamma: Any, tau: Any, wxr: Any, free: Any) -> Any:
 
 def _vertical_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
     """No linearisation at the vertical: refused (ValueError, reported by
-    :mod:`rollingtop.dynamics.stability`)."""
+    :mod:`rollingtop.stability`)."""
     raise ValueError(
         "the parallel model's constraint direction tau = e3 x gamma / s is undefined at the "
         "vertical, and the state there does not determine the motion (the continuation through "

@@ -156,7 +156,7 @@ def _vertical_spin(body: SphericalTop, pole: int) -> float:
 
     ``I1 + m l^2`` is the moment of inertia about the contact point across the axis, and
     ``I3 + m R l`` the spin's gyroscopic moment once rolling couples the tilt rate to the
-    centre's velocity. Found by the linearisation (:mod:`rollingtop.dynamics.stability`) and
+    centre's velocity. Found by the linearisation (:mod:`rollingtop.stability`) and
     held to it in the tests to round-off on several bodies; it reduces to Routh's classical
     condition for an eccentric sphere.
     """

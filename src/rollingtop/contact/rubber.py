@@ -3,7 +3,7 @@
 The rough model's three rows ``(vp, e_k) = 0`` along the body axes, plus a fourth row on the
 angular velocity alone, ``J = (0, 0, 0, gamma)`` (``docs/model.md``, "Constraints"). Its reaction
 is a torque ``mu gamma`` about the normal (no force: its row of force directions is 0, so the
-contact force of :func:`rollingtop.dynamics._kernel.reaction` is the no-slip rows' alone). Its
+contact force of :func:`rollingtop._compiled._kernel.reaction` is the no-slip rows' alone). Its
 bias is ``(gamma', w) = (gamma x w, w) = 0``. Neither reaction does work (``vp = 0``,
 ``(w, gamma) = 0``): the energy is conserved; the torque changes the angular momentum about the
 normal, so the rough model's Jellett integral and the area and Lagrange integrals are lost

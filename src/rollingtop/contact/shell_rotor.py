@@ -224,7 +224,7 @@ def accelerations(
 def accel(p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace, variant: int) -> int:
     """The pair's accelerations (:func:`accelerations`), ``delta'`` included (the kernel writes
     the kinematics first, :func:`direction_rate` a placeholder). The reaction's rows for
-    :func:`rollingtop.dynamics._kernel.reaction`: the contact force along the body axes."""
+    :func:`rollingtop._compiled._kernel.reaction`: the contact force along the body axes."""
     vd1, vd2, vd3, wd1, wd2, wd3, dd, l1, l2, l3 = accelerations(p, y)
     dy[0], dy[1], dy[2], dy[3], dy[4], dy[5] = vd1, vd2, vd3, wd1, wd2, wd3
     dy[DELTA] = dd  # after the kinematics (rollingtop._compiled._template.dynamics.rhs)
@@ -322,7 +322,7 @@ def _velocity(
 
 
 def _vertical_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
-    """Not analysed: refused (ValueError, reported by :mod:`rollingtop.dynamics.stability`)."""
+    """Not analysed: refused (ValueError, reported by :mod:`rollingtop.stability`)."""
     raise ValueError(
         "the shell-rotor pair's vertical spin is not linearised: the generic linearisation "
         "sees the rotor's state only, and the shell's spin is a further variable; simulate it"

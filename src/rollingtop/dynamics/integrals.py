@@ -14,8 +14,8 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rollingtop._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 from rollingtop.body import SphericalTop
-from rollingtop.dynamics._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 
 __all__ = ["INTEGRALS", "F6_reduced", "evaluate"]
 
@@ -97,7 +97,7 @@ def reduced_components(Y: ArrayLike, pole: str | None = None) -> dict[str, Float
 
     Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``. The basis is the one of the
     constraint direction ``nu`` carried in the state (``psi_nu``, see
-    :mod:`rollingtop.dynamics._layout`): ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``,
+    :mod:`rollingtop._layout`): ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``,
     ``tau = nu x gamma``, ``n = e3 x tau`` and the signed ``s = (nu, e3)``. Away from a pole
     passage this is exactly the paper's ``tau = e3 x gamma / s``, ``n = -(gamma1, gamma2, 0) / s``
     with ``s = sqrt(1 - gamma3^2) > 0``; after a passage of the pole in a pole case ``s, tau, n``

@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rollingtop._layout import ALPHA, GAMMA, POSITION, V, W
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel
-from rollingtop.dynamics._layout import ALPHA, GAMMA, POSITION, V, W
 from rollingtop.dynamics.state import initial_state
 
 __all__ = ["InitialConditions"]

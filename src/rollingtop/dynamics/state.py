@@ -9,13 +9,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import compiling, for_code
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
+from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
 
 __all__ = ["initial_state", "constraint_residuals", "project_state", "UNIT_TOLERANCE"]
 

@@ -10,15 +10,15 @@ from typing import TypedDict
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import compiling, for_code, for_model
+from rollingtop._compiled._events import EVENTS
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import IntegrationError
 from rollingtop._jit import call
+from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import DEFAULT_MODEL, ContactModel, get_model, kernel_by_code
-from rollingtop.dynamics._events import EVENTS
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
-from rollingtop.integrate import _dop853 as dop
 
 __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
 
@@ -252,7 +252,7 @@ def integrate(
         Kernel code (:class:`rollingtop.contact.Kernel`): ``model.kernel(body, y0).code``, the
         model's own or the variant it picks for this state.
     params : ndarray, shape (9,)
-        ``SphericalTop.params`` (:data:`~rollingtop.dynamics._layout.N_PARAMS` entries).
+        ``SphericalTop.params`` (:data:`~rollingtop._layout.N_PARAMS` entries).
     y0 : ndarray, shape (18,)
         Constraint-consistent initial state (:func:`rollingtop.dynamics.state.initial_state`).
     t_eval : ndarray, shape (n,)

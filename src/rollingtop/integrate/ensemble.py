@@ -25,9 +25,9 @@ from numpy.typing import ArrayLike
 
 from rollingtop._compiled import compiling, for_model
 from rollingtop._jit import call
+from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray
 from rollingtop.contact import DEFAULT_MODEL, KERNELS, ContactModel, get_model
-from rollingtop.dynamics._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 
 __all__ = ["integrate_batch", "compile_ensemble"]
 

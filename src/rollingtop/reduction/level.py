@@ -365,7 +365,7 @@ def pole_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArr
     level ``(M3 = I3 omega3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north, the value
     of ``F6`` at the vertical spin); the other directions are integrals (0). The meridian model's
     vertical spin (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`,
-    :mod:`rollingtop.dynamics.stability`); ``body`` must be dynamically symmetric."""
+    :mod:`rollingtop.stability`); ``body`` must be dynamically symmetric."""
     M3 = body.I3 * omega3
     C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3
     level = LevelSet(body, M3, pole * M3, C2)

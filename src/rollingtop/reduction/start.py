@@ -15,8 +15,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rollingtop._layout import W
 from rollingtop.body import SphericalTop
-from rollingtop.dynamics._layout import W
 from rollingtop.reduction.level import LevelSet
 from rollingtop.reduction.orbits import orbits
 from rollingtop.reduction.variables import reduced_integrals, state_from_level

@@ -1,24 +1,24 @@
 """Compiled batches of one contact model: Poincare crossings of many trajectories, and the chaos
 indicators of many initial states, in parallel (numba ``prange``; one stepper with its own work
-arrays per trajectory). Their constants: :mod:`rollingtop.chaos._kernels`."""
+arrays per trajectory). Their constants: :mod:`rollingtop._compiled._section`."""
 
 from __future__ import annotations
 
 import numpy as np
 from numba import prange
 
+from rollingtop._compiled import _dop853 as dop
+from rollingtop._compiled._events import W_TAU
+from rollingtop._compiled._flags import STOP_POLL_STEPS, read_flag
+from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._section import POLISH_DT, POLISH_ITERATIONS
 from rollingtop._compiled._template.dynamics import project, rhs
 from rollingtop._compiled._template.events import event_value
 from rollingtop._compiled._template.stepper import run, start
 from rollingtop._compiled._template.tangent import run_indicators
 from rollingtop._jit import compiled, kernel
+from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray, IntArray, Workspace
-from rollingtop.chaos._kernels import POLISH_DT, POLISH_ITERATIONS
-from rollingtop.dynamics._events import W_TAU
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
-from rollingtop.integrate import _dop853 as dop
-from rollingtop.integrate._flags import STOP_POLL_STEPS, read_flag
 
 
 @kernel

@@ -1,5 +1,5 @@
 """Compiled event functions of one contact model: scalar functions of the state whose zeros the
-stepper locates (the codes: :mod:`rollingtop.dynamics._events`).
+stepper locates (the codes: :mod:`rollingtop._compiled._events`).
 
 ``W_TAU``: ``s * w_tau = (w, e3 x gamma) = gamma1 w2 - gamma2 w1``, zero exactly when
 ``w_tau = 0`` (for ``s > 0``): the turning points of ``gamma3`` (paper eq. 3.3,
@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import math
 
+from rollingtop._compiled._events import W_TAU
 from rollingtop._compiled._template import _dispatch
 from rollingtop._jit import kernel
 from rollingtop._types import FloatArray
-from rollingtop.dynamics._events import W_TAU
 
 
 @kernel

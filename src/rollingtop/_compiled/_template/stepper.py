@@ -5,12 +5,12 @@ The method is Dormand & Prince's explicit Runge-Kutta pair of order 8(5,3) with 
 continuous extension (Hairer, Norsett & Wanner, *Solving ODEs I*, Sec. II.10), with the step-size
 control of Hairer's ``dop853.f`` as also used by ``scipy.integrate.DOP853``: the error norm
 combines the 5th- and 3rd-order estimates, safety factor 0.9, step ratio in [0.2, 10]. Why a
-stepper of our own, its status codes and control arrays: :mod:`rollingtop.integrate._dop853`.
+stepper of our own, its status codes and control arrays: :mod:`rollingtop._compiled._dop853`.
 
 Everything here takes bare arrays and runs in numba's nopython mode; see
 :func:`rollingtop.integrate.driver.integrate` for the validated entry point. The stepping
 functions allocate nothing and are compiled without reference counting (``_nrt=False``); the
-stages come from generated code (:mod:`rollingtop.integrate._dop853_stages`), the dense output
+stages come from generated code (:mod:`rollingtop._compiled._dop853_stages`), the dense output
 and the roots located on it from :mod:`.dense`.
 """
 
@@ -20,13 +20,7 @@ import math
 
 import numpy as np
 
-from rollingtop._compiled._template.dense import event_root, normal_root, prepare_dense
-from rollingtop._compiled._template.dynamics import project, rhs, rhs_inline
-from rollingtop._compiled._template.events import event_value
-from rollingtop._jit import compiled, kernel
-from rollingtop._types import FloatArray, IntArray, Workspace
-from rollingtop.dynamics._kernel import reaction
-from rollingtop.integrate._dop853 import (
+from rollingtop._compiled._dop853 import (
     ATOL,
     BUDGET_EXHAUSTED,
     ERROR_EXPONENT,
@@ -55,8 +49,14 @@ from rollingtop.integrate._dop853 import (
     new_track,
     update_track,
 )
-from rollingtop.integrate._dop853_dense import dense_eval
-from rollingtop.integrate._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._dop853_dense import dense_eval
+from rollingtop._compiled._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._kernel import reaction
+from rollingtop._compiled._template.dense import event_root, normal_root, prepare_dense
+from rollingtop._compiled._template.dynamics import project, rhs, rhs_inline
+from rollingtop._compiled._template.events import event_value
+from rollingtop._jit import compiled, kernel
+from rollingtop._types import FloatArray, IntArray, Workspace
 
 
 @compiled()
@@ -185,7 +185,7 @@ def run(
     out : ndarray, shape (n_samples, 18)
         Samples, each projected onto the constraints.
     ev_spec : ndarray of int64, shape (2,)
-        Event function code (:mod:`rollingtop.dynamics._events`, 0 for none) and direction
+        Event function code (:mod:`rollingtop._compiled._events`, 0 for none) and direction
         (+1: rising zeros only, -1: falling, 0: both).
     ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 18)
         Times and projected states of the located events.

@@ -2,7 +2,7 @@
 chaos indicators.
 
 The augmented state, the finite-difference tangent dynamics, the projection and renormalisation
-are described in :mod:`rollingtop.chaos._tangent`, which holds the pieces that do not depend on
+are described in :mod:`rollingtop._compiled._tangent`, which holds the pieces that do not depend on
 the model; the functions here call the model's right-hand side and projection
 (:mod:`.dynamics`), so they are compiled per model. The validated entry point is
 :mod:`rollingtop.chaos.lyapunov`.
@@ -14,11 +14,10 @@ import math
 
 import numpy as np
 
-from rollingtop._compiled._template.dynamics import project, rhs
-from rollingtop._compiled._template.stepper import initial_step
-from rollingtop._jit import compiled, kernel
-from rollingtop._types import FloatArray, IntArray, Workspace
-from rollingtop.chaos._tangent import (
+from rollingtop._compiled import _dop853 as dop
+from rollingtop._compiled._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._tangent import (
     ATOL,
     DELTA,
     H_ABS,
@@ -40,10 +39,11 @@ from rollingtop.chaos._tangent import (
     renormalise,
     signed_tilt,
 )
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
-from rollingtop.integrate import _dop853 as dop
-from rollingtop.integrate._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._template.dynamics import project, rhs
+from rollingtop._compiled._template.stepper import initial_step
+from rollingtop._jit import compiled, kernel
+from rollingtop._layout import N_STATE
+from rollingtop._types import FloatArray, IntArray, Workspace
 
 
 @kernel
@@ -148,7 +148,7 @@ def advance(
     -------
     status : int
         ``dop.FINISHED``, ``dop.STEP_TOO_SMALL``, ``dop.NOT_FINITE``,
-        ``dop.TOO_MANY_REJECTED`` (the codes of :mod:`rollingtop.integrate._dop853`) or
+        ``dop.TOO_MANY_REJECTED`` (the codes of :mod:`rollingtop._compiled._dop853`) or
         :data:`REACHED_VERTICAL`.
     """
     t = ctrl[T]

@@ -20,10 +20,10 @@ tests hold each closed form to it).
 Kinematics: ``alpha' = alpha x w``, ``beta' = beta x w``, ``gamma' = gamma x w``,
 ``X' = (v, alpha)``, ``Y' = (v, beta)`` (eq. 2.1).
 
-All functions take bare arrays (state ``y`` of :mod:`rollingtop.dynamics._layout`, parameters
+All functions take bare arrays (state ``y`` of :mod:`rollingtop._layout`, parameters
 ``p`` of :attr:`rollingtop.SphericalTop.params`, the kernel code ``code`` of one of this model's
 kernels) and preallocated work arrays ``ws = (J, bias, dirs, A, lam)`` of shapes
-``(4, 6), (4,), (4, 3), (4, 4), (4,)`` (:func:`rollingtop.dynamics._kernel.new_workspace`).
+``(4, 6), (4,), (4, 3), (4, 4), (4,)`` (:func:`rollingtop._compiled._kernel.new_workspace`).
 The kernels called at every stage allocate nothing and are compiled without reference counting
 (:func:`rollingtop._jit.kernel`).
 """
@@ -32,14 +32,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from rollingtop._compiled._kernel import new_workspace, reaction, solve_spd
 from rollingtop._compiled.meridian import _dispatch
 from rollingtop._compiled.meridian._dispatch import CLOSED_ACCEL, CLOSED_PROJECTION
 from rollingtop._compiled.meridian._dispatch import rows as constraint_rows
 from rollingtop._jit import compiled, inline, kernel
+from rollingtop._layout import MAX_ROWS, N_STATE
 from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact._rows import free_forces
-from rollingtop.dynamics._kernel import new_workspace, reaction, solve_spd
-from rollingtop.dynamics._layout import MAX_ROWS, N_STATE
 
 __all__ = [
     "constraint_rows",
@@ -71,7 +71,7 @@ def rhs_inline(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Work
     """Right-hand side ``dy = y'`` of the constrained equations; returns the number of rows.
 
     After the call ``ws[4][:nrows]`` holds the multipliers ``lambda`` and ``ws[2]`` the force
-    directions, from which :func:`rollingtop.dynamics._kernel.reaction` forms the contact force.
+    directions, from which :func:`rollingtop._compiled._kernel.reaction` forms the contact force.
     The model's closed form where it has one, else the general path (:func:`rhs_rows`). Inlined
     into the stepper's stage loop (:func:`.stepper.run`): a call there passes the workspace's five
     arrays field by field, twelve times a step, which cost 15 % of the paper's model's time

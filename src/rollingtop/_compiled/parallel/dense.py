@@ -2,9 +2,9 @@
 """Dense output of a DOP853 step and the zeros located on it, for one contact model.
 
 The 7th-order continuous extension of the step (Hairer, Norsett & Wanner, *Solving ODEs I*,
-Sec. II.10; the coefficients of :mod:`rollingtop.integrate._dop853_tableau`), built from the
+Sec. II.10; the coefficients of :mod:`rollingtop._compiled._dop853_tableau`), built from the
 step's own stages (:func:`prepare_dense`; evaluated by the shared
-:func:`rollingtop.integrate._dop853_dense.dense_eval`), and the bisections on it that locate the
+:func:`rollingtop._compiled._dop853_dense.dense_eval`), and the bisections on it that locate the
 first loss of contact and the zeros of an event function. Called by the stepper
 (:func:`.stepper.run`); compiled without reference counting like it
 (:func:`rollingtop._jit.kernel`).
@@ -12,14 +12,14 @@ first loss of contact and the zeros of an event function. Called by the stepper
 
 from __future__ import annotations
 
+from rollingtop._compiled._dop853_dense import dense_eval
+from rollingtop._compiled._dop853_stages import stage
+from rollingtop._compiled._dop853_tableau import D
+from rollingtop._compiled._kernel import reaction
 from rollingtop._compiled.parallel.dynamics import project, rhs
 from rollingtop._compiled.parallel.events import event_value
 from rollingtop._jit import kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.dynamics._kernel import reaction
-from rollingtop.integrate._dop853_dense import dense_eval
-from rollingtop.integrate._dop853_stages import stage
-from rollingtop.integrate._dop853_tableau import D
 
 
 @kernel

@@ -11,13 +11,13 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
+from rollingtop._compiled import _dop853 as dop
+from rollingtop._compiled._flags import STOP_POLL_STEPS, read_flag
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop._compiled.rough.stepper import run, start
 from rollingtop._jit import compiled
+from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray, IntArray
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
-from rollingtop.integrate import _dop853 as dop
-from rollingtop.integrate._flags import STOP_POLL_STEPS, read_flag
 
 
 @compiled()

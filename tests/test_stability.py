@@ -1,4 +1,4 @@
-"""Vertical spins (rollingtop.dynamics.stability) and the steady rollings' linearisation.
+"""Vertical spins (rollingtop.stability) and the steady rollings' linearisation.
 
 Each threshold is checked three ways: the linearisation's eigenvalues (bisection) against the
 model's closed form, the meridian closed form against ``U''`` at the pole of the pole level
@@ -16,16 +16,16 @@ import pytest
 
 from rollingtop import InitialConditions, IntegrationOptions, SphericalTop, simulate
 from rollingtop.contact import MODELS as REGISTRY
-from rollingtop.dynamics.stability import (
+from rollingtop.reduction import LevelSet, steady_motions
+from rollingtop.stability import (
     StabilityError,
     vertical_spin_eigenvalues,
     vertical_spins,
 )
-from rollingtop.reduction import LevelSet, steady_motions
 
-from ..conftest import EXAMPLES, PAPER_BODY, scenario_text
-from ..reduction import plain
-from ..test_cli import run_cli
+from .conftest import EXAMPLES, PAPER_BODY, scenario_text
+from .reduction import plain
+from .test_cli import run_cli
 
 #: Every registered model: a new one is held to its vertical-spin threshold by simulation.
 MODELS = tuple(REGISTRY)
@@ -255,7 +255,7 @@ def test_cli_stability_errors(capsys, tmp_path):
 
 def test_readme_states_the_computed_thresholds():
     """The README's sentence on vertical spins quotes these rates (rounded to 2 decimals)."""
-    from ..conftest import ROOT
+    from .conftest import ROOT
 
     text = " ".join((ROOT / "README.md").read_text().split())
     rates = {

@@ -34,14 +34,14 @@ from typing import Any
 import numpy as np
 
 from rollingtop._compiled import for_code
+from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import RollingTopError
 from rollingtop._jit import call
+from rollingtop._layout import N_STATE
 from rollingtop._numdiff import central_jacobian
 from rollingtop._types import ComplexArray, FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics._kernel import new_workspace
-from rollingtop.dynamics._layout import N_STATE
 from rollingtop.reduction.level import pole_eigenvalues
 
 __all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]

@@ -1,11 +1,11 @@
 """Compiled tangent (variational) dynamics integrated with the motion, for chaos indicators.
 
 The augmented state is ``z = (y, delta, W, Z, t)``, shape :data:`N_AUG`: the state ``y``
-(:mod:`rollingtop.dynamics._layout`), a tangent vector ``delta`` of the same layout, the MEGNO
+(:mod:`rollingtop._layout`), a tangent vector ``delta`` of the same layout, the MEGNO
 integrals ``W = int_0^t (delta' . delta / |delta|^2) s ds`` and ``Z = int_0^t Y(s) ds`` with
 ``Y = 2 W / t`` (Cincotta & Simo 2000, *Astron. Astrophys. Suppl.* 147, 205), and the time ``t``
 itself (``t' = 1``: the Runge-Kutta stages see their own times). It is advanced by the same
-DOP853 pair as the motion (:mod:`rollingtop.integrate._dop853`: the generated stages and error
+DOP853 pair as the motion (:mod:`rollingtop._compiled._dop853`: the generated stages and error
 estimates; the error norm covers ``y`` and ``delta``).
 
 **Tangent dynamics.** ``delta' = Df(y) delta`` is the directional derivative of the compiled
@@ -44,10 +44,10 @@ import math
 
 import numpy as np
 
+from rollingtop._compiled import _dop853 as dop
 from rollingtop._jit import kernel
+from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray
-from rollingtop.dynamics._layout import N_STATE
-from rollingtop.integrate import _dop853 as dop
 
 #: Components of the augmented state: y, delta, W, Z, t.
 N_AUG = 2 * N_STATE + 3

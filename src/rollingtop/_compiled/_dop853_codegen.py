@@ -1,4 +1,4 @@
-"""Writes :mod:`rollingtop.integrate._dop853_stages` from the tableau (run as a module).
+"""Writes :mod:`rollingtop._compiled._dop853_stages` from the tableau (run as a module).
 
 Why generated code: a stage ``y + h sum_j A[s, j] K[j]`` written as a loop over ``j`` with a
 run-time stage index ``s`` costs about four times the arithmetic (short loops of run-time
@@ -7,7 +7,7 @@ one loop over the components whose body LLVM vectorises, with zero coefficients 
 source is committed so that numba's compile cache can find it; a test checks that it matches
 this generator and the tableau.
 
-    python -m rollingtop.integrate._dop853_codegen
+    python -m rollingtop._compiled._dop853_codegen
 """
 
 from __future__ import annotations
@@ -15,15 +15,15 @@ from __future__ import annotations
 from collections.abc import Iterable
 from pathlib import Path
 
-from rollingtop.integrate._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A
+from rollingtop._compiled._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A
 
 TARGET = Path(__file__).with_name("_dop853_stages.py")
 LINE_LENGTH = 100
 
 HEADER = '''"""DOP853 stages and error estimates, coefficients spelled out (GENERATED: do not edit).
 
-Written by ``python -m rollingtop.integrate._dop853_codegen`` from
-:mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
+Written by ``python -m rollingtop._compiled._dop853_codegen`` from
+:mod:`rollingtop._compiled._dop853_tableau`; see that generator for why.
 """
 
 from __future__ import annotations

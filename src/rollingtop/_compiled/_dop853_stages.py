@@ -1,7 +1,7 @@
 """DOP853 stages and error estimates, coefficients spelled out (GENERATED: do not edit).
 
-Written by ``python -m rollingtop.integrate._dop853_codegen`` from
-:mod:`rollingtop.integrate._dop853_tableau`; see that generator for why.
+Written by ``python -m rollingtop._compiled._dop853_codegen`` from
+:mod:`rollingtop._compiled._dop853_tableau`; see that generator for why.
 """
 
 from __future__ import annotations

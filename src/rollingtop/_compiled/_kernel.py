@@ -14,8 +14,8 @@ import math
 import numpy as np
 
 from rollingtop._jit import compiled, inline, kernel
+from rollingtop._layout import MAX_ROWS
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.dynamics._layout import MAX_ROWS
 
 __all__ = ["new_workspace", "reaction", "solve_spd"]
 
