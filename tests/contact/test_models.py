@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from rollingtop import InitialStateError, SphericalTop, initial_state
-from rollingtop._compiled import _codegen, for_model
+from rollingtop._compiled import _codegen, for_code, for_model, packages_of
 from rollingtop.contact import KERNELS, MODELS, kernel_by_code
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
@@ -95,8 +95,11 @@ def test_the_compiled_dispatch_agrees_with_the_model(kernel):
     assert model.kernels[0].code == model.code and kernel in model.kernels
     y = _state(SYMMETRIC, model)
     J, bias, dirs, _, _ = _kernel.new_workspace()
-    dispatch = for_model(model)._dispatch
-    assert kernel.code in dispatch.CODES and dispatch.CODES == tuple(k.code for k in model.kernels)
+    dispatch = for_code(kernel.code)._dispatch
+    assert kernel.code in dispatch.CODES
+    codes = [c for package in packages_of(model) for c in package._dispatch.CODES]
+    assert codes == [k.code for k in model.kernels]  # the model's own package first
+    assert for_model(model)._dispatch.CODES == (model.code,)
     assert dispatch.rows(kernel.code, SYMMETRIC.params, y, J, bias, dirs) == len(model.constraints)
     assert dispatch.carries_direction(kernel.code) == kernel.carries_direction
 

@@ -1,11 +1,17 @@
-"""The compiled core, one package per contact model, compiled on first use.
+"""The compiled core, one package per contact model (and one for a model's variants),
+compiled on first use.
 
 Each registered contact model has a package here (``rollingtop._compiled.meridian``, ...),
 generated from :mod:`rollingtop._compiled._template` by :mod:`rollingtop._compiled._codegen`:
 its right-hand side, projection, diagnostics, DOP853 stepper, ensemble kernel, tangent dynamics
-and chaos batches, compiled against that model's functions alone. :func:`for_model` imports a
-model's package (cheap: nothing is compiled at import); numba compiles each function on its
-first call, or loads it from its on-disk cache, so a command pays only for the models it runs.
+and chaos batches, compiled against that model's functions alone. A model with variants (the
+meridian model's pole cases, :class:`rollingtop.contact.Kernel`) has a second package for them,
+``meridian_variants``: its own kernel's code is then straight-line, with no branch on the
+variant, and a run that needs no variant compiles none (:data:`GROUPS`). :func:`for_code`
+imports the package of a kernel code (cheap: nothing is compiled at import); numba compiles each
+function on its first call, or loads it from its on-disk cache, so a command pays only for the
+kernels it runs. The modules beside the packages (``_kernel``, ``_dop853``, ...) are the
+compiled pieces every model shares, compiled once.
 
 :func:`compiling` wraps a first call that may compile: when numba actually compiles (a cache
 miss, not a load), the notifier (:func:`set_notifier`; the command line's prints one line on
@@ -20,24 +26,75 @@ import importlib
 import logging
 import time
 from collections.abc import Iterator
+from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, Protocol
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from rollingtop import _jit
-from rollingtop.contact import MODULES, ContactModel, get_model, kernel_by_code
+from rollingtop._types import IntArray
+from rollingtop.contact import MODULES, ContactModel, get_model, kernels_of
 
 __all__ = [
     "ESTIMATES",
-    "PACKAGES",
+    "GROUPS",
+    "Group",
     "Notifier",
+    "by_package",
     "compiling",
     "for_code",
     "for_model",
+    "packages_of",
     "set_notifier",
 ]
 
-#: Compiled package of each model, by model name (the model module's own name).
-PACKAGES: dict[str, str] = {m.MODEL.name: m.__name__.rsplit(".", 1)[1] for m in MODULES}
+
+@dataclass(frozen=True)
+class Group:
+    """Kernels compiled together, in one generated package.
+
+    Attributes
+    ----------
+    package : str
+        The package's name under :mod:`rollingtop._compiled` (``meridian``,
+        ``meridian_variants``).
+    model : str
+        The contact model.
+    codes : tuple of int
+        The kernel codes it runs.
+    base : int
+        The code of the model's own kernel (a kernel's variant index is its code minus it).
+    label : str
+        What it is, in words (``the meridian model's``).
+    """
+
+    package: str
+    model: str
+    codes: tuple[int, ...]
+    base: int
+    label: str
+
+
+def _groups() -> tuple[Group, ...]:
+    out = []
+    for module in MODULES:
+        name = module.__name__.rsplit(".", 1)[1]
+        kernels = kernels_of(module.MODEL)
+        base = kernels[0].code
+        model = module.MODEL.name
+        out.append(Group(name, model, (base,), base, f"the {model} model's"))
+        if len(kernels) > 1:
+            variants = ", ".join(str(k.variant) for k in kernels[1:])
+            out.append(Group(f"{name}_variants", model, tuple(k.code for k in kernels[1:]), base,
+                             f"the {model} model's variants ({variants})"))  # fmt: skip
+    return tuple(out)
+
+
+#: The compiled packages: each model's own kernel, then its variants if it has any.
+GROUPS: tuple[Group, ...] = _groups()
+_GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 
 #: Rough seconds a cold compilation of one model's group of kernels takes on a 2-core machine,
 #: rounded from the paper's model's (``benchmarks/run_benchmarks.py --only cold_start`` measures
@@ -50,21 +107,45 @@ ESTIMATES: dict[str, float] = {
 }
 
 
-def for_model(model: str | ContactModel) -> ModuleType:
-    """The compiled package of ``model`` (a name or a :class:`~rollingtop.contact.ContactModel`).
-
-    Its modules ``dynamics``, ``events``, ``dense``, ``stepper``, ``ensemble``, ``tangent`` and
-    ``chaos`` hold the functions of :mod:`rollingtop._compiled._template`, compiled for this
-    model's kernel codes only (a code of another model is not checked: the caller picks the
-    package by the code, :func:`for_code`).
-    """
-    name = get_model(model).name
-    return importlib.import_module(f"{__name__}.{PACKAGES[name]}")
+def group_of(code: int) -> Group:
+    """The group of kernel code ``code`` (``ValueError`` for an unknown code)."""
+    try:
+        return _GROUP_OF_CODE[int(code)]
+    except KeyError:
+        known = len(_GROUP_OF_CODE)
+        raise ValueError(f"unknown kernel code {code} (known: 0 to {known - 1})") from None
 
 
 def for_code(code: int) -> ModuleType:
-    """The compiled package of the model whose kernel has code ``code``."""
-    return for_model(kernel_by_code(int(code)).model)
+    """The compiled package that runs kernel code ``code``.
+
+    Its modules ``dynamics``, ``events``, ``dense``, ``stepper``, ``ensemble``, ``tangent`` and
+    ``chaos`` hold the functions of :mod:`rollingtop._compiled._template`, compiled for its
+    group's codes only (:data:`GROUPS`; a code of another group is not checked by the compiled
+    functions: pick the package by the code).
+    """
+    return importlib.import_module(f"{__name__}.{group_of(code).package}")
+
+
+def for_model(model: str | ContactModel) -> ModuleType:
+    """The compiled package of ``model``'s own kernel (a name or a
+    :class:`~rollingtop.contact.ContactModel`)."""
+    return for_code(get_model(model).code)
+
+
+def packages_of(model: str | ContactModel) -> list[ModuleType]:
+    """Every compiled package of ``model``: its own kernel's, then its variants'."""
+    name = get_model(model).name
+    return [importlib.import_module(f"{__name__}.{g.package}") for g in GROUPS if g.model == name]
+
+
+def by_package(codes: ArrayLike) -> list[tuple[ModuleType, IntArray]]:
+    """The indices of ``codes`` (kernel codes, shape (N,)) run by each compiled package, in the
+    order the packages first appear (``ValueError`` for an unknown code)."""
+    codes = np.asarray(codes, dtype=np.int64)
+    names = np.array([group_of(int(c)).package for c in codes])
+    return [(importlib.import_module(f"{__name__}.{n}"), np.flatnonzero(names == n))
+            for n in dict.fromkeys(names)]  # fmt: skip
 
 
 class Notifier(Protocol):
@@ -110,24 +191,31 @@ def set_notifier(notifier: Notifier | None) -> Notifier:
     return previous
 
 
-def message(model: str, what: str) -> str:
-    """The announcement of a cold compilation of ``model``'s group ``what``."""
+def message(label: str, what: str) -> str:
+    """The announcement of a cold compilation of ``what`` kernels of ``label`` (a
+    :attr:`Group.label`, or a model's name)."""
+    if not label.startswith("the "):
+        label = f"the {label} model's"
     estimate = ESTIMATES.get(what)
     about = f", about {estimate:.0f} s" if estimate else ""
     if _jit.caching_disabled():
-        return (f"compiling the {model} model's {what} kernels (numba cannot save its cache: "
-                f"every run compiles them{about})")  # fmt: skip
-    return f"compiling the {model} model's {what} kernels (first run only{about})"
+        return (f"compiling {label} {what} kernels (numba cannot save its cache: every run "
+                f"compiles them{about})")  # fmt: skip
+    return f"compiling {label} {what} kernels (first run only{about})"
 
 
 @contextlib.contextmanager
-def compiling(model: str | ContactModel, what: str) -> Iterator[None]:
-    """Announce (through the notifier, once per process for a model and group) that numba
-    compiles ``model``'s kernels of group ``what`` while the block runs, if it does: a block
-    whose functions all load from numba's cache says nothing."""
+def compiling(target: str | ContactModel | ModuleType, what: str) -> Iterator[None]:
+    """Announce (through the notifier, once per process for a package and group) that numba
+    compiles ``what`` kernels of ``target`` -- a model (its own kernel's package) or a compiled
+    package (:func:`for_code`) -- while the block runs, if it does: a block whose functions all
+    load from numba's cache says nothing."""
     from numba.core import event
 
-    name = get_model(model).name
+    if isinstance(target, ModuleType):
+        name = group_of(target._dispatch.CODES[0]).label
+    else:
+        name = group_of(get_model(target).code).label
     started: list[float] = []
 
     class Listener(event.Listener):

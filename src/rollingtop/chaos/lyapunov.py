@@ -188,16 +188,16 @@ def _compile_indicators(
     """Compile (or load) the tangent kernel apart from a timed run, by a run of one tiny step;
     seconds spent, 0 after the first call in a process (its types never change)."""
     kernels = for_code(code)
-    if kernels.MODEL in _indicators_compiled:
+    if kernels.PACKAGE in _indicators_compiled:
         return 0.0
     import time
 
     start = time.perf_counter()
-    with compiling(kernels.MODEL, "chaos"):
+    with compiling(kernels, "chaos"):
         call(kernels.tangent.run_indicators, code, p, y0.copy(), d0.copy(), np.array([1e-9]),
              float(rtol), atol, 1, np.full((1, 3), np.nan), np.full((1, N_STATE), np.nan),
              np.zeros(4), stop)  # fmt: skip
-    _indicators_compiled.add(kernels.MODEL)
+    _indicators_compiled.add(kernels.PACKAGE)
     return time.perf_counter() - start
 
 

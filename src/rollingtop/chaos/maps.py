@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rollingtop._compiled import compiling, for_code
+from rollingtop._compiled import by_package, compiling
 from rollingtop._compiled._tangent import STATUS_NAMES
 from rollingtop._errors import ScenarioError
 from rollingtop._layout import N_STATE
@@ -35,11 +35,14 @@ def _chunk(
     """One batch (a Dask task, or the whole map in-process): outputs ``(out, stats)``."""
     out = np.full((len(states), t.size, 3), np.nan)
     stats = np.zeros((len(states), 4))
-    kernels = for_code(int(codes[0]))  # one model: its own compiled batch
-    with compiling(kernels.MODEL, "chaos"):
-        run_threaded(kernels.chaos.indicator_batch, (codes, params, states, tangents, t, rtol,
-                                                     atol, max_steps, out, stats, s_stop),
-                     threads)  # fmt: skip
+    # package by package: the model's own kernel, its variants (pole levels) in theirs
+    for kernels, idx in by_package(codes):
+        part = out[idx], stats[idx]  # copies the kernel fills
+        with compiling(kernels, "chaos"):
+            run_threaded(kernels.chaos.indicator_batch, (codes[idx], params, states[idx],
+                                                         tangents[idx], t, rtol, atol, max_steps,
+                                                         *part, s_stop), threads)  # fmt: skip
+        out[idx], stats[idx] = part
     return out, stats
 
 

@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rollingtop._compiled import compiling, for_model
+from rollingtop._compiled import by_package, compiling
 from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
 from rollingtop._compiled._section import SECTION_STATS
 from rollingtop._errors import InitialStateError, ScenarioError
@@ -174,16 +174,24 @@ def poincare_section(
     ev_t = np.full((K, crossings), np.nan)
     ev_y = np.full((K, crossings, N_STATE), np.nan)
     stats = np.zeros((K, len(SECTION_STATS)))
-    poll = None
-    if progress is not None:
-        # the kernel writes each crossing's time into ev_t (NaN until then) as it finds it
-        def poll() -> None:
-            progress(int(np.count_nonzero(~np.isnan(ev_t))), ev_t.size)
+    wall, used = 0.0, 1
+    # package by package: the model's own kernel, its variants (pole levels) in theirs
+    for kernels, idx in by_package(codes):
+        part = ev_t[idx], ev_y[idx], stats[idx]  # copies the kernel fills
+        done = int(np.count_nonzero(~np.isnan(ev_t)))
+        poll = None
+        if progress is not None:
+            # the kernel writes each crossing's time into ev_t (NaN until then) as it finds it
+            def poll(found: FloatArray = part[0], before: int = done) -> None:
+                progress(before + int(np.count_nonzero(~np.isnan(found))), ev_t.size)
 
-    with compiling(model, "chaos"):
-        wall, used = run_threaded(for_model(model).chaos.section_batch,
-                                  (codes, body.params, Y0, float(t_max), float(rtol), float(atol),
-                                   int(max_steps), ev_t, ev_y, stats), threads, poll)  # fmt: skip
+        with compiling(kernels, "chaos"):
+            seconds, used = run_threaded(kernels.chaos.section_batch,
+                                         (codes[idx], body.params, Y0[idx], float(t_max),
+                                          float(rtol), float(atol), int(max_steps), *part),
+                                         threads, poll)  # fmt: skip
+        wall += seconds
+        ev_t[idx], ev_y[idx], stats[idx] = part
     found = stats[:, 1].astype(int)
     if progress is not None:
         progress(int(found.sum()), ev_t.size)

@@ -5,20 +5,21 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from types import ModuleType
 from typing import TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
-from rollingtop._compiled import compiling, for_code, for_model
+from rollingtop._compiled import compiling, for_code, for_model, packages_of
 from rollingtop._compiled._events import EVENTS
 from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import IntegrationError
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
-from rollingtop.contact import DEFAULT_MODEL, ContactModel, get_model, kernel_by_code
+from rollingtop.contact import DEFAULT_MODEL, ContactModel
 
 __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
 
@@ -27,7 +28,7 @@ __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
 #: :mod:`rollingtop._signals`). Resuming does not change the step sequence.
 PROGRESS_CHUNK = 20_000
 
-#: Seconds each model's integrator took to compile or load in this process.
+#: Seconds each compiled package's integrator took to compile or load in this process.
 _compiled: dict[str, float] = {}
 
 
@@ -105,31 +106,37 @@ def _workspace(n_samples: int) -> _Work:
     )
 
 
-def compile_kernels(model: str | ContactModel = DEFAULT_MODEL) -> float:
+def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:
     """Compile (or load from numba's cache) ``model``'s integrator kernels -- its projection,
     stepper (with and without events) and diagnostics -- and no other model's; returns the
     seconds spent.
 
-    Only the first call for a model in a process does work; later calls return 0. When numba
-    compiles (its cache holds nothing for them yet) the compiled core's notifier says so first
+    ``variants``: also the kernels of the model's variants (the meridian model's pole cases,
+    a package of their own: :data:`rollingtop._compiled.GROUPS`). Only the first call for a
+    package in a process does work; later calls return 0. When numba compiles (its cache holds
+    nothing for them yet) the compiled core's notifier says so first
     (:func:`rollingtop._compiled.compiling`).
     """
-    name = get_model(model).name
-    if name in _compiled:
+    packages = packages_of(model) if variants else [for_model(model)]
+    return sum(_compile_package(kernels) for kernels in packages)
+
+
+def _compile_package(kernels: ModuleType) -> float:
+    """:func:`compile_kernels` for one compiled package."""
+    if kernels.PACKAGE in _compiled:
         return 0.0
     start = time.perf_counter()
     p = np.array(WARMUP_PARAMS)
     y = np.zeros(N_STATE)
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
-    kernels = for_model(name)
     code = kernels._dispatch.CODES[0]
-    with compiling(name, "integrator"):
+    with compiling(kernels, "integrator"):
         call(kernels.dynamics.project, code, p, y, call(new_workspace))
         _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
         call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
-    _compiled[name] = time.perf_counter() - start
-    return _compiled[name]
+    _compiled[kernels.PACKAGE] = time.perf_counter() - start
+    return _compiled[kernels.PACKAGE]
 
 
 def _run_compiled(
@@ -300,7 +307,7 @@ def integrate(
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
     event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
-    compile_s = compile_kernels(kernel_by_code(int(code)).model)
+    compile_s = _compile_package(for_code(int(code)))
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
         params,

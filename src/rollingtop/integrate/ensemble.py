@@ -18,16 +18,17 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from types import ModuleType
 
 import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rollingtop._compiled import compiling, for_model
+from rollingtop._compiled import by_package, compiling, for_model, packages_of
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray
-from rollingtop.contact import DEFAULT_MODEL, KERNELS, ContactModel, get_model
+from rollingtop.contact import DEFAULT_MODEL, ContactModel
 
 __all__ = ["integrate_batch", "compile_ensemble"]
 
@@ -43,23 +44,27 @@ WAIT_SLICE = 0.05
 _compiled: set[str] = set()
 
 
-def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL) -> float:
+def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:
     """Compile (or load from the cache) ``model``'s parallel kernel, and no other model's;
-    seconds spent (0 when done in this process)."""
-    name = get_model(model).name
-    if name in _compiled:
+    seconds spent (0 when done in this process). ``variants``: also its variants' (their own
+    compiled package, :data:`rollingtop._compiled.GROUPS`)."""
+    packages = packages_of(model) if variants else [for_model(model)]
+    return sum(_compile_package(kernels) for kernels in packages)
+
+
+def _compile_package(kernels: ModuleType) -> float:
+    if kernels.PACKAGE in _compiled:
         return 0.0
     start = time.perf_counter()
     y = np.zeros((1, N_STATE))
     y[0, 6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
     P = np.array([WARMUP_PARAMS])
-    kernels = for_model(name)
     codes = np.full(1, kernels._dispatch.CODES[0], dtype=np.int64)
-    with compiling(name, "ensemble"):
+    with compiling(kernels, "ensemble"):
         call(kernels.ensemble.batch, codes, P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
              np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
              np.zeros(1, dtype=np.int64))  # fmt: skip
-    _compiled.add(name)
+    _compiled.add(kernels.PACKAGE)
     return time.perf_counter() - start
 
 
@@ -120,10 +125,7 @@ def integrate_batch(
     if params.shape != (N, N_PARAMS) or codes.shape != (N,):  # the kernels do not check reads
         raise ValueError(f"params must have shape ({N}, {N_PARAMS}) and codes ({N},), got "
                          f"{params.shape} and {codes.shape}")  # fmt: skip
-    if N and (codes.min() < 0 or codes.max() >= len(KERNELS)):
-        bad = codes[(codes < 0) | (codes >= len(KERNELS))][0]
-        raise ValueError(f"unknown kernel code {bad} (known: 0 to {len(KERNELS) - 1})")
-    models = np.array([k.model for k in KERNELS])[codes]
+    groups = by_package(codes)  # ValueError for an unknown code
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     out = np.full((N, t_eval.size, N_STATE), np.nan)
     final = np.full((N, N_STATE), np.nan)
@@ -139,16 +141,16 @@ def integrate_batch(
     done = [0]  # trajectories finished, written by the worker
     failure: list[BaseException] = []
 
-    # model by model, each by its own compiled kernel (compiled here, in the calling thread)
-    groups = [(for_model(name).ensemble.batch, np.flatnonzero(models == name))
-              for name in dict.fromkeys(models)]  # fmt: skip
-    for name in dict.fromkeys(models):
-        compile_ensemble(name)
+    # package by package (a model, or its variants), each by its own compiled kernel (compiled
+    # here, in the calling thread)
+    for kernels, _ in groups:
+        _compile_package(kernels)
 
     def work() -> None:
         try:
             numba.set_num_threads(n_threads)
-            for batch, idx in groups:
+            for kernels, idx in groups:
+                batch = kernels.ensemble.batch
                 contiguous = idx.size == idx[-1] - idx[0] + 1
                 for lo in range(0, idx.size, step):
                     hi = min(idx.size, lo + step)

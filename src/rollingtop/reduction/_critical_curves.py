@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 from rollingtop.body import SphericalTop
+from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.steady import critical_points
 

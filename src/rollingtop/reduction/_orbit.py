@@ -9,9 +9,8 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from scipy.optimize import brentq
-
 from rollingtop._json import json_ready
+from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet
 
 __all__ = ["SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE", "Orbit", "turning_point"]

@@ -26,8 +26,8 @@ from typing import NamedTuple, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
+from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet
 
 __all__ = [

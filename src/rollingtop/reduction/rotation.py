@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction._quadrature import period
+from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits
 from rollingtop.reduction.steady import SteadyMotion, critical_points

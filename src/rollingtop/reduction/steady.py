@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 from rollingtop._json import json_ready
 from rollingtop._numdiff import DIFF_STEP, central_jacobian
+from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet, near_north
 
 __all__ = ["SteadyMotion", "steady_motions", "critical_points"]

@@ -19,7 +19,6 @@ from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import F6_reduced
@@ -94,6 +93,8 @@ def integrate_reduced(
     A 4-dimensional smooth system away from the poles: SciPy's integrator is adequate here.
     """
     t_eval = np.asarray(t_eval, dtype=float)
+    from scipy.integrate import solve_ivp  # on first use: a third of a second to import
+
     sol = solve_ivp(
         lambda t, x: reduced_rhs(body, M3, x),
         (t_eval[0], t_eval[-1]),
