@@ -419,11 +419,9 @@ def readme_block(res) -> str:
     numpy_rhs = w1r["solve_ivp_numpy_rhs"]["speedup_of_rollingtop"]  # paired with rollingtop
     rows.append(f"| SciPy solve_ivp DOP853, NumPy rhs (one run) | {numpy_rhs:.0f} |")
     w2r = res["W2"]
-    rows += ["", f"First run, empty numba cache: `rollingtop simulate examples/paper.toml --t-end 1` "
-             f"{cs['simulate_empty_cache_s']:.0f} s, the README's portrait "
-             f"{cs['portrait_empty_cache_s']:.0f} s, `rollingtop warmup` "
-             f"{cs['warmup_empty_cache_s']:.0f} s; a short `simulate` with a warm cache: "
-             f"{cs['simulate_warm_cache_s']:.2f} s (whole processes). Ensemble of {w2r['n']} trajectories on 2 threads: "
+    rows += ["", "Start-up on the same machine: what a newcomer waits for, each a whole process "
+             "(the first command of the quick start is the first row):", "", start_table(cs),
+             "", f"Ensemble of {w2r['n']} trajectories on 2 threads: "
              f"{100 * w2r['parallel_efficiency_2']:.0f} % parallel efficiency."]  # fmt: skip
     if res.get("atlas"):
         a = res["atlas"]

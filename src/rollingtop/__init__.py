@@ -5,7 +5,7 @@ Dynamically Symmetric Spherical Top with One Nonholonomic Constraint", Russian J
 Nonlinear Dynamics 19(1), 2023, 3-17 (doi:10.20537/nd221205), and its neighbour contact models.
 """
 
-from importlib import metadata as _metadata
+from typing import Any
 
 from rollingtop._errors import (
     BodyError,
@@ -27,10 +27,20 @@ from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario,
 from rollingtop.simulate import simulate, simulate_models
 from rollingtop.trajectory import Trajectory
 
-try:  # the one version string: pyproject.toml, read from the installed metadata
-    __version__ = _metadata.version("rollingtop")
-except _metadata.PackageNotFoundError:  # a source tree on sys.path, not installed
-    __version__ = "0+unknown"
+
+def __getattr__(name: str) -> Any:
+    """``__version__``, read on first use (PEP 562): importlib.metadata costs every command a
+    twentieth of a second at start-up, and few ask for the version."""
+    if name == "__version__":
+        from importlib import metadata
+
+        try:  # the one version string: pyproject.toml, read from the installed metadata
+            version = metadata.version("rollingtop")
+        except metadata.PackageNotFoundError:  # a source tree on sys.path, not installed
+            version = "0+unknown"
+        globals()["__version__"] = version
+        return version
+    raise AttributeError(f"module 'rollingtop' has no attribute {name!r}")
 
 __all__ = [
     "BodyError",

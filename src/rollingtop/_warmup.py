@@ -17,8 +17,6 @@ after editing a kernel. Nothing here deletes files.
 
 from __future__ import annotations
 
-import concurrent.futures
-import multiprocessing
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -84,6 +82,9 @@ def warmup(
             if progress is not None:
                 progress(name, out[name])
         return out
+    import concurrent.futures  # here: every command imports this module, few run warmup
+    import multiprocessing
+
     # spawn: a fresh interpreter per worker (no fork of a process holding numba's threads)
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:

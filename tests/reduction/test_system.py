@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from rollingtop import load_scenario, simulate
+from rollingtop.contact import get_model
 from rollingtop.reduction import (
     LevelSet,
     integrate_reduced,
@@ -91,3 +92,34 @@ def test_level_set_is_the_reduced_system_on_a_level(paper_body):
         g3_dot, _, _, w_tau_dot_33 = reduced_rhs(paper_body, level.M3, x)
         assert -np.sin(theta) * theta_dot == pytest.approx(g3_dot, rel=1e-13)
         assert w_tau_dot == pytest.approx(w_tau_dot_33, rel=1e-12)
+
+
+#: The closed-form normal force against the compiled right-hand side and reaction: round-off.
+NORMAL_FORCE_RTOL = 1e-11
+
+
+def test_normal_force_in_closed_form_matches_the_compiled_reaction(rng):
+    """N = m (g + a3 gamma3'') from the reduced field, at random points of two level sets'
+    phase planes, against the meridian model's compiled right-hand side and reaction at the
+    full states there (rollingtop.reduction.states_on_level, itself held to state_from_level)."""
+    from rollingtop.reduction import state_from_level, states_on_level
+    from rollingtop.reduction.system import normal_force
+
+    from ..kernels import contact_forces
+
+    body = load_scenario(EXAMPLES / "fig5.toml").body
+    for M3, C1, C2 in [(1.0, 0.5, -2.0), (-0.7, 0.2, 1.3)]:
+        level = LevelSet(body, M3, C1, C2)
+        g3 = rng.uniform(-0.95, 0.95, size=40)
+        w = rng.normal(size=40)
+        Y = states_on_level(level, g3, w)
+        for k in range(3):  # the vectorised states are state_from_level's
+            h = float(level.energy(np.arccos(g3[k]), w[k]))
+            y = state_from_level(level, h, float(g3[k]), branch=1 if w[k] >= 0 else -1)
+            np.testing.assert_allclose(Y[k], y, rtol=0, atol=1e-13)
+        theta = np.arccos(g3)
+        N = normal_force(body, M3, np.array([g3, level.v_tau(theta), level.w_n(theta), w]))
+        out = np.empty((len(Y), 2))
+        contact_forces(get_model("meridian").code, body.params, np.ascontiguousarray(Y), out)
+        np.testing.assert_allclose(N, out[:, 0], rtol=NORMAL_FORCE_RTOL, atol=1e-13)
+        assert np.ptp(N) > 0.1  # the points differ: the comparison is not of constants

@@ -17,6 +17,9 @@ from rollingtop.symbolic.claims import Claim, s_sym
 from rollingtop.symbolic.equations import SYMBOLS as S
 
 SLIP_ATOL = 1e-8  # slip along nu over t = 100 at rtol 1e-11, through the pole passages
+#: Outside the case the slip varies by far more than the tolerance that holds it in the case
+#: (over t = 20: 1.07 with a3 = 0.1; 3.7e-3 with I3 = 0.3 != I1, where it drifts slowly).
+SLIP_VARIES = 1e4 * SLIP_ATOL
 LIMIT_RATIO = (30.0, 300.0)  # h0 drift(I3 = 1e-4) / drift(I3 = 1e-6): linear in I3 is 100
 STEADY_ATOL = 1e-6  # |w_tau|, |w_n| once the balanced case has settled (t = 600)
 
@@ -106,7 +109,7 @@ def test_compiled_kernel_conserves_the_slip_in_the_case_only():
     assert get_model("parallel").integrals_for(body) == ("energy", "jellett", "slip_nu")
     for a3, I3 in [(0.1, 0.4), (0.0, 0.3)]:
         body, _, slip = _slip_run(a3, I3, np.random.default_rng(3), t_end=20.0)
-        assert np.ptp(slip) > 1e-2
+        assert np.ptp(slip) > SLIP_VARIES
         assert "slip_nu" not in get_model("parallel").integrals_for(body)
 
 

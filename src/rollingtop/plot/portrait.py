@@ -21,19 +21,16 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from rollingtop._compiled import compiling, for_model
-from rollingtop._jit import call
-from rollingtop.contact.meridian import MODEL
 from rollingtop.reduction import (
     LevelSet,
     LevelSetError,
     Orbit,
     orbits,
-    state_from_level,
     steady_motions,
 )
 from rollingtop.reduction._quadrature import energy_gap
 from rollingtop.reduction.level import Real
+from rollingtop.reduction.system import normal_force
 
 __all__ = ["phase_portrait", "default_h_levels"]
 
@@ -85,18 +82,12 @@ def _orbit_curve(
 
 
 def _normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatArray:
-    """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape (nw, ng)."""
-    states = []
-    for gg in g3:
-        theta = math.acos(gg)
-        for ww in w:
-            h = float(level.energy(theta, ww))
-            states.append(state_from_level(level, h, gg, branch=1 if ww >= 0 else -1))
-    Y = np.ascontiguousarray(states)
-    out = np.empty((len(Y), 2))
-    with compiling(MODEL, "dynamics"):
-        call(for_model(MODEL).dynamics.contact_forces, MODEL.code, level.body.params, Y, out)
-    return out[:, 0].reshape(len(g3), len(w)).T
+    """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape (nw, ng), in
+    closed form (:func:`rollingtop.reduction.system.normal_force`; no compiled code)."""
+    G, Wt = np.meshgrid(g3, w, indexing="ij")
+    theta = np.arccos(G)
+    x = np.array([G, level.v_tau(theta), level.w_n(theta), Wt])
+    return normal_force(level.body, level.M3, x).T
 
 
 def phase_portrait(

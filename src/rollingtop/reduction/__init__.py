@@ -19,6 +19,7 @@ from rollingtop.reduction.variables import (
     reduce_state,
     reduced_integrals,
     state_from_level,
+    states_on_level,
 )
 
 __all__ = [
@@ -35,5 +36,6 @@ __all__ = [
     "reduced_integrals_of",
     "reduced_rhs",
     "state_from_level",
+    "states_on_level",
     "steady_motions",
 ]

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import F6_reduced
 
-__all__ = ["reduced_rhs", "reduced_integrals_of", "integrate_reduced"]
+__all__ = ["normal_force", "reduced_rhs", "reduced_integrals_of", "integrate_reduced"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 
@@ -63,6 +63,24 @@ def reduced_rhs(body: SphericalTop, M3: float, x: FloatArray) -> FloatArray:
             / rho,
         ]
     )
+
+
+def normal_force(body: SphericalTop, M3: float, x: ArrayLike) -> FloatArray:
+    """The normal force of the plane at reduced states ``x`` (shape ``(4, ...)``, as in
+    :func:`reduced_rhs`), in closed form: shape ``(...)``.
+
+    The centre of mass is at height ``R + a3 gamma3`` and only gravity and the normal force act
+    on it vertically (the meridian constraint's force is along ``nu``, horizontal), so
+    ``N = m (g + a3 gamma3'')`` with ``gamma3'' = s w_tau' - gamma3 w_tau^2`` (``gamma3' = s
+    w_tau``, ``s' = -gamma3 w_tau``) and ``w_tau'`` from eq. (3.3). A phase portrait shades
+    where ``N < 0`` with it, in NumPy: the reduction's pictures need no compiled code.
+    """
+    x = np.asarray(x, dtype=float)
+    g3, w_tau = x[0], x[3]
+    s = np.sqrt(1 - g3 * g3)
+    dw_tau = reduced_rhs(body, M3, x)[3]
+    N: FloatArray = body.m * (body.g + body.a3 * (s * dw_tau - g3 * w_tau * w_tau))
+    return N
 
 
 def reduced_integrals_of(body: SphericalTop, M3: float, x: ArrayLike) -> dict[str, FloatArray]:
