@@ -42,6 +42,7 @@ def __getattr__(name: str) -> Any:
         return version
     raise AttributeError(f"module 'rollingtop' has no attribute {name!r}")
 
+
 __all__ = [
     "BodyError",
     "ContactLostWarning",
