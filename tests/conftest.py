@@ -86,3 +86,14 @@ def admissible_omega(model, gamma, omega):
             d = np.asarray(d, dtype=float)
             omega -= (omega @ d) / (d @ d) * d
     return omega
+
+
+@pytest.fixture(scope="session", autouse=True)
+def kernels_compiled_in_parallel():
+    """Compile (or load) every model's integrator and ensemble kernels before the first test,
+    one process per model on every core (:func:`rollingtop.warmup`): on a cold numba cache the
+    tests would otherwise compile them one after the other, on one core. A warm cache loads in
+    seconds."""
+    from rollingtop import warmup
+
+    warmup()

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop._compiled import by_package
 from rollingtop._compiled._dop853 import STATUS_NAMES
 from rollingtop._errors import ScenarioError
 from rollingtop._layout import N_STATE, state_components
@@ -27,8 +28,7 @@ from rollingtop.ensemble_tables import (
     read_table,
     states_from_table,
 )
-from rollingtop.integrate.driver import compile_kernels
-from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
+from rollingtop.integrate.ensemble import compile_ensemble_code, integrate_batch
 from rollingtop.scenario import (
     Scenario,
     short_repr,
@@ -270,7 +270,8 @@ def simulate_ensemble(
         out, final, stats, wall, used = _on_client(client, codes, params, states, t_eval, rtol,
                                                    atol, max_steps, progress)  # fmt: skip
     else:
-        compile_s = compile_kernels() + compile_ensemble()
+        # the packages of the codes it runs (the model's own, its variants'), and no other
+        compile_s = sum(compile_ensemble_code(c) for c in _first_codes(codes))
         out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol,
                                                   atol=atol, max_steps=max_steps, threads=threads,
                                                   progress=progress)  # fmt: skip
@@ -286,6 +287,11 @@ def simulate_ensemble(
     )  # fmt: skip
 
 
+def _first_codes(codes: IntArray) -> list[int]:
+    """One kernel code of each compiled package among ``codes``."""
+    return [int(codes[idx[0]]) for _, idx in by_package(codes)]
+
+
 #: Chunks of states per worker thread when :func:`simulate_ensemble` runs on a Dask client.
 CLIENT_CHUNKS = 4
 
@@ -295,8 +301,6 @@ def _integrate_chunk(
     atol: float, max_steps: int,
 ) -> tuple[FloatArray, FloatArray, FloatArray, float]:  # fmt: skip
     """One Dask task of :func:`simulate_ensemble`: a chunk on one thread of a worker."""
-    compile_kernels()
-    compile_ensemble()
     return integrate_batch(codes, params, states, t_eval, rtol=rtol, atol=atol,
                            max_steps=max_steps, threads=1)  # fmt: skip
 

@@ -218,18 +218,22 @@ def compiling(target: str | ContactModel | ModuleType, what: str) -> Iterator[No
         name = group_of(get_model(target).code).label
     started: list[float] = []
 
+    # numba's listeners are global and its events come from any thread's compile; a listener
+    # must never raise into a compile (numba would fail it): a notifier's error is logged
     class Listener(event.Listener):
         def on_start(self, ev: Any) -> None:
             if not started:
                 started.append(time.perf_counter())
                 first = (name, what) not in _announced
                 _announced.add((name, what))
-                _notifier.start(message(name, what), first)
+                _tell(_notifier.start, message(name, what), first)
 
         def on_end(self, ev: Any) -> None:
+            if not started:  # the end of a compile that began before the block
+                return
             dispatcher = ev.data.get("dispatcher")
             func = getattr(getattr(dispatcher, "py_func", None), "__qualname__", "?")
-            _notifier.step(func, time.perf_counter() - started[0])
+            _tell(_notifier.step, func, time.perf_counter() - started[0])
 
     listener = Listener()
     event.register("numba:compile", listener)  # type: ignore[no-untyped-call]
@@ -238,4 +242,12 @@ def compiling(target: str | ContactModel | ModuleType, what: str) -> Iterator[No
     finally:
         event.unregister("numba:compile", listener)  # type: ignore[no-untyped-call]
         if started:
-            _notifier.done(time.perf_counter() - started[0])
+            _tell(_notifier.done, time.perf_counter() - started[0])
+
+
+def _tell(method: Any, *args: Any) -> None:
+    """Call a notifier's ``method``, logging (not raising) what it raises."""
+    try:
+        method(*args)
+    except Exception:  # a notifier must not fail a compilation
+        logging.getLogger("rollingtop").exception("the compile notifier failed")

@@ -31,8 +31,12 @@ __all__ = ["run_scenario", "simulate"]
 def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
     """:func:`rollingtop.simulate` of ``sc`` with a progress bar on a terminal and its warnings
     as lines (``options``: those of :func:`rollingtop.simulate`)."""
+    from rollingtop.contact import get_model
+    from rollingtop.integrate.driver import compile_code
     from rollingtop.simulate import simulate as run
 
+    if sc.y0 is not None:  # compile before the bar: the compile notice has the terminal to itself
+        compile_code(get_model(options.get("model") or sc.model).kernel_code(sc.body, sc.y0))
     with _output.timing(sc.integration.t_end) as progress:
         return _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
 

@@ -241,8 +241,9 @@ def initial_state(
     if model.slot_value is not None:
         y[17] = model.slot_value(body, y)
     code = _start_code(body, model, y)
-    with compiling(model, "integrator"):  # the projection: a model's first compiled kernel
-        call(for_code(code).dynamics.project, code, body.params, y, call(new_workspace))
+    kernels = for_code(code)  # the model's own package, or its variants'
+    with compiling(kernels, "integrator"):  # the projection: a model's first compiled kernel
+        call(kernels.dynamics.project, code, body.params, y, call(new_workspace))
     return y
 
 
@@ -291,7 +292,7 @@ def project_state(
     ws = call(new_workspace)
     code = _start_code(body, model, y)
     dynamics = for_code(code).dynamics
-    with compiling(model, "integrator"):
+    with compiling(for_code(code), "integrator"):
         if model.slot_value is not None:  # the rows' projection of (v, w), then the model's slot
             call(dynamics.project_velocity_rows, code, body.params, y, ws)
             y[17] = model.slot_value(body, y)

@@ -21,7 +21,7 @@ from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
 
-__all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_kernels"]
+__all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "compile_kernels"]
 
 #: Accepted steps per call of the compiled loop (tens of milliseconds). Between calls the driver
 #: is back in Python: the progress callback runs and so do signal handlers (Ctrl-C, SIGTERM;
@@ -119,6 +119,12 @@ def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool
     """
     packages = packages_of(model) if variants else [for_model(model)]
     return sum(_compile_package(kernels) for kernels in packages)
+
+
+def compile_code(code: int) -> float:
+    """:func:`compile_kernels` for the package that runs kernel code ``code`` (a model's own, or
+    its variants'); seconds spent."""
+    return _compile_package(for_code(int(code)))
 
 
 def _compile_package(kernels: ModuleType) -> float:

@@ -24,13 +24,13 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rollingtop._compiled import by_package, compiling, for_model, packages_of
+from rollingtop._compiled import by_package, compiling, for_code, for_model, packages_of
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
 
-__all__ = ["integrate_batch", "compile_ensemble"]
+__all__ = ["integrate_batch", "compile_ensemble", "compile_ensemble_code"]
 
 #: Trajectories per call of the parallel kernel when a progress callback is given.
 BATCH = 256
@@ -42,6 +42,7 @@ CHUNK = 4
 WAIT_SLICE = 0.05
 
 _compiled: set[str] = set()
+_lock = threading.Lock()
 
 
 def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:
@@ -52,7 +53,18 @@ def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL, *, variants: boo
     return sum(_compile_package(kernels) for kernels in packages)
 
 
+def compile_ensemble_code(code: int) -> float:
+    """:func:`compile_ensemble` for the package that runs kernel code ``code``; seconds spent
+    (the integration's own compile: :func:`integrate_batch` does it, untimed, where needed)."""
+    return _compile_package(for_code(int(code)))
+
+
 def _compile_package(kernels: ModuleType) -> float:
+    with _lock:  # Dask runs tasks in threads: one compilation of a package per process
+        return _compile_package_locked(kernels)
+
+
+def _compile_package_locked(kernels: ModuleType) -> float:
     if kernels.PACKAGE in _compiled:
         return 0.0
     start = time.perf_counter()
