@@ -79,6 +79,8 @@ def _dispatch_source(group: Group) -> str:
 
     closed_accel = hasattr(module, "accel")
     closed_projection = hasattr(module, "project_velocity")
+    # the variants (rare: the pole levels) keep the shorter compile
+    inline_rhs = getattr(module, "INLINE_RHS", False) and group.codes == (group.base,)
     rows = call("rows", "p, y, J, bias, dirs", True, "")
     accel = call("accel", "p, y, dy, ws", True, "return -1")
     project = call("project_velocity", "p, y", False, "return None")
@@ -105,6 +107,7 @@ from rollingtop.contact import {imports}
 
 CLOSED_ACCEL = {closed_accel}
 CLOSED_PROJECTION = {closed_projection}
+INLINE_RHS = {inline_rhs}
 CODES: tuple[int, ...] = {tuple(group.codes)!r}
 
 

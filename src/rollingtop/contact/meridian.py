@@ -64,6 +64,10 @@ from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import contact_row, normal_row, sync_azimuth
 from rollingtop.contact._rows import sync_direction as sync_geometric
 
+#: The stepper's stage loop inlines this model's right-hand side (short closed form: fast, and
+#: cheap to compile twice; :data:`rollingtop._compiled._template._dispatch.INLINE_RHS`).
+INLINE_RHS = True
+
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
 

@@ -14,6 +14,10 @@ from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import normal_row
 
+#: The stepper's stage loop inlines this model's right-hand side (short closed form: fast, and
+#: cheap to compile twice; :data:`rollingtop._compiled._template._dispatch.INLINE_RHS`).
+INLINE_RHS = True
+
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
 

@@ -52,6 +52,7 @@ from rollingtop._compiled._dop853 import (
 from rollingtop._compiled._dop853_dense import dense_eval
 from rollingtop._compiled._dop853_stages import scaled_errors, stage
 from rollingtop._compiled._kernel import reaction
+from rollingtop._compiled._template._dispatch import INLINE_RHS
 from rollingtop._compiled._template.dense import event_root, normal_root, prepare_dense
 from rollingtop._compiled._template.dynamics import project, rhs, rhs_inline
 from rollingtop._compiled._template.events import event_value
@@ -234,7 +235,10 @@ def run(
                 K[0, i] = f[i]
             for s in range(1, 12):
                 stage(K, s, y, h, ytmp)
-                rhs_inline(code, p, ytmp, K[s], ws)
+                if INLINE_RHS:
+                    rhs_inline(code, p, ytmp, K[s], ws)
+                else:
+                    rhs(code, p, ytmp, K[s], ws)
             # new point: the 13th stage's combination is the solution's (first same as last)
             stage(K, int(np.int64(12)), y, h, ynew)  # not a literal: one compile of stage
             nc_new = rhs(code, p, ynew, K[12], ws)

@@ -17,6 +17,7 @@ from rollingtop.contact import meridian
 
 CLOSED_ACCEL = True
 CLOSED_PROJECTION = True
+INLINE_RHS = False
 CODES: tuple[int, ...] = (1, 2)
 
 

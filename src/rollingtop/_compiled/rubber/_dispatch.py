@@ -16,6 +16,7 @@ from rollingtop.contact import _rows, rubber
 
 CLOSED_ACCEL = True
 CLOSED_PROJECTION = True
+INLINE_RHS = True
 CODES: tuple[int, ...] = (6,)
 
 

@@ -16,6 +16,7 @@ from rollingtop.contact import shell_rotor
 
 CLOSED_ACCEL = True
 CLOSED_PROJECTION = True
+INLINE_RHS = False
 CODES: tuple[int, ...] = (7,)
 
 

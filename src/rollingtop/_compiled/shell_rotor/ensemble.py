@@ -47,8 +47,10 @@ def integrate_one(
     ws = new_workspace()
     y = y0.copy()
     f = np.zeros(n)
-    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, 0, out, ytmp, ynew, ws)
     ev_spec = np.zeros(2, dtype=np.int64)
+    # the event code read from the array: a literal 0 would compile a second start
+    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew,
+                                ws)  # fmt: skip
     ev_t = np.zeros(1)
     ev_y = np.zeros((1, n))
     while True:

@@ -79,8 +79,10 @@ def section_one(
     f = np.zeros(n)
     t_eval = np.array([0.0, t_max])
     out = np.zeros((2, n))
-    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, W_TAU, out, ytmp, ynew, ws)
     ev_spec = np.array([W_TAU, 1], dtype=np.int64)
+    # the event code read from the array: the literal W_TAU would compile a second start
+    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew,
+                                ws)  # fmt: skip
     wanted = ev_t.shape[0]
     while True:
         if read_flag(stop) != 0:
