@@ -65,8 +65,18 @@ def test_warmup_refuses_an_unknown_model(capsys):
     assert "glue" in err and err.count("\n") == 1
 
 
-def test_warmup_runs_models_in_separate_processes():
-    """Two models, two processes (spawned: each compiles or loads from the suite's cache)."""
-    seconds = _warmup.warmup(["smooth", "rough"], processes=2)
-    assert list(seconds) == ["smooth", "rough"]
+def test_warmup_runs_packages_in_separate_processes():
+    """Two models, three packages (the meridian model's variants have their own), two processes
+    (spawned: each compiles or loads from the suite's cache); each model's seconds are its
+    packages' sums, reported once per model."""
+    told = []
+    seconds = _warmup.warmup(["meridian", "rough"], processes=2,
+                             progress=lambda name, s: told.append(name))  # fmt: skip
+    assert list(seconds) == ["meridian", "rough"] and sorted(told) == ["meridian", "rough"]
     assert all(set(g) == set(_warmup.GROUPS) for g in seconds.values())
+    packages = [g.package for g in _warmup._packages(["meridian", "rough"])]
+    assert packages == [
+        "meridian",
+        "rough",
+        "meridian_variants",
+    ]  # own kernels first, longest first

@@ -21,6 +21,8 @@ import os
 import time
 from collections.abc import Callable, Sequence
 
+from rollingtop._compiled import GROUPS as PACKAGES
+from rollingtop._compiled import Group
 from rollingtop.contact import MODELS, get_model
 
 #: The groups compiled for each model by :func:`warmup`, in order, with what each serves.
@@ -30,22 +32,49 @@ GROUPS = {
 }
 
 
-def warm_model(model: str) -> dict[str, float]:
-    """Compile (or load) ``model``'s groups of kernels (:data:`GROUPS`), its variants' too, in
-    this process; the seconds each took."""
-    from rollingtop.integrate.driver import compile_kernels
-    from rollingtop.integrate.ensemble import compile_ensemble
+def warm_package(package: str) -> dict[str, float]:
+    """Compile (or load) the groups of kernels (:data:`GROUPS`) of one compiled package
+    (:data:`rollingtop._compiled.GROUPS`: a model's own kernel, or its variants) in this
+    process; the seconds each took."""
+    from rollingtop.integrate.driver import compile_code
+    from rollingtop.integrate.ensemble import compile_ensemble_code
 
-    steps: dict[str, Callable[..., float]] = {
-        "integrator": compile_kernels,
-        "ensemble": compile_ensemble,
+    code = next(g.codes[0] for g in PACKAGES if g.package == package)
+    steps: dict[str, Callable[[int], float]] = {
+        "integrator": compile_code,
+        "ensemble": compile_ensemble_code,
     }
     seconds = {}
     for name, step in steps.items():
         start = time.perf_counter()
-        step(model, variants=True)
+        step(code)
         seconds[name] = time.perf_counter() - start
     return seconds
+
+
+def warm_model(model: str) -> dict[str, float]:
+    """Compile (or load) ``model``'s groups of kernels (:data:`GROUPS`), its variants' too, in
+    this process; the seconds each took."""
+    name = get_model(model).name
+    return _sum([warm_package(g.package) for g in _packages([name])])
+
+
+def _sum(parts: list[dict[str, float]]) -> dict[str, float]:
+    return {group: sum(p[group] for p in parts) for group in GROUPS}
+
+
+def _packages(models: Sequence[str]) -> list[Group]:
+    """The compiled packages of ``models``, the longest to compile first: the models' own
+    (their modules' sizes as the measure: the closed forms make most of the code), then the
+    variants'. Handed out in this order, the last process to finish is not left with a long
+    one alone."""
+    import os.path
+
+    from rollingtop.contact import MODULES
+
+    size = {m.MODEL.name: os.path.getsize(str(m.__file__)) for m in MODULES}
+    chosen = [g for g in PACKAGES if g.model in models]
+    return sorted(chosen, key=lambda g: (g.codes != (g.base,), -size[g.model]))
 
 
 def warmup(
@@ -55,7 +84,8 @@ def warmup(
     progress: Callable[[str, dict[str, float]], None] | None = None,
 ) -> dict[str, dict[str, float]]:
     """Compile (or load from numba's cache) the kernels of ``models`` (default: every registered
-    model), one process per model, ``processes`` at a time (default: the CPUs).
+    model), one process per compiled package (a model's own kernel, its variants'), ``processes``
+    at a time (default: the CPUs), the longest first.
 
     Parameters
     ----------
@@ -74,24 +104,29 @@ def warmup(
     """
     names = [get_model(m).name for m in (MODELS if models is None else models)]
     names = list(dict.fromkeys(names))
-    workers = max(1, min(len(names), processes or os.cpu_count() or 1))
+    packages = _packages(names)
+    workers = max(1, min(len(packages), processes or os.cpu_count() or 1))
+    parts: dict[str, list[dict[str, float]]] = {name: [] for name in names}
     out: dict[str, dict[str, float]] = {}
-    if workers == 1:
-        for name in names:
-            out[name] = warm_model(name)
+
+    def finished(group: Group, seconds: dict[str, float]) -> None:
+        parts[group.model].append(seconds)
+        if len(parts[group.model]) == sum(g.model == group.model for g in packages):
+            out[group.model] = _sum(parts[group.model])
             if progress is not None:
-                progress(name, out[name])
-        return out
+                progress(group.model, out[group.model])
+
+    if workers == 1:
+        for group in packages:
+            finished(group, warm_package(group.package))
+        return {name: out[name] for name in names}
     import concurrent.futures  # here: every command imports this module, few run warmup
     import multiprocessing
 
     # spawn: a fresh interpreter per worker (no fork of a process holding numba's threads)
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
-        futures = {pool.submit(warm_model, name): name for name in names}
+        futures = {pool.submit(warm_package, g.package): g for g in packages}
         for future in concurrent.futures.as_completed(futures):
-            name = futures[future]
-            out[name] = future.result()
-            if progress is not None:
-                progress(name, out[name])
+            finished(futures[future], future.result())
     return {name: out[name] for name in names}

@@ -25,12 +25,13 @@ __all__ = ["warmup"]
     "--processes",
     type=click.IntRange(min=1),
     default=None,
-    help="Models compiled at once, one process each (default: the CPUs).",
+    help="Packages compiled at once, one process each (default: the CPUs).",
 )
 @json_option
 def warmup(models: tuple[str, ...], processes: int | None, as_json: bool) -> None:
     """Compile each model's kernels once (or load them from numba's cache), one process per
-    model in parallel, so that later commands start fast; print each model's seconds."""
+    compiled package (a model's own kernel, its variants') in parallel, so that later commands
+    start fast; print each model's seconds."""
     from rollingtop._warmup import warmup as compile_models
 
     names = list(models) or list(MODELS)
@@ -38,7 +39,7 @@ def warmup(models: tuple[str, ...], processes: int | None, as_json: bool) -> Non
     click.echo(
         f"rollingtop: compiling the kernels of {len(names)} model"
         f"{'s' if len(names) != 1 else ''} ({', '.join(names)}), "
-        "one process each; cached kernels load in a second",
+        "one process per compiled package, the longest first; cached kernels load in a second",
         err=True,
     )
 
