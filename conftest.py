@@ -42,3 +42,11 @@ if "NUMBA_CACHE_DIR" not in os.environ:
                 shutil.rmtree(old, ignore_errors=True)
     _here.mkdir(parents=True, exist_ok=True)
     os.environ["NUMBA_CACHE_DIR"] = str(_here)
+
+
+def pytest_report_header(config: object) -> str:
+    """Say where the compiled kernels are cached, and that a first run compiles them (the
+    suite's first fixture compiles every model's, one process per package, before any dot)."""
+    where = os.environ.get("NUMBA_CACHE_DIR")
+    return (f"numba cache: {where} (a first run compiles every model's kernels into it before "
+            "the first test, then the tests compile the rest)")  # fmt: skip

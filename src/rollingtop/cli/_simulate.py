@@ -7,6 +7,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 import click
+import numpy as np
 
 from rollingtop.cli import _output
 from rollingtop.cli._options import (
@@ -35,10 +36,18 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
     from rollingtop.integrate.driver import compile_code
     from rollingtop.simulate import simulate as run
 
-    if sc.y0 is not None:  # compile before the bar: the compile notice has the terminal to itself
-        compile_code(get_model(options.get("model") or sc.model).kernel_code(sc.body, sc.y0))
+    compiled = 0.0
+    if sc.y0 is not None and np.all(np.isfinite(sc.y0)):
+        # compile before the bar, so that the compile notice has the terminal to itself; a
+        # state the run then refuses (huge values) must not warn here first
+        with np.errstate(all="ignore"):
+            code = get_model(options.get("model") or sc.model).kernel_code(sc.body, sc.y0)
+        compiled = compile_code(code)
     with _output.timing(sc.integration.t_end) as progress:
-        return _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
+        traj = _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
+    # the compilation belongs to the run's statistics, wherever it happened
+    traj.stats["compile_time_s"] = float(traj.stats.get("compile_time_s", 0.0)) + compiled
+    return traj
 
 
 def _integrals_table(summary: dict[str, Any]) -> Table:
