@@ -263,7 +263,7 @@ def start_table(cs) -> str:
         f"{cs['simulate_empty_cache_s']:.1f} |",
         f"| then `rollingtop simulate examples/rough.toml --t-end 1` (compiles rough alone) | "
         f"paper's model's | {cs['rough_after_paper_s']:.1f} |",
-        f"| `rollingtop warmup` (every model, one process each) | empty | "
+        f"| `rollingtop warmup` (every model, one process per compiled package) | empty | "
         f"{cs['warmup_empty_cache_s']:.1f} |",
         f"| a short `simulate` (median of {cs['warm_runs']}) | warm | "
         f"{cs['simulate_warm_cache_s']:.2f} |",
