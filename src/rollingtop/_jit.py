@@ -15,22 +15,21 @@ the written expression and do not depend on reassociation).
 - :func:`compiled`: a driver that may allocate (reference counting on), with extra options.
 
 The decorators are typed (they return the function's own type), so that type checkers see the
-Python signature of each kernel.
+Python signature of each kernel. They defer numba itself: a decorated function is recorded,
+and the first call of any (or :func:`load_numba`, which :func:`rollingtop._compiled.for_code`
+calls) imports numba and makes them all dispatchers, in place (:class:`_Deferred`).
 """
 
 from __future__ import annotations
 
+import sys
+import threading
 import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from numba import njit as _numba_njit
-
 F = TypeVar("F", bound=Callable[..., Any])
-
-# numba's stubs do not know the private ``_nrt`` flag; the options are checked by numba itself
-njit: Any = _numba_njit
 
 #: Options shared by every compiled function of the package.
 BASE_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy", "fastmath": {"contract"}}
@@ -48,21 +47,87 @@ def _registered(dispatcher: Any) -> Any:
     return dispatcher
 
 
+class _Deferred:
+    """A function of the package not yet handed to numba.
+
+    Importing numba takes a sixth of a second, and numba's first use of its NumPy support more:
+    the commands that need no compiled code (a portrait, the reduction, ``--help``) should not
+    pay for it. So the decorators below only record their function while numba is not loaded;
+    the first call of any of them (or a look at a dispatcher's attributes) loads numba, makes
+    every recorded function a dispatcher, and puts the dispatchers where the deferred functions
+    were in the package's modules -- where numba, compiling a caller, looks its callees up.
+    """
+
+    __slots__ = ("dispatcher", "func", "options")
+
+    def __init__(self, func: Callable[..., Any], options: dict[str, Any]) -> None:
+        self.func = func
+        self.options = options
+        self.dispatcher: Any = None
+
+    def _real(self) -> Any:
+        if self.dispatcher is None:
+            load_numba()
+        return self.dispatcher
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return self._real()(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._real(), name)
+
+
+_pending: list[_Deferred] = []
+_numba_loaded = False
+_load_lock = threading.RLock()
+
+
+def load_numba() -> None:
+    """Load numba and make every function of the package that the decorators recorded a numba
+    dispatcher, in place in the package's modules (see :class:`_Deferred`); done once."""
+    global _numba_loaded
+    with _load_lock:
+        if _numba_loaded:
+            return
+        from numba import njit
+
+        for deferred in _pending:
+            deferred.dispatcher = _registered(njit(**deferred.options)(deferred.func))
+        _numba_loaded = True
+        for name, module in list(sys.modules.items()):
+            if module is None or not (name == "rollingtop" or name.startswith("rollingtop.")):
+                continue
+            for attr, value in list(vars(module).items()):
+                if type(value) is _Deferred:
+                    setattr(module, attr, value.dispatcher)
+        _pending.clear()
+
+
+def _make(func: F, options: dict[str, Any]) -> F:
+    if _numba_loaded:  # a module imported after numba: its dispatcher at once
+        from numba import njit
+
+        return cast(F, _registered(njit(**options)(func)))
+    deferred = _Deferred(func, options)
+    _pending.append(deferred)
+    return cast(F, deferred)
+
+
 def kernel(func: F) -> F:
     """Compile ``func`` as a stage kernel: no reference counting, no allocation."""
-    return cast(F, _registered(njit(**BASE_OPTIONS, _nrt=False)(func)))
+    return _make(func, {**BASE_OPTIONS, "_nrt": False})
 
 
 def inline(func: F) -> F:
     """Compile ``func`` as a helper inlined into every compiled caller."""
-    return cast(F, _registered(njit(**BASE_OPTIONS, inline="always")(func)))
+    return _make(func, {**BASE_OPTIONS, "inline": "always"})
 
 
 def compiled(**options: Any) -> Callable[[F], F]:
     """Compile a function that may allocate, with :data:`BASE_OPTIONS` and ``options``."""
 
     def decorate(func: F) -> F:
-        return cast(F, _registered(njit(**{**BASE_OPTIONS, **options})(func)))
+        return _make(func, {**BASE_OPTIONS, **options})
 
     return decorate
 
@@ -91,6 +156,7 @@ def disable_caching() -> None:
     dispatcher of the package, those made from now on included."""
     global _caching_off
     _caching_off = True
+    load_numba()
     for dispatcher in _DISPATCHERS:
         _disable_cache(dispatcher)
 

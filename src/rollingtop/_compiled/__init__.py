@@ -124,7 +124,9 @@ def for_code(code: int) -> ModuleType:
     group's codes only (:data:`GROUPS`; a code of another group is not checked by the compiled
     functions: pick the package by the code).
     """
-    return importlib.import_module(f"{__name__}.{group_of(code).package}")
+    package = group_of(code).package
+    _jit.load_numba()  # compiled code is wanted: its functions numba dispatchers from here on
+    return importlib.import_module(f"{__name__}.{package}")
 
 
 def for_model(model: str | ContactModel) -> ModuleType:
@@ -136,7 +138,7 @@ def for_model(model: str | ContactModel) -> ModuleType:
 def packages_of(model: str | ContactModel) -> list[ModuleType]:
     """Every compiled package of ``model``: its own kernel's, then its variants'."""
     name = get_model(model).name
-    return [importlib.import_module(f"{__name__}.{g.package}") for g in GROUPS if g.model == name]
+    return [for_code(g.codes[0]) for g in GROUPS if g.model == name]
 
 
 def by_package(codes: ArrayLike) -> list[tuple[ModuleType, IntArray]]:
@@ -144,7 +146,7 @@ def by_package(codes: ArrayLike) -> list[tuple[ModuleType, IntArray]]:
     order the packages first appear (``ValueError`` for an unknown code)."""
     codes = np.asarray(codes, dtype=np.int64)
     names = np.array([group_of(int(c)).package for c in codes])
-    return [(importlib.import_module(f"{__name__}.{n}"), np.flatnonzero(names == n))
+    return [(for_code(int(codes[names == n][0])), np.flatnonzero(names == n))
             for n in dict.fromkeys(names)]  # fmt: skip
 
 

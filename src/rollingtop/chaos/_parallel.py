@@ -13,7 +13,6 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-import numba
 import numpy as np
 
 from rollingtop._jit import call
@@ -25,6 +24,8 @@ __all__ = ["run_threaded", "thread_count"]
 
 def thread_count(threads: int | None) -> int:
     """Threads a batch uses: ``threads`` (at most numba's), else numba's current number."""
+    import numba  # on first use: importing it is a sixth of a second
+
     if threads is None:
         return int(numba.get_num_threads())
     # numba.config sets its options at run time (no stubs)
@@ -42,6 +43,8 @@ def run_threaded(
     and the threads used. ``stop`` is an int64 flag array the kernel polls; ``poll()``, if
     given, is called in the calling thread after each wait of ``WAIT_SLICE`` seconds (to report
     progress from what the kernel has written so far)."""
+    import numba  # on first use: importing it is a sixth of a second
+
     stop: IntArray = np.zeros(1, dtype=np.int64)
     n_threads = thread_count(threads)
     failure: list[BaseException] = []

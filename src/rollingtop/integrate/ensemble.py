@@ -20,7 +20,6 @@ import time
 from collections.abc import Callable
 from types import ModuleType
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -130,6 +129,8 @@ def integrate_batch(
         :class:`rollingtop._errors.Interrupted` from a signal): the trajectories stop within
         :data:`STOP_POLL_STEPS` steps and the exception propagates; no result is returned.
     """
+    import numba  # on first use: importing it is a sixth of a second
+
     states = np.ascontiguousarray(states, dtype=float)
     N = states.shape[0]
     codes = np.ascontiguousarray(codes, dtype=np.int64)
