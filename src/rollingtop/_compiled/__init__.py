@@ -135,10 +135,12 @@ def for_model(model: str | ContactModel) -> ModuleType:
     return for_code(get_model(model).code)
 
 
-def packages_of(model: str | ContactModel) -> list[ModuleType]:
-    """Every compiled package of ``model``: its own kernel's, then its variants'."""
-    name = get_model(model).name
-    return [for_code(g.codes[0]) for g in GROUPS if g.model == name]
+def packages_of(model: str | ContactModel, *, variants: bool = True) -> list[ModuleType]:
+    """The compiled packages of ``model``: its own kernel's, then (``variants``) its variants'."""
+    model = get_model(model)
+    if not variants:
+        return [for_code(model.code)]
+    return [for_code(g.codes[0]) for g in GROUPS if g.model == model.name]
 
 
 def by_package(codes: ArrayLike) -> list[tuple[ModuleType, IntArray]]:

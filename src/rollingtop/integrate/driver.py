@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
-from rollingtop._compiled import compiling, for_code, for_model, packages_of
+from rollingtop._compiled import compiling, for_code, packages_of
 from rollingtop._compiled._events import EVENTS
 from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import IntegrationError
@@ -117,8 +117,7 @@ def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool
     nothing for them yet) the compiled core's notifier says so first
     (:func:`rollingtop._compiled.compiling`).
     """
-    packages = packages_of(model) if variants else [for_model(model)]
-    return sum(_compile_package(kernels) for kernels in packages)
+    return sum(_compile_package(kernels) for kernels in packages_of(model, variants=variants))
 
 
 def compile_code(code: int) -> float:
@@ -313,7 +312,7 @@ def integrate(
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
     event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
-    compile_s = _compile_package(for_code(int(code)))
+    compile_s = compile_code(code)
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
         params,

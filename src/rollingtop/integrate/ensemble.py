@@ -23,7 +23,7 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rollingtop._compiled import by_package, compiling, for_code, for_model, packages_of
+from rollingtop._compiled import by_package, compiling, for_code, packages_of
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray
@@ -48,8 +48,7 @@ def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL, *, variants: boo
     """Compile (or load from the cache) ``model``'s parallel kernel, and no other model's;
     seconds spent (0 when done in this process). ``variants``: also its variants' (their own
     compiled package, :data:`rollingtop._compiled.GROUPS`)."""
-    packages = packages_of(model) if variants else [for_model(model)]
-    return sum(_compile_package(kernels) for kernels in packages)
+    return sum(_compile_package(kernels) for kernels in packages_of(model, variants=variants))
 
 
 def compile_ensemble_code(code: int) -> float:

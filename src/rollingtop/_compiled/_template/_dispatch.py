@@ -27,37 +27,37 @@ INLINE_RHS = False
 CODES: tuple[int, ...] = ()
 
 
-def _template() -> NotImplementedError:
-    return NotImplementedError("the template's dispatch is never compiled (see the module)")
+#: What the stand-ins raise if called: the generated modules replace them.
+NEVER_CALLED = "the template's dispatch is a stand-in, never called: see the module docstring"
 
 
 def rows(
     code: int, p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray
 ) -> int:
     """The constraint rows of kernel ``code``, their bias and force directions; their number."""
-    raise _template()
+    raise NotImplementedError(NEVER_CALLED)
 
 
 def accel(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Workspace) -> int:
     """Closed-form accelerations of kernel ``code`` into ``dy[:6]``; the number of rows."""
-    raise _template()
+    raise NotImplementedError(NEVER_CALLED)
 
 
 def project_velocity(code: int, p: FloatArray, y: FloatArray) -> None:
     """Closed-form velocity projection of kernel ``code``, in place."""
-    raise _template()
+    raise NotImplementedError(NEVER_CALLED)
 
 
 def direction_rate(code: int, p: FloatArray, y: FloatArray) -> float:
     """``psi_nu'`` under kernel ``code`` (0 unless it carries a constraint direction)."""
-    raise _template()
+    raise NotImplementedError(NEVER_CALLED)
 
 
 def sync_direction(code: int, y: FloatArray) -> None:
     """Re-synchronise ``psi_nu`` with the axis azimuth after a step, as kernel ``code`` does."""
-    raise _template()
+    raise NotImplementedError(NEVER_CALLED)
 
 
 def carries_direction(code: int) -> bool:
     """Whether kernel ``code`` carries its constraint direction in ``psi_nu``."""
-    raise _template()
+    raise NotImplementedError(NEVER_CALLED)
