@@ -64,17 +64,17 @@ def _sum(parts: list[dict[str, float]]) -> dict[str, float]:
 
 
 def _packages(models: Sequence[str]) -> list[Group]:
-    """The compiled packages of ``models``, the longest to compile first: the models' own
-    (their modules' sizes as the measure: the closed forms make most of the code), then the
-    variants'. Handed out in this order, the last process to finish is not left with a long
-    one alone."""
+    """The compiled packages of ``models``, the longest to compile first: by their model's
+    module's size (the closed forms make most of the code), a model's variants right after its
+    own package (they compile as long). Handed out in this order, the last process to finish is
+    not left with a long one alone."""
     import os.path
 
     from rollingtop.contact import MODULES
 
     size = {m.MODEL.name: os.path.getsize(str(m.__file__)) for m in MODULES}
     chosen = [g for g in PACKAGES if g.model in models]
-    return sorted(chosen, key=lambda g: (g.codes != (g.base,), -size[g.model]))
+    return sorted(chosen, key=lambda g: (-size[g.model], g.codes != (g.base,)))
 
 
 def warmup(

@@ -28,6 +28,7 @@ from rollingtop.ensemble_tables import (
     read_table,
     states_from_table,
 )
+from rollingtop.integrate._threads import thread_count
 from rollingtop.integrate.ensemble import compile_ensemble_code, integrate_batch
 from rollingtop.scenario import (
     Scenario,
@@ -252,14 +253,10 @@ def simulate_ensemble(
                 f"state {k + 1} violates the constraint {which} of model {model.name!r} "
                 "(build states with rollingtop.initial_state for the same body)"
             )
-    import numba
-
     if threads is not None:
         if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 1:
             raise ScenarioError(f"threads = {short_repr(threads)} must be an integer >= 1")
-        # what is really used (numba.config sets its options at run time: no stubs)
-        max_threads: int = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
-        threads = min(int(threads), max_threads)
+        threads = thread_count(int(threads))  # what is really used
     # the model picks its kernel variant per state (meridian: the pole cases)
     codes = np.array([model.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)],
                      dtype=np.int64)  # fmt: skip
@@ -275,7 +272,7 @@ def simulate_ensemble(
         out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol,
                                                   atol=atol, max_steps=max_steps, threads=threads,
                                                   progress=progress)  # fmt: skip
-        used = numba.get_num_threads() if threads is None else int(threads)
+        used = thread_count(threads)
     integrals = _ensemble_integrals(model, bodies, codes, states, final)
     return EnsembleResult(
         model=model, bodies=bodies, initial=states, final=final, t_end=float(t_end),

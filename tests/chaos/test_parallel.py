@@ -64,8 +64,9 @@ def test_the_parallel_exponent_by_two_nearby_trajectories():
 
 
 def test_the_readme_states_what_the_chaos_command_measures():
-    """README: 'the finite-time maximal Lyapunov exponent ... is 0.016 at t = 3000 and the mean
-    MEGNO 22', for examples/parallel_chaotic.toml."""
+    """README: 'the finite-time maximal Lyapunov exponent ... is 0.013 at t = 3000 and the mean
+    MEGNO 23' (a finite-time exponent of a chaotic motion: its digits move with the last bits
+    of the compiled code), for examples/parallel_chaotic.toml."""
     from pathlib import Path
 
     from rollingtop.scenario import load_scenario

@@ -102,8 +102,8 @@ _GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 ESTIMATES: dict[str, float] = {
     "dynamics": 4.0,
     "integrator": 9.0,
-    "ensemble": 6.0,
-    "chaos": 20.0,
+    "ensemble": 2.0,
+    "chaos": 6.0,
 }
 
 

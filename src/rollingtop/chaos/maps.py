@@ -14,9 +14,9 @@ from rollingtop._errors import ScenarioError
 from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos.lyapunov import check_options, check_state, initial_tangent, vertical_stop
 from rollingtop.contact import ContactModel, get_model
+from rollingtop.integrate._threads import run_rows
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -39,9 +39,10 @@ def _chunk(
     for kernels, idx in by_package(codes):
         part = out[idx], stats[idx]  # copies the kernel fills
         with compiling(kernels, "chaos"):
-            run_threaded(kernels.chaos.indicator_batch, (codes[idx], params, states[idx],
-                                                         tangents[idx], t, rtol, atol, max_steps,
-                                                         *part, s_stop), threads)  # fmt: skip
+            run_rows(kernels.chaos.indicator_batch,
+                     (codes[idx], params, states[idx], tangents[idx], t, rtol, atol, max_steps,
+                      *part, s_stop),
+                     (0, 2, 3, 8, 9), idx.size, threads=threads)  # fmt: skip
         out[idx], stats[idx] = part
     return out, stats
 

@@ -44,11 +44,11 @@ from rollingtop._errors import InitialStateError, ScenarioError
 from rollingtop._layout import GAMMA, N_STATE, W, state_components
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
-from rollingtop.chaos._parallel import run_threaded
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics.integrals import reduced_components
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
+from rollingtop.integrate._threads import run_rows
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -182,14 +182,15 @@ def poincare_section(
         poll = None
         if progress is not None:
             # the kernel writes each crossing's time into ev_t (NaN until then) as it finds it
-            def poll(found: FloatArray = part[0], before: int = done) -> None:
+            def poll(_: int, found: FloatArray = part[0], before: int = done) -> None:
                 progress(before + int(np.count_nonzero(~np.isnan(found))), ev_t.size)
 
         with compiling(kernels, "chaos"):
-            seconds, used = run_threaded(kernels.chaos.section_batch,
-                                         (codes[idx], body.params, Y0[idx], float(t_max),
-                                          float(rtol), float(atol), int(max_steps), *part),
-                                         threads, poll)  # fmt: skip
+            seconds, used = run_rows(kernels.chaos.section_batch,
+                                     (codes[idx], body.params, Y0[idx], float(t_max), float(rtol),
+                                      float(atol), int(max_steps), *part),
+                                     (0, 2, 7, 8, 9), idx.size, threads=threads,
+                                     poll=poll)  # fmt: skip
         wall += seconds
         ev_t[idx], ev_y[idx], stats[idx] = part
     found = stats[:, 1].astype(int)

@@ -165,7 +165,7 @@ def _pole_residual(
     return residual
 
 
-@inline
+@kernel  # a call of its own: taken only near the pole; inlined, it doubled the compile time
 def pole_rate(p: FloatArray, y: FloatArray) -> float:
     """``K*``: the rate of the carried direction at which ``K'`` has no ``1/sigma`` term (the
     limit of ``psi' = -w_n / s`` along every motion that reaches the pole; module docstring).

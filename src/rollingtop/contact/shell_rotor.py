@@ -122,7 +122,7 @@ def _column(
     )
 
 
-@inline
+@kernel  # a call of its own: inlined in each of its 14 uses, it took 10 s to compile
 def _dot_mt(
     p: FloatArray, g1: float, g2: float, g3: float, i: int,
     x1: float, x2: float, x3: float, x4: float, x5: float, x6: float, x7: float,
@@ -136,7 +136,7 @@ def _dot_mt(
     return c1 * x1 + c2 * x2 + c3 * x3 + w1 * x4 + w2 * x5 + w3 * x6 + d * x7
 
 
-@inline
+@kernel  # a call of its own (see _dot_mt)
 def _gram(p: FloatArray, g1: float, g2: float, g3: float, i: int, j: int) -> float:
     """``(T^T M T)_ij``."""
     w1 = 1.0 if j == 0 else 0.0

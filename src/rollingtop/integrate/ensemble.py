@@ -1,16 +1,16 @@
-"""Ensembles: many trajectories integrated in parallel on all cores (numba ``prange``).
+"""Ensembles: many trajectories integrated in parallel on all cores (threads running a compiled
+``nogil`` kernel chunk by chunk, :mod:`rollingtop.integrate._threads`).
 
 Each trajectory keeps its own adaptive steps (the same compiled stepper as a single run, with its
 own work arrays); memory is bounded by what is kept: final states, statistics, and samples only
 when asked for.
 
-The parallel kernel runs in a worker thread without the GIL, while the calling thread waits in
-short slices (:data:`WAIT_SLICE`), so that its signal handlers run (Python runs them in the main
-thread only, between bytecodes). On any exception there (Ctrl-C, SIGTERM, an error in the
-progress callback) it raises a stop flag, which every trajectory polls each
-:data:`STOP_POLL_STEPS` accepted steps, waits for the worker, and re-raises: the kernel stops
-within milliseconds, whatever the length of a trajectory. Polling only splits the stepper's loop
-into calls, which does not change the steps.
+The kernel runs without the GIL on worker threads, while the calling thread waits in short
+slices, so that its signal handlers run (Python runs them in the main thread only, between
+bytecodes). On any exception there (Ctrl-C, SIGTERM, an error in the progress callback) it
+raises a stop flag, which every trajectory polls each ``STOP_POLL_STEPS`` accepted steps, waits
+for the threads, and re-raises: the kernel stops within milliseconds, whatever the length of a
+trajectory. Polling only splits the stepper's loop into calls, which does not change the steps.
 """
 
 from __future__ import annotations
@@ -28,17 +28,14 @@ from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
+from rollingtop.integrate._threads import run_rows
 
 __all__ = ["integrate_batch", "compile_ensemble", "compile_ensemble_code"]
 
-#: Trajectories per call of the parallel kernel when a progress callback is given.
-BATCH = 256
-#: Trajectories per chunk handed to a thread. numba's default splits the loop into one
-#: contiguous block per thread up front; trajectories differ in cost (a grid of initial states
-#: runs from cheap to dear), so small chunks taken on demand keep every core busy to the end.
+#: Trajectories per chunk handed to a thread (:func:`rollingtop.integrate._threads.run_rows`):
+#: trajectories differ in cost (a grid of initial states runs from cheap to dear), so small
+#: chunks taken on demand keep every core busy to the end.
 CHUNK = 4
-#: Seconds the calling thread waits for the worker at a time (its signal handlers run between).
-WAIT_SLICE = 0.05
 
 _compiled: set[str] = set()
 _lock = threading.Lock()
@@ -104,10 +101,10 @@ def integrate_batch(
     t_eval : ndarray, shape (n,)
         Sample times shared by all (``[t0, t_end]`` keeps only the ends).
     threads : int, optional
-        Threads to use (default: numba's, all cores).
+        Threads to use (default: numba's thread count, ``NUMBA_NUM_THREADS``: all cores).
     progress : callable, optional
-        ``progress(done, N)`` now and then as batches of :data:`BATCH` trajectories finish
-        (called in the calling thread), and ``progress(N, N)`` at the end.
+        ``progress(done, N)`` now and then as chunks of trajectories finish (called in the
+        calling thread), and ``progress(N, N)`` at the end.
 
     Returns
     -------
@@ -126,10 +123,8 @@ def integrate_batch(
     KeyboardInterrupt
         (or any exception raised in the calling thread while it waits, such as
         :class:`rollingtop._errors.Interrupted` from a signal): the trajectories stop within
-        :data:`STOP_POLL_STEPS` steps and the exception propagates; no result is returned.
+        ``STOP_POLL_STEPS`` steps and the exception propagates; no result is returned.
     """
-    import numba  # on first use: importing it is a sixth of a second
-
     states = np.ascontiguousarray(states, dtype=float)
     N = states.shape[0]
     codes = np.ascontiguousarray(codes, dtype=np.int64)
@@ -142,61 +137,32 @@ def integrate_batch(
     out = np.full((N, t_eval.size, N_STATE), np.nan)
     final = np.full((N, N_STATE), np.nan)
     stats = np.zeros((N, 6))
-    # numba's thread count is per thread: the worker takes the caller's (or ``threads``)
-    n_threads = numba.get_num_threads()
-    if threads is not None:
-        # numba.config sets its options at run time (no stubs)
-        max_threads: int = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
-        n_threads = max(1, min(int(threads), max_threads))
-    step = N if progress is None else BATCH
-    stop = np.zeros(1, dtype=np.int64)
-    done = [0]  # trajectories finished, written by the worker
-    failure: list[BaseException] = []
+    wall = 0.0
+    before = 0  # trajectories of the packages already run
+    reported = [0]
+
+    def poll(done: int) -> None:
+        if progress is not None and reported[0] < before + done < N:
+            reported[0] = before + done
+            progress(reported[0], N)
 
     # package by package (a model, or its variants), each by its own compiled kernel (compiled
-    # here, in the calling thread)
-    for kernels, _ in groups:
+    # here, in the calling thread, before the threads start)
+    for kernels, idx in groups:
         _compile_package(kernels)
-
-    def work() -> None:
-        try:
-            numba.set_num_threads(n_threads)
-            for kernels, idx in groups:
-                batch = kernels.ensemble.batch
-                contiguous = idx.size == idx[-1] - idx[0] + 1
-                for lo in range(0, idx.size, step):
-                    hi = min(idx.size, lo + step)
-                    rows = slice(idx[lo], idx[hi - 1] + 1) if contiguous else idx[lo:hi]
-                    # a slice is a view the kernel writes into; fancy indexing is a copy
-                    part = out[rows], final[rows], stats[rows]
-                    with numba.parallel_chunksize(CHUNK):
-                        call(batch, codes[rows], params[rows], states[rows], t_eval, rtol, atol,
-                             max_steps, *part, stop)  # fmt: skip
-                    if not contiguous:
-                        out[rows], final[rows], stats[rows] = part
-                    if stop[0]:
-                        return
-                    done[0] += hi - lo
-        except BaseException as exc:  # pragma: no cover - re-raised in the calling thread
-            failure.append(exc)
-
-    start = time.perf_counter()
-    worker = threading.Thread(target=work, name="rollingtop-ensemble", daemon=True)
-    worker.start()
-    reported = 0
-    try:
-        while worker.is_alive():
-            worker.join(WAIT_SLICE)
-            if progress is not None and reported < done[0] < N:
-                reported = done[0]
-                progress(reported, N)
-    except BaseException:
-        stop[0] = 1  # every trajectory sees it within STOP_POLL_STEPS steps
-        worker.join()
-        raise
-    wall = time.perf_counter() - start
-    if failure:
-        raise failure[0]
+        contiguous = idx.size == idx[-1] - idx[0] + 1
+        rows = slice(idx[0], idx[-1] + 1) if contiguous else idx
+        # a slice is a view the kernel writes into; fancy indexing is a copy, written back
+        part = out[rows], final[rows], stats[rows]
+        seconds, _ = run_rows(kernels.ensemble.batch,
+                              (codes[rows], params[rows], states[rows], t_eval, rtol, atol,
+                               max_steps, *part),
+                              (0, 1, 2, 7, 8, 9), idx.size, threads=threads, chunk=CHUNK,
+                              poll=poll)  # fmt: skip
+        wall += seconds
+        if not contiguous:
+            out[rows], final[rows], stats[rows] = part
+        before += idx.size
     if progress is not None:
         progress(N, N)
     return out, final, stats, wall

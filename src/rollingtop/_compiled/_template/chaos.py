@@ -1,11 +1,12 @@
 """Compiled batches of one contact model: Poincare crossings of many trajectories, and the chaos
-indicators of many initial states, in parallel (numba ``prange``; one stepper with its own work
-arrays per trajectory). Their constants: :mod:`rollingtop._compiled._section`."""
+indicators of many initial states: serial ``nogil`` loops over their rows (one stepper with its
+own work arrays per trajectory), run in parallel chunk by chunk on threads by
+:func:`rollingtop.integrate._threads.run_rows`. Their constants:
+:mod:`rollingtop._compiled._section`."""
 
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled._events import W_TAU
@@ -104,7 +105,7 @@ def section_one(
     stats[4] = track[dop.MIN_NORMAL]
 
 
-@compiled(parallel=True, nogil=True)
+@compiled(nogil=True)
 def section_batch(
     codes: IntArray,
     p: FloatArray,
@@ -120,7 +121,7 @@ def section_batch(
 ) -> None:
     """:func:`section_one` for every row of ``Y0`` (shape (K, 18)); ``ev_t`` (K, N) and
     ``ev_y`` (K, N, 18) receive the crossings, ``stats`` (K, 5)."""
-    for k in prange(Y0.shape[0]):
+    for k in range(Y0.shape[0]):
         if read_flag(stop) != 0:
             stats[k, 0] = dop.INTERRUPTED
         else:
@@ -128,7 +129,7 @@ def section_batch(
                          stats[k], stop)  # fmt: skip
 
 
-@compiled(parallel=True, nogil=True)
+@compiled(nogil=True)
 def indicator_batch(
     codes: IntArray,
     p: FloatArray,
@@ -147,7 +148,7 @@ def indicator_batch(
     ``D0`` (both (K, 18)); ``out`` (K, n, 3), ``stats`` (K, 4). A trajectory not yet started
     when ``stop[0]`` is set is marked ``INTERRUPTED``."""
     states = np.zeros((0, N_STATE))
-    for k in prange(Y0.shape[0]):
+    for k in range(Y0.shape[0]):
         if read_flag(stop) != 0:
             stats[k, 0] = dop.INTERRUPTED
         else:
