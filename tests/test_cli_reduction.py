@@ -23,7 +23,7 @@ def test_equilibria_json(capsys, paper_body):
     expected = steady_motions(LevelSet(paper_body, 1.0, 0.5, -2.0))
     for e, m in zip(eq, expected, strict=True):
         assert e["U"] == m.U and e["gamma3"] == m.gamma3
-    assert data["level"] == {"M3": 1.0, "C1": 0.5, "C2": -2.0, "pole": None}
+    assert data["level"] == {"M3": 1.0, "C1": 0.5, "C2": -2.0, "model": "meridian", "pole": None}
 
 
 def test_orbits_json_uses_h_from_level_and_option(capsys, paper_body):
@@ -77,7 +77,11 @@ def test_portrait_writes_each_format(capsys, tmp_path, suffix):
     ("args", "message"),
     [
         (["orbits", FIG5, "--h", "1.0"], "h is below the minimum of the effective potential"),
-        (["equilibria", str(EXAMPLES / "smooth.toml")], "needs the meridian model"),
+        (["equilibria", str(EXAMPLES / "parallel.toml")], "parallel model has no reduction"),
+        (
+            ["bifurcation", str(EXAMPLES / "smooth.toml")],
+            "`rollingtop bifurcation` needs the meridian",
+        ),
         (["portrait", FIG5, "-o", "x.gif"], "unknown output format '.gif'"),
         (["portrait", FIG5, "-o", "x.png", "--h-levels", "a,b"], "expected comma-separated"),
     ],

@@ -195,6 +195,17 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
     if orbit.kind != "periodic":
         raise LevelSetError(f"no per-period map for a {orbit.kind} orbit ({orbit.note})")
     T = orbit.period
+    drift = level.uniform_drift()
+    if drift is not None:  # the CoM moves uniformly whatever the axis does: a translation
+        turns, turns_err = rotation_number(level, h, orbit)
+        D = drift * T
+        theta0 = start_theta(orbit)
+        dpsi, dpsi_err = 2 * math.pi * turns, 2 * math.pi * turns_err
+        if drift == 0:
+            return PeriodMap(T, dpsi, (0.0, 0.0), "bounded", (0.0, 0.0), 0.0, None, False,
+                             theta0, dpsi_err)  # fmt: skip
+        return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None,
+                         (drift.real, drift.imag), False, theta0, dpsi_err)  # fmt: skip
     if level.pole == "both":  # no spin: the axis does not precess (rollingtop.reduction.no_spin)
         dpsi, dpsi_err = 0.0, 0.0
         theta0, w_tau0 = start_theta(orbit), 0.0

@@ -11,9 +11,11 @@ A scenario names a body, a contact model, initial conditions and integration opt
     [initial]     gamma, omega, optional alpha, position, and the model's free velocity
                   components (ContactModel.free_velocity) or a full v
     [integration] t_end, rtol, atol, samples, max_steps            (defaults: DEFAULTS)
-    [level]       M3, C1, C2 and optionally h, gamma3, branch, phi, psi: a level set of the
-                  integrals of a model with a reduction (ContactModel.has_reduction; paper
-                  Sec. 3). With h and no [initial], the initial state is built on that level
+    [level]       the integrals of the model's reduction (ContactModel.reduction: M3, C1, C2
+                  for the meridian model, M3, C1, p_horizontal for the smooth one; C2 and
+                  p_horizontal may be left out) and optionally h, gamma3,
+                  branch, phi, psi (rollingtop.reduction.models; paper Sec. 3). With h and no
+                  [initial], the initial state is built on that level
                   (rollingtop.reduction.start.start_on_level)
 
 :func:`load_scenario` reads a file into a :class:`Scenario` of typed objects: the
@@ -89,7 +91,12 @@ __all__ = [
 _BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3", "I2")
 _INITIAL_KEYS = ("gamma", "omega", "alpha", "position", "v")
 _VECTOR_LENGTHS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3}
-_LEVEL_KEYS = ("M3", "C1", "C2", "h", "gamma3", "branch", "phi", "psi")
+#: Where a motion starts on a level, after the level's own integrals (ContactModel.reduction).
+_LEVEL_PLACEMENT = ("h", "gamma3", "branch", "phi", "psi")
+_LEVEL_KEYS = ("M3", "C1", "C2", "p_horizontal", *_LEVEL_PLACEMENT)
+#: Integrals a [level] may leave out: C2 (``rollingtop bifurcation`` scans it), p_horizontal
+#: (the smooth model's drift: 0).
+_LEVEL_OPTIONAL = {"C2": None, "p_horizontal": 0.0}
 
 #: Largest scenario file read (bytes).
 MAX_SCENARIO_BYTES = 1 << 20
@@ -109,9 +116,10 @@ def check_model_name(where: str, name: object) -> str:
 class LevelSpec:
     """A level set of a reduction's integrals, as given in a ``[level]`` table.
 
-    ``M3, C1, C2`` (Lagrange, area, F6) fix the level set; ``h`` (reduced energy
-    ``E - I3 w3^2/2 - m g R``) an orbit on it. ``gamma3`` (default: the first orbit's lowest
-    turning point, or its other one when the lowest lies beyond a pole passage),
+    ``M3, C1, C2`` (Lagrange, area, F6) fix the level set of the meridian model, ``M3, C1,
+    p_horizontal`` (Lagrange, area, the horizontal momentum's size) the smooth model's; ``h``
+    (reduced energy ``E - I3 w3^2/2 - m g R``) an orbit on it. ``gamma3`` (default: the first
+    orbit's lowest turning point, or its other one when the lowest lies beyond a pole passage),
     ``branch`` (sign of ``w_tau``, default +1), ``phi`` and ``psi`` (Euler angles, default 0)
     place the initial state when the scenario has no ``[initial]`` table
     (:func:`rollingtop.reduction.start.start_on_level`).
@@ -120,6 +128,7 @@ class LevelSpec:
     M3: float
     C1: float
     C2: float | None = None
+    p_horizontal: float | None = None
     h: float | None = None
     gamma3: float | None = None
     branch: int = 1
@@ -127,7 +136,7 @@ class LevelSpec:
     psi: float = 0.0
 
     def __post_init__(self) -> None:
-        for key in ("M3", "C1", "C2", "h", "gamma3", "phi", "psi"):
+        for key in ("M3", "C1", "C2", "p_horizontal", "h", "gamma3", "phi", "psi"):
             value = getattr(self, key)
             if value is not None:
                 object.__setattr__(self, key, number("level", key, value))
@@ -137,14 +146,19 @@ class LevelSpec:
             raise ScenarioError(f"level.branch = {short_repr(self.branch)} must be +1 or -1")
         object.__setattr__(self, "branch", int(self.branch))
 
-    def level_set(self, body: SphericalTop) -> LevelSet:
-        """The :class:`~rollingtop.reduction.LevelSet` ``(M3, C1, C2)`` of ``body``."""
-        from rollingtop.reduction.level import LevelSet
+    def level_set(self, body: SphericalTop, model: ContactModel | None = None) -> LevelSet:
+        """The :class:`~rollingtop.reduction.LevelSet` of ``body`` under ``model``'s reduction
+        (default the meridian model's, ``(M3, C1, C2)``): the integrals it names
+        (:attr:`ContactModel.reduction`)."""
+        from rollingtop.reduction.models import reduction_of
 
-        if self.C2 is None:
+        reduction = reduction_of(model or get_model(DEFAULT_MODEL))
+        if "C2" in reduction.names and self.C2 is None:
             raise ScenarioError("[level] is missing C2 (only `rollingtop bifurcation` does "
                                 "without it)")  # fmt: skip
-        return LevelSet(body, self.M3, self.C1, self.C2)
+        values = {name: getattr(self, name) for name in reduction.names}
+        values = {k: _LEVEL_OPTIONAL[k] if v is None else v for k, v in values.items()}
+        return reduction.level(body, values)
 
 
 @dataclass(frozen=True)
@@ -181,16 +195,28 @@ class Scenario:
             self._require_reduction("an initial state built from [level]")
             from rollingtop.reduction.start import start_on_level
 
-            y0 = start_on_level(spec.level_set(self.body), spec.h, gamma3=spec.gamma3,
+            y0 = start_on_level(spec.level_set(self.body, self.model), spec.h, gamma3=spec.gamma3,
                                 branch=spec.branch, phi=spec.phi, psi=spec.psi)  # fmt: skip
         object.__setattr__(self, "y0", y0)
 
     def _require_reduction(self, what: str) -> None:
+        """A :class:`ScenarioError` for ``what`` unless the model has a reduction
+        (:func:`rollingtop.reduction.models.reduction_of`)."""
+        if not self.model.reduction:
+            from rollingtop.reduction.models import reduction_of
+
+            reduction_of(self.model)  # its ScenarioError says what the model has instead
+
+    def _require_full_reduction(self, what: str) -> None:
+        """A :class:`ScenarioError` for ``what`` unless the whole of the paper's reduction
+        applies (:attr:`ContactModel.has_reduction`: the bifurcation diagrams, rotation numbers,
+        atlas)."""
         if not self.model.has_reduction:
             names = " or ".join(m.name for m in MODELS.values() if m.has_reduction)
+            reduced = ", ".join(m.name for m in MODELS.values() if m.reduction)
             raise ScenarioError(
-                f"{what} needs the {names} model (the reduction is the paper's), "
-                f"not {self.model.name!r}"
+                f"{what} needs the {names} model so far, not {self.model.name!r} (the steady "
+                f"motions, orbits and portraits serve every model with a reduction: {reduced})"
             )
 
     def require_state(self) -> NDArray[np.float64]:
@@ -203,18 +229,20 @@ class Scenario:
 
     def level_set(self) -> LevelSet:
         """The :class:`~rollingtop.reduction.LevelSet` of ``[level]``, else of the initial state
-        (:func:`~rollingtop.reduction.start.level_of_state`)."""
+        (:meth:`rollingtop.reduction.models.Reduction.level_of_state`), under the model's
+        reduction."""
         self._require_reduction("the reduction to one degree of freedom")
         if self.level is not None:
-            return self.level.level_set(self.body)
-        from rollingtop.reduction.start import level_of_state
+            return self.level.level_set(self.body, self.model)
+        from rollingtop.reduction.models import reduction_of
 
-        return level_of_state(self.body, self.require_state())
+        return reduction_of(self.model).level_of_state(self.body, self.require_state())
 
-    def level_integrals(self) -> tuple[float, float, float | None]:
+    def level_integrals(self, what: str = "this command") -> tuple[float, float, float | None]:
         """``(M3, C1, C2)`` of ``[level]`` (``C2`` may be absent: ``None``), else of the initial
-        state (:func:`~rollingtop.reduction.start.level_of_state`)."""
-        self._require_reduction("the reduction to one degree of freedom")
+        state: the paper's level, for the commands that need its whole reduction
+        (:meth:`_require_full_reduction`)."""
+        self._require_full_reduction(what)
         if self.level is not None:
             return self.level.M3, self.level.C1, self.level.C2
         level = self.level_set()
@@ -222,14 +250,15 @@ class Scenario:
 
     def level_h(self) -> float:
         """The reduced energy ``h`` of ``[level]``, else of the initial state
-        (:func:`~rollingtop.reduction.start.reduced_energy`)."""
+        (:meth:`rollingtop.reduction.models.Reduction.reduced_energy`)."""
         if self.level is not None and self.level.h is not None:
             return self.level.h
         if self.level is not None and self.initial is None:
             raise ScenarioError("no h: give h in [level] (or --h)")
-        from rollingtop.reduction.start import reduced_energy
+        self._require_reduction("the reduced energy")
+        from rollingtop.reduction.models import reduction_of
 
-        return reduced_energy(self.body, self.require_state())
+        return reduction_of(self.model).reduced_energy(self.body, self.require_state())
 
     def level_summary(self) -> dict[str, Any] | None:
         """The level of the scenario's motion and the energy it implies, where the model has
@@ -242,13 +271,15 @@ class Scenario:
             spin_energy + mgR`` (:func:`~rollingtop.reduction.start.level_energy`), ``source``
             (``"[level]"`` where it gives ``h``, else ``"initial state"``).
         """
-        if not (self.model.has_reduction and self.body.symmetric) or self.y0 is None:
+        if not (self.model.reduction and self.body.symmetric) or self.y0 is None:
             return None
         from rollingtop.reduction.start import level_energy
 
-        M3, C1, C2 = self.level_integrals()
+        values = self.level_set().values()
         h, given = self.level_h(), self.level is not None and self.level.h is not None
-        return {"M3": M3, "C1": C1, "C2": C2, "h": h, "energy": level_energy(self.body, M3, h),
+        M3 = values["M3"]
+        return {**values, "C2": values.get("C2"), "h": h,
+                "energy": level_energy(self.body, M3, h),
                 "spin_energy": M3 * M3 / (2.0 * self.body.I3),
                 "mgR": self.body.m * self.body.g * self.body.R,
                 "source": "[level]" if given else "initial state"}  # fmt: skip
@@ -303,8 +334,21 @@ class Scenario:
         level: LevelSpec | None = None
         if "level" in data:
             level_t = data["level"]
-            _reject_unknown("level", level_t, _LEVEL_KEYS)
-            missing = [k for k in ("M3", "C1") if k not in level_t]
+            if not model.reduction:
+                from rollingtop.reduction.models import reduction_of
+
+                try:
+                    reduction_of(model)
+                except ScenarioError as err:
+                    raise ScenarioError(f"[level]: {err}") from None
+            # the model's own integrals (ContactModel.reduction), then where to start
+            for key in level_t:
+                if key not in model.reduction + _LEVEL_PLACEMENT:
+                    raise ScenarioError(
+                        f"unknown key level.{short_name(key)} for the {model.name} model (its "
+                        f"level: {', '.join(model.reduction)}; then {', '.join(_LEVEL_PLACEMENT)})"
+                    )
+            missing = [k for k in model.reduction if k not in level_t and k not in _LEVEL_OPTIONAL]
             if missing:
                 raise ScenarioError(f"[level] is missing {', '.join(missing)}")
             level = LevelSpec(**level_t)

@@ -76,7 +76,9 @@ def survey_orbits(level: LevelSet, h: float) -> list[OrbitSurvey]:
     found = orbits(level, h)
     return [
         OrbitSurvey(
-            o, period_map(level, h, o) if o.kind == "periodic" else None, near_pole(level, h, o)
+            o,
+            period_map(level, h, o) if o.kind == "periodic" else None,
+            near_pole(level, h, o),
         )  # fmt: skip
         for o in found
     ]

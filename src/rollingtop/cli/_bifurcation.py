@@ -82,7 +82,7 @@ def bifurcation(
 
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
-    M3, C1, C2 = sc.level_integrals()
+    M3, C1, C2 = sc.level_integrals("`rollingtop bifurcation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=ranges["C2"], h_range=ranges["h"])
     width = 2.0 * max(abs(M3), abs(C1), 1e-3)
     c1_window = ranges["C1"] or (-width, width)

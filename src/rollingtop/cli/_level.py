@@ -30,7 +30,8 @@ def _level_of(scenario: str) -> LevelSet:
 
 
 def _level_json(level: LevelSet, **extra: float) -> dict[str, Any]:
-    return {"M3": level.M3, "C1": level.C1, "C2": level.C2, "pole": level.pole, **extra}
+    """The level's own integrals (:meth:`LevelSet.values`), its model and pole case."""
+    return {**level.values(), "model": level.model, "pole": level.pole, **extra}
 
 
 def _num(x: float | None) -> str:

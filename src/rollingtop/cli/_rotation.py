@@ -55,7 +55,7 @@ def rotation(
 
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
-    M3, C1, C2 = sc.level_integrals()
+    M3, C1, C2 = sc.level_integrals("`rollingtop rotation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=c2_window, h_range=h_window)
     c2w = (float(diagram.C2_grid[0]), float(diagram.C2_grid[-1]))
     hw = (float(diagram.h_grid[0]), float(diagram.h_grid[-1]))

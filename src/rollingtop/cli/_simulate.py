@@ -72,9 +72,11 @@ def _level_line(level: dict[str, Any]) -> str:
     """The level of the motion and the energy it implies
     (:meth:`rollingtop.scenario.Scenario.level_summary`), in one line."""
     where = "of [level]" if level["source"] == "[level]" else "of the initial state"
-    C2 = "" if level["C2"] is None else f", C2 = {level['C2']:.10g}"
+    skip = ("h", "energy", "spin_energy", "mgR", "source")
+    named = ", ".join(f"{k} = {v:.10g}" for k, v in level.items()
+                      if k not in skip and v is not None)  # fmt: skip
     h, spin, mgR, energy = (f"{level[k]:.10g}" for k in ("h", "spin_energy", "mgR", "energy"))
-    return (f"level {where}: h = {h} (M3 = {level['M3']:.10g}, C1 = {level['C1']:.10g}{C2}); "
+    return (f"level {where}: h = {h} ({named}); "
             f"energy = h + M3^2/(2 I3) + m g R = {h} + {spin} + {mgR} = {energy}")  # fmt: skip
 
 

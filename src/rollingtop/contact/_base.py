@@ -157,9 +157,17 @@ class ContactModel:
         unit vector ``tau = e3 x gamma / s`` (the symbolic layer's parametrisation, rational in
         ``gamma``); ``None`` with no such constraints.
     has_reduction : bool
-        Whether the model's motions of a dynamically symmetric body reduce to one degree of
-        freedom (:mod:`rollingtop.reduction`, the paper's Sec. 3): the level sets, orbits,
-        portraits and absolute-motion quadratures apply.
+        Whether the whole of the paper's reduction applies (:mod:`rollingtop.reduction`, Sec. 3):
+        besides the level sets, orbits and portraits of :attr:`reduction`, the bifurcation
+        diagrams, rotation numbers, the atlas and the symbolic claims of the reduction. The
+        meridian model only, so far.
+    reduction : tuple of str
+        The names of the integrals that fix a level set of the model's reduction to one degree
+        of freedom (a dynamically symmetric body), in order: ``("M3", "C1", "C2")`` for the
+        meridian model; empty for a model without one. The keys of a scenario's ``[level]``
+        table. The reduction itself (potential, mass, level of a state, state of a level) is
+        registered under the model's name in :mod:`rollingtop.reduction.models`: a declaration
+        here, since the contact package never imports the reduction.
     colour : str
         Matplotlib colour of the model in figures that compare models.
     particular_integrals : callable or None
@@ -216,6 +224,7 @@ class ContactModel:
     spin_directions: Callable[[Any], dict[str, Any]] | None = None
     symbolic_omega: Callable[[Any, Any, Any], Any] | None = None
     has_reduction: bool = False
+    reduction: tuple[str, ...] = ()
     colour: str = "#7f7f7f"
     particular_integrals: Callable[[SphericalTop], tuple[str, ...]] | None = None
     symbolic_claims: str | None = None

@@ -374,6 +374,7 @@ MODEL = ContactModel(
     vertical_spin=_vertical_spin,
     vertical_through_reduction=True,
     has_reduction=True,
+    reduction=("M3", "C1", "C2"),
     colour="#1f77b4",
     devices=("roller", "shell", "skates"),
 )

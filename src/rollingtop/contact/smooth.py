@@ -88,5 +88,6 @@ MODEL = ContactModel(
     symbolic_directions=_symbolic_directions,
     symbolic_velocity=_symbolic_velocity,
     vertical_spin=_vertical_spin,
+    reduction=("M3", "C1", "p_horizontal"),
     colour="#2ca02c",
 )

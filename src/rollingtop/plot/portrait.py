@@ -97,7 +97,8 @@ def phase_portrait(
     show_contact: bool = True,
     figsize: tuple[float, float] = (7.0, 7.5),
 ) -> Figure:
-    """Phase portrait on the level set ``(M3, C1, C2)``: orbits at ``h_levels``, separatrices,
+    """Phase portrait on a level set (the meridian model's ``(M3, C1, C2)``, or another model's
+    :class:`~rollingtop.reduction.LevelSet`): orbits at ``h_levels``, separatrices,
     steady motions, the effective potential below.
 
     Parameters
@@ -187,8 +188,10 @@ def phase_portrait(
                frameon=False)  # fmt: skip
     pole = {None: "", "south": ", south pole case", "north": ", north pole case",
             "both": ", no spin: both poles"}[level.pole]  # fmt: skip
+    symbols = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}"}
+    named = r",\ ".join(f"{symbols.get(k, k)}={v:g}" for k, v in level.values().items())
     ax.set_title(
-        rf"$M_3={level.M3:g},\ C_1={level.C1:g},\ C_2={level.C2:g}${pole}"
+        rf"{level.model} model: ${named}${pole}"
         "\n"
         rf"$R={body.R:g},\ m={body.m:g},\ g={body.g:g},\ a_3={body.a3:g},\ "
         rf"I_1={body.I1:g},\ I_3={body.I3:g}$",

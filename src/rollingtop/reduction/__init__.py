@@ -1,4 +1,5 @@
-"""Reduction of the meridian model to one degree of freedom (paper Sec. 3).
+"""Reduction of the meridian model to one degree of freedom (paper Sec. 3), and of the other
+models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`).
 
 - :mod:`.variables`: full state <-> reduced variables and integrals.
 - :mod:`.system`: the reduced system (eq. 3.3).
@@ -11,7 +12,9 @@
 """
 
 from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
+from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
 from rollingtop.reduction.orbits import Orbit, orbits
+from rollingtop.reduction.smooth import SmoothLevel
 from rollingtop.reduction.steady import SteadyMotion, steady_motions
 from rollingtop.reduction.system import integrate_reduced, reduced_integrals_of, reduced_rhs
 from rollingtop.reduction.variables import (
@@ -27,6 +30,9 @@ __all__ = [
     "LevelSet",
     "LevelSetError",
     "Orbit",
+    "REDUCTIONS",
+    "Reduction",
+    "SmoothLevel",
     "SteadyMotion",
     "euler_angles",
     "integrate_reduced",
@@ -35,6 +41,7 @@ __all__ = [
     "reduced_integrals",
     "reduced_integrals_of",
     "reduced_rhs",
+    "reduction_of",
     "state_from_level",
     "states_on_level",
     "steady_motions",

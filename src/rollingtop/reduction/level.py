@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, TypeAlias, TypeVar, overload
+from typing import Any, ClassVar, TypeAlias, TypeVar, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -96,6 +96,12 @@ class LevelSet:
     ``1 -+ cos(theta) = 2 sin^2(theta/2)`` (``2 cos^2``), so ``U`` keeps its relative accuracy
     inside the wall (see :meth:`_q`).
     """
+
+    #: The integrals that name the level, in order (:attr:`ContactModel.reduction`): the keys
+    #: of a ``[level]`` table and of the level in JSON output (:meth:`values`).
+    integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "C2")
+    #: The contact model whose reduction this is (:mod:`rollingtop.reduction.models`).
+    model: ClassVar[str] = "meridian"
 
     body: SphericalTop
     M3: float
@@ -341,6 +347,50 @@ class LevelSet:
         """
         w_tau_dot: Real = (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
         return -w_tau, w_tau_dot
+
+    def uniform_drift(self) -> complex | None:
+        """The centre of mass's horizontal velocity ``X' + i Y'`` in the fixed frame of
+        :mod:`rollingtop.absolute` when it is constant (a model with conserved horizontal
+        momentum), else ``None``: the meridian model's turns with the axis
+        (:func:`rollingtop.absolute.period_map`)."""
+        return None
+
+    def values(self) -> dict[str, float]:
+        """The level's integrals by name (:attr:`integrals`)."""
+        return {name: float(getattr(self, name)) for name in self.integrals}
+
+    def com_velocity(self, theta: Real, w_tau: Real, frame: dict[str, FloatArray]) -> FloatArray:
+        """The centre of mass's velocity (body frame) at ``theta`` with ``w_tau``, from the
+        constraints and :meth:`v_tau`: ``v_tau tau - (R gamma3 + a3) w_tau n - R s w_tau e3``
+        (``docs/model.md``, "Reduced variables"). ``frame`` holds the unit vectors ``tau, n, e3,
+        gamma`` (shape ``(..., 3)``, broadcast with ``theta`` and ``w_tau`` of shape ``(...)``).
+        """
+        b = self.body
+        t = np.asarray(theta, dtype=float)[..., None]
+        wt = np.asarray(w_tau, dtype=float)[..., None]
+        v_tau = np.asarray(self.v_tau(theta), dtype=float)[..., None]
+        v: FloatArray = (v_tau * frame["tau"] - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
+                         - b.R * np.sin(t) * wt * frame["e3"])  # fmt: skip
+        return v
+
+    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
+        """Eigenvalues of the reduced equations (eq. 3.3) linearised at the steady motion at
+        ``gamma3``, by central differences of :func:`rollingtop.reduction.reduced_rhs` at
+        ``(gamma3, v_tau, w_n, 0)`` (:func:`rollingtop.reduction.steady.linearised_eigenvalues`
+        says why)."""
+        from rollingtop._numdiff import DIFF_STEP, central_jacobian
+        from rollingtop.reduction.system import reduced_rhs
+
+        theta = math.acos(gamma3)
+        x0 = np.array([gamma3, float(self.v_tau(theta)), float(self.w_n(theta)), 0.0])
+        steps = DIFF_STEP * np.maximum(1.0, np.abs(x0))
+        # stay inside (-1, 1): near a pole the step in gamma3 shrinks with the distance to it
+        steps[0] = min(steps[0], 0.25 * (1.0 - abs(gamma3)))
+        D = central_jacobian(lambda x: reduced_rhs(self.body, self.M3, x), x0, steps)
+        if not np.all(np.isfinite(D)):  # a steady motion at round-off distance from a pole
+            return np.full(4, complex(math.nan, math.nan))
+        out: ComplexArray = np.linalg.eigvals(D).astype(complex)
+        return out
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -17,7 +17,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rollingtop._json import json_ready
-from rollingtop._numdiff import DIFF_STEP, central_jacobian
 from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet, near_north
 
@@ -141,18 +140,7 @@ def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex
     eigenvalues (the integrals ``C1, C2``) and ``+-sqrt(-U''_theta / rho)``, which the tests
     compare with the potential's curvature.
     """
-    from rollingtop.reduction.system import reduced_rhs
-
-    theta = math.acos(gamma3)
-    x0 = np.array([gamma3, float(level.v_tau(theta)), float(level.w_n(theta)), 0.0])
-    steps = DIFF_STEP * np.maximum(1.0, np.abs(x0))
-    # stay inside (-1, 1): near a pole the step in gamma3 shrinks with the distance to it
-    steps[0] = min(steps[0], 0.25 * (1.0 - abs(gamma3)))
-    D = central_jacobian(lambda x: reduced_rhs(level.body, level.M3, x), x0, steps)
-    if not np.all(np.isfinite(D)):  # a steady motion at round-off distance from a pole
-        return np.full(4, complex(math.nan, math.nan))
-    out: NDArray[np.complex128] = np.linalg.eigvals(D).astype(complex)
-    return out
+    return level.linearised_eigenvalues(gamma3)
 
 
 def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
@@ -169,10 +157,11 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     omega = math.sqrt(U2t / rho) if kind == "center" else math.nan
     v_tau = float(level.v_tau(theta))
     psi_dot = float(level.psi_dot(theta))
+    drift = level.uniform_drift()  # a model whose centre of mass drifts uniformly (smooth)
     eig: tuple[tuple[float, float], ...] = ()
     stable = None
     if abs(s) > 1e-8 and 0.0 < theta < math.pi:
-        ev = linearised_eigenvalues(level, math.cos(theta))
+        ev = level.linearised_eigenvalues(math.cos(theta))
         if np.all(np.isfinite(ev)):
             eig = tuple((float(z.real), float(z.imag)) for z in ev)
             size = max(1.0, float(np.max(np.abs(ev))))
@@ -191,8 +180,10 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
         v_tau=v_tau,
         spin=level.M3 / body.I3,
         precession_rate=psi_dot,
-        com_speed=abs(v_tau),
-        com_radius=abs(v_tau / psi_dot) if psi_dot != 0 else math.inf,
+        com_speed=abs(v_tau) if drift is None else abs(drift),
+        com_radius=(abs(v_tau / psi_dot) if psi_dot != 0 else math.inf)
+        if drift is None
+        else (math.inf if drift else 0.0),
         eigenvalues=eig,
         linearly_stable=stable,
     )

@@ -128,7 +128,6 @@ def state_from_level(
         )
     w_tau = branch * float(level.w_tau(theta, h))  # 0 at a turning point
     w_n = float(level.w_n(theta))
-    v_tau = float(level.v_tau(theta))
     s = math.sin(theta)
     gamma = np.array([s * math.sin(phi), s * math.cos(phi), gamma3])
     e3 = np.array([0.0, 0.0, 1.0])
@@ -138,7 +137,7 @@ def state_from_level(
     alpha = math.cos(psi) * nu + math.sin(psi) * tau
     beta = math.sin(psi) * nu - math.cos(psi) * tau
     w = w_tau * tau + w_n * n + (level.M3 / body.I3) * e3
-    v = v_tau * tau - (body.R * gamma3 + body.a3) * w_tau * n - body.R * s * w_tau * e3
+    v = level.com_velocity(theta, w_tau, {"tau": tau, "n": n, "e3": e3, "gamma": gamma})
     y = np.empty(18)
     y[0:3], y[3:6], y[6:9], y[9:12], y[12:15] = v, w, alpha, beta, gamma
     y[15:17] = position
@@ -170,13 +169,13 @@ def states_on_level(level: LevelSet, gamma3: ArrayLike, w_tau: ArrayLike) -> Flo
     theta = np.arccos(g3)
     s = np.sin(theta)
     w_n = np.asarray(level.w_n(theta), dtype=float)
-    v_tau = np.asarray(level.v_tau(theta), dtype=float)
     y = np.zeros((*g3.shape, 18))
     # phi = 0: gamma = (0, s, gamma3), tau = (-1, 0, 0), n = (0, -1, 0), nu = (0, -gamma3, s);
     # psi = 0: alpha = nu, beta = -tau (the frames of state_from_level)
-    y[..., 0] = -v_tau
-    y[..., 1] = (body.R * g3 + body.a3) * wt
-    y[..., 2] = -body.R * s * wt
+    gamma = np.stack([np.zeros_like(s), s, g3], axis=-1)
+    frame = {"tau": np.array([-1.0, 0.0, 0.0]), "n": np.array([0.0, -1.0, 0.0]),
+             "e3": np.array([0.0, 0.0, 1.0]), "gamma": gamma}  # fmt: skip
+    y[..., 0:3] = level.com_velocity(theta, wt, frame)
     y[..., 3] = -wt
     y[..., 4] = -w_n
     y[..., 5] = level.M3 / body.I3

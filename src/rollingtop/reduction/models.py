@@ -1,0 +1,122 @@
+"""Each contact model's reduction to one degree of freedom, by the model's name.
+
+A model declares the integrals that fix a level of its reduction
+(:attr:`rollingtop.contact.ContactModel.reduction`); its :class:`Reduction` here says how to
+build the level (a :class:`~rollingtop.reduction.LevelSet` kind: the potential, the mass, the
+precession and the centre of mass's velocity as functions of the nutation angle), how to read
+it and the reduced energy off a full state, and how the reduced energy relates to the full one.
+Everything downstream -- steady motions, orbits, quadratures, portraits, starting a motion on a
+level -- takes the level and asks it, whatever the model.
+
+=========  ========================  ======================================================
+model      level                     reduced energy ``h``
+=========  ========================  ======================================================
+meridian   ``M3, C1, C2``            ``E - I3 w3^2/2 - m g R`` (paper eq. 3.11)
+smooth     ``M3, C1, p_horizontal``  ``E - I3 w3^2/2 - m g R``
+=========  ========================  ======================================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop._errors import ScenarioError
+from rollingtop._layout import W
+from rollingtop.body import SphericalTop
+from rollingtop.contact import MODELS, ContactModel, get_model
+from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.smooth import SmoothLevel, smooth_integrals
+from rollingtop.reduction.variables import reduced_integrals
+
+__all__ = ["REDUCTIONS", "Reduction", "reduction_of"]
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """How a contact model's motions of a dynamically symmetric body reduce to one degree of
+    freedom.
+
+    Attributes
+    ----------
+    model : str
+        The contact model's name.
+    level_type : type
+        The :class:`~rollingtop.reduction.LevelSet` kind of its levels; its ``integrals`` are
+        the level's names (the model's :attr:`~rollingtop.contact.ContactModel.reduction`).
+    integrals : callable
+        ``integrals(body, Y) -> dict``: the level's integrals and the reduced energy ``h`` of
+        states ``Y`` (shape ``(..., 18)``), each of shape ``(...)``.
+    energy : str
+        What ``h`` is, in terms of the full energy ``E``.
+    sources : str
+        Where the reduction comes from.
+    """
+
+    model: str
+    level_type: type[LevelSet]
+    integrals: Callable[[SphericalTop, ArrayLike], dict[str, NDArray[np.float64]]]
+    energy: str
+    sources: str
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The names of the integrals that fix a level."""
+        return self.level_type.integrals
+
+    def level(
+        self, body: SphericalTop, values: Mapping[str, float], scale: float = 0.0
+    ) -> LevelSet:
+        """The level set of ``body`` with the integrals ``values`` (every name of
+        :attr:`names`; a missing or unknown one is a :class:`ScenarioError` listing them)."""
+        missing = [n for n in self.names if n not in values]
+        unknown = [n for n in values if n not in self.names]
+        if missing or unknown:
+            what = f"missing {', '.join(missing)}" if missing else f"unknown {', '.join(unknown)}"
+            raise ScenarioError(f"a level of the {self.model} model's reduction is fixed by "
+                                f"{', '.join(self.names)} ({what})")  # fmt: skip
+        given = {n: float(values[n]) for n in self.names}
+        return self.level_type(body, **given, scale=scale)
+
+    def level_of_state(self, body: SphericalTop, y: ArrayLike) -> LevelSet:
+        """The level set the state ``y`` (shape (18,)) lies on; ``|I w|`` is the round-off scale
+        of ``M3`` and ``C1`` in the pole decision (:class:`~rollingtop.reduction.LevelSet`)."""
+        y = np.asarray(y, dtype=float)
+        values = self.integrals(body, y)
+        scale = float(np.linalg.norm(body.inertia * y[W]))
+        return self.level(body, {n: float(values[n]) for n in self.names}, scale=scale)
+
+    def reduced_energy(self, body: SphericalTop, y: ArrayLike) -> float:
+        """The reduced energy ``h`` of the state ``y`` (:attr:`energy`)."""
+        return float(self.integrals(body, np.asarray(y, dtype=float))["h"])
+
+
+REDUCTIONS: dict[str, Reduction] = {
+    r.model: r
+    for r in (
+        Reduction("meridian", LevelSet, reduced_integrals,
+                  "E - I3 w3^2/2 - m g R",
+                  "Kilin and Ivanova 2023, Sec. 3 (eqs. 3.8-3.11)"),
+        Reduction("smooth", SmoothLevel, smooth_integrals,
+                  "E - I3 w3^2/2 - m g R",
+                  "Lagrange's top about its centre of mass with the vertical motion's mass "
+                  "(Routh, Advanced Rigid Dynamics, Sec. 242)"),
+    )
+}  # fmt: skip
+
+
+def reduction_of(model: str | ContactModel) -> Reduction:
+    """The reduction of ``model`` (a name or a :class:`ContactModel`); a
+    :class:`ScenarioError` in one line for a model without one, naming those with one and what
+    serves the others."""
+    model = get_model(model) if isinstance(model, str) else model
+    if model.reduction and model.name in REDUCTIONS:
+        return REDUCTIONS[model.name]
+    names = ", ".join(m.name for m in MODELS.values() if m.reduction and m.name in REDUCTIONS)
+    raise ScenarioError(
+        f"the {model.name} model has no reduction to one degree of freedom (models with one: "
+        f"{names}); explore its motions with `rollingtop simulate`, `section` and `chaos`"
+    )
