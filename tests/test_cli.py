@@ -318,8 +318,8 @@ def test_model_choices_come_from_the_registry(capsys):
 def test_simulate_relates_the_level_h_to_the_energy(capsys):
     """Fig. 5's scenario gives [level] h = 4: the report prints h beside the energy it implies,
     E = h + M3^2/(2 I3) + m g R = 4 + 1 + 1 = 6 (docs/model.md), which the integrated energy
-    integral confirms; a level of the initial state is labelled so; a model without the
-    reduction has none."""
+    integral confirms; a level of the initial state is labelled so; the rough model's level is
+    its own; a model without a reduction has none."""
     fig5 = str(EXAMPLES / "fig5.toml")
     code, out, err = run_cli(capsys, "simulate", fig5, "--t-end", "0.5")
     assert code == 0, err
@@ -328,6 +328,7 @@ def test_simulate_relates_the_level_h_to_the_energy(capsys):
     code, out, err = run_cli(capsys, "simulate", fig5, "--t-end", "0.5", "--json")
     summary = json.loads(out)
     assert summary["level"] == {"M3": 1.0, "C1": 0.5, "C2": -2.0, "h": 4.0, "energy": 6.0,
+                                "energy_formula": "h + M3^2/(2 I3) + m g R",
                                 "spin_energy": 1.0, "mgR": 1.0, "source": "[level]"}  # fmt: skip
     assert summary["integrals"]["energy"]["initial"] == pytest.approx(6.0, abs=1e-12)
     code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "paper.toml"), "--t-end", "0.5",
@@ -336,8 +337,15 @@ def test_simulate_relates_the_level_h_to_the_energy(capsys):
     assert level["source"] == "initial state" and level["h"] == pytest.approx(0.4849, abs=1e-12)
     assert level["energy"] == pytest.approx(json.loads(out)["integrals"]["energy"]["initial"],
                                              abs=1e-12)  # fmt: skip
+    # the rough model's own level (jellett, routh) and its energy, E = h + m g R
     code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "rough.toml"), "--t-end", "0.5",
                              "--json")  # fmt: skip
+    level = json.loads(out)["level"]
+    assert {"jellett", "routh"} <= set(level) and level["energy_formula"] == "h + m g R"
+    assert level["energy"] == pytest.approx(json.loads(out)["integrals"]["energy"]["initial"],
+                                             abs=1e-12)  # fmt: skip
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "parallel.toml"), "--t-end",
+                             "0.5", "--json")  # fmt: skip
     assert code == 0 and "level" not in json.loads(out)
 
 

@@ -93,7 +93,7 @@ _INITIAL_KEYS = ("gamma", "omega", "alpha", "position", "v")
 _VECTOR_LENGTHS = {"gamma": 3, "omega": 3, "alpha": 3, "position": 2, "v": 3}
 #: Where a motion starts on a level, after the level's own integrals (ContactModel.reduction).
 _LEVEL_PLACEMENT = ("h", "gamma3", "branch", "phi", "psi")
-_LEVEL_KEYS = ("M3", "C1", "C2", "p_horizontal", *_LEVEL_PLACEMENT)
+_LEVEL_KEYS = ("M3", "C1", "C2", "p_horizontal", "jellett", "routh", *_LEVEL_PLACEMENT)
 #: Integrals a [level] may leave out: C2 (``rollingtop bifurcation`` scans it), p_horizontal
 #: (the smooth model's drift: 0).
 _LEVEL_OPTIONAL = {"C2": None, "p_horizontal": 0.0}
@@ -125,10 +125,12 @@ class LevelSpec:
     (:func:`rollingtop.reduction.start.start_on_level`).
     """
 
-    M3: float
-    C1: float
+    M3: float | None = None
+    C1: float | None = None
     C2: float | None = None
     p_horizontal: float | None = None
+    jellett: float | None = None
+    routh: float | None = None
     h: float | None = None
     gamma3: float | None = None
     branch: int = 1
@@ -136,7 +138,18 @@ class LevelSpec:
     psi: float = 0.0
 
     def __post_init__(self) -> None:
-        for key in ("M3", "C1", "C2", "p_horizontal", "h", "gamma3", "phi", "psi"):
+        for key in (
+            "M3",
+            "C1",
+            "C2",
+            "p_horizontal",
+            "jellett",
+            "routh",
+            "h",
+            "gamma3",
+            "phi",
+            "psi",
+        ):
             value = getattr(self, key)
             if value is not None:
                 object.__setattr__(self, key, number("level", key, value))
@@ -157,8 +170,8 @@ class LevelSpec:
             raise ScenarioError("[level] is missing C2 (only `rollingtop bifurcation` does "
                                 "without it)")  # fmt: skip
         values = {name: getattr(self, name) for name in reduction.names}
-        values = {k: _LEVEL_OPTIONAL[k] if v is None else v for k, v in values.items()}
-        return reduction.level(body, values)
+        values = {k: _LEVEL_OPTIONAL.get(k) if v is None else v for k, v in values.items()}
+        return reduction.level(body, {k: v for k, v in values.items() if v is not None})
 
 
 @dataclass(frozen=True)
@@ -244,7 +257,9 @@ class Scenario:
         (:meth:`_require_full_reduction`)."""
         self._require_full_reduction(what)
         if self.level is not None:
-            return self.level.M3, self.level.C1, self.level.C2
+            M3, C1 = self.level.M3, self.level.C1
+            assert M3 is not None and C1 is not None  # the meridian model's [level] has them
+            return M3, C1, self.level.C2
         level = self.level_set()
         return level.M3, level.C1, level.C2
 
@@ -273,15 +288,15 @@ class Scenario:
         """
         if not (self.model.reduction and self.body.symmetric) or self.y0 is None:
             return None
-        from rollingtop.reduction.start import level_energy
-
-        values = self.level_set().values()
+        level = self.level_set()
+        values = level.values()
         h, given = self.level_h(), self.level is not None and self.level.h is not None
-        M3 = values["M3"]
-        return {**values, "C2": values.get("C2"), "h": h,
-                "energy": level_energy(self.body, M3, h),
-                "spin_energy": M3 * M3 / (2.0 * self.body.I3),
-                "mgR": self.body.m * self.body.g * self.body.R,
+        body = self.body
+        M3 = values.get("M3")
+        return {**values, "C2": values.get("C2"), "h": h, "energy": level.full_energy(h),
+                "energy_formula": level.energy_formula,
+                "spin_energy": None if M3 is None else M3 * M3 / (2.0 * body.I3),
+                "mgR": body.m * body.g * body.R,
                 "source": "[level]" if given else "initial state"}  # fmt: skip
 
     def with_overrides(self, **overrides: Any) -> Scenario:

@@ -41,8 +41,8 @@ def _num(x: float | None) -> str:
 def _steady_table(level: LevelSet, motions: Sequence[SteadyMotion]) -> Table:
     from rich.table import Table
 
-    spin = level.M3 / level.body.I3
-    table = Table(title=f"steady motions on {level.describe()} (spin w3 = {spin:.7g})")
+    spin = "" if "M3" not in level.values() else f" (spin w3 = {level.M3 / level.body.I3:.7g})"
+    table = Table(title=f"steady motions on {level.describe()}{spin}")
     cols = ("gamma3", "U", "type", "omega", "period", "psi'", "|v_CoM|", "CoM radius")
     for col in cols:
         table.add_column(col, justify="left" if col == "type" else "right")
@@ -74,9 +74,7 @@ def equilibria(scenario: str, as_json: bool) -> None:
 def _orbits_table(level: LevelSet, h: float, survey: Sequence[OrbitSurvey]) -> Table:
     from rich.table import Table
 
-    from rollingtop.reduction.start import level_energy
-
-    energy = level_energy(level.body, level.M3, h)
+    energy = level.full_energy(h)
     table = Table(title=f"orbits on {level.describe()}, h = {h:g} (energy {energy:g})")
     cols = ("gamma3_min", "gamma3_max", "period", "+-", "delta_psi", "motion", "circle / drift",
             "note")  # fmt: skip
@@ -124,9 +122,7 @@ def orbits(scenario: str, h: float | None, as_json: bool) -> None:
     survey = survey_orbits(level, h)
     if as_json:
         rows = [row.to_dict() for row in survey]
-        from rollingtop.reduction.start import level_energy
-
-        energy = level_energy(level.body, level.M3, h)
+        energy = level.full_energy(h)
         click.echo(json.dumps({"level": _level_json(level, h=h, energy=energy), "orbits": rows}))
     else:
         _output.console().print(_orbits_table(level, h, survey))

@@ -72,12 +72,15 @@ def _level_line(level: dict[str, Any]) -> str:
     """The level of the motion and the energy it implies
     (:meth:`rollingtop.scenario.Scenario.level_summary`), in one line."""
     where = "of [level]" if level["source"] == "[level]" else "of the initial state"
-    skip = ("h", "energy", "spin_energy", "mgR", "source")
+    skip = ("h", "energy", "energy_formula", "spin_energy", "mgR", "source")
     named = ", ".join(f"{k} = {v:.10g}" for k, v in level.items()
                       if k not in skip and v is not None)  # fmt: skip
-    h, spin, mgR, energy = (f"{level[k]:.10g}" for k in ("h", "spin_energy", "mgR", "energy"))
-    return (f"level {where}: h = {h} ({named}); "
-            f"energy = h + M3^2/(2 I3) + m g R = {h} + {spin} + {mgR} = {energy}")  # fmt: skip
+    h, mgR, energy = (f"{level[k]:.10g}" for k in ("h", "mgR", "energy"))
+    terms = [h] + ([] if level["spin_energy"] is None else [f"{level['spin_energy']:.10g}"])
+    return (
+        f"level {where}: h = {h} ({named}); energy = {level['energy_formula']} = "
+        f"{' + '.join([*terms, mgR])} = {energy}"
+    )
 
 
 def _print_report(summary: dict[str, Any]) -> None:

@@ -181,6 +181,7 @@ MODEL = ContactModel(
     constraints=("no slip (vp, e1) = 0", "no slip (vp, e2) = 0", "no slip (vp, e3) = 0"),
     free_velocity={},
     integrals_symmetric=("energy", "jellett", "routh"),
+    reduction=("jellett", "routh"),
     integrals_general=("energy",),
     velocity=_velocity,
     symbolic_directions=_symbolic_directions,

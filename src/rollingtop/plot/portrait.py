@@ -30,7 +30,6 @@ from rollingtop.reduction import (
 )
 from rollingtop.reduction._quadrature import energy_gap
 from rollingtop.reduction.level import Real
-from rollingtop.reduction.system import normal_force
 
 __all__ = ["phase_portrait", "default_h_levels"]
 
@@ -83,11 +82,10 @@ def _orbit_curve(
 
 def _normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatArray:
     """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape (nw, ng), in
-    closed form (:func:`rollingtop.reduction.system.normal_force`; no compiled code)."""
+    closed form (:meth:`rollingtop.reduction.LevelSet.normal_force`; no compiled code)."""
     G, Wt = np.meshgrid(g3, w, indexing="ij")
-    theta = np.arccos(G)
-    x = np.array([G, level.v_tau(theta), level.w_n(theta), Wt])
-    return normal_force(level.body, level.M3, x).T
+    N: FloatArray = level.normal_force(np.arccos(G), Wt).T
+    return N
 
 
 def phase_portrait(
@@ -189,7 +187,8 @@ def phase_portrait(
     pole = {None: "", "south": ", south pole case", "north": ", north pole case",
             "both": ", no spin: both poles"}[level.pole]  # fmt: skip
     symbols = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}"}
-    named = r",\ ".join(f"{symbols.get(k, k)}={v:g}" for k, v in level.values().items())
+    upright = {k: r"\mathrm{" + k + "}" for k in level.values()}
+    named = r",\ ".join(f"{symbols.get(k, upright[k])}={v:g}" for k, v in level.values().items())
     ax.set_title(
         rf"{level.model} model: ${named}${pole}"
         "\n"

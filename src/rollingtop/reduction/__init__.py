@@ -1,5 +1,6 @@
 """Reduction of the meridian model to one degree of freedom (paper Sec. 3), and of the other
-models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`).
+models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, and the rough
+model's, :mod:`.rough`).
 
 - :mod:`.variables`: full state <-> reduced variables and integrals.
 - :mod:`.system`: the reduced system (eq. 3.3).
@@ -14,6 +15,7 @@ models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`).
 from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
 from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
 from rollingtop.reduction.orbits import Orbit, orbits
+from rollingtop.reduction.rough import RoughLevel
 from rollingtop.reduction.smooth import SmoothLevel
 from rollingtop.reduction.steady import SteadyMotion, steady_motions
 from rollingtop.reduction.system import integrate_reduced, reduced_integrals_of, reduced_rhs
@@ -32,6 +34,7 @@ __all__ = [
     "Orbit",
     "REDUCTIONS",
     "Reduction",
+    "RoughLevel",
     "SmoothLevel",
     "SteadyMotion",
     "euler_angles",

@@ -348,6 +348,31 @@ class LevelSet:
         w_tau_dot: Real = (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
         return -w_tau, w_tau_dot
 
+    #: :meth:`full_energy` in words.
+    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
+
+    def full_energy(self, h: float) -> float:
+        """The energy ``E`` of the full system on this level at reduced energy ``h``:
+        ``h + M3^2 / (2 I3) + m g R`` (:func:`rollingtop.reduction.start.level_energy`)."""
+        b = self.body
+        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
+
+    def spin(self, theta: Real) -> Real:
+        """The spin ``w3`` at ``theta``: ``M3 / I3``, constant (Lagrange's integral)."""
+        out: Real = self.M3 / self.body.I3 + 0.0 * theta
+        return out
+
+    def normal_force(self, theta: Real, w_tau: Real) -> Real:
+        """The plane's normal force at ``(theta, w_tau)`` on the level: the centre of mass is at
+        height ``R + a3 gamma3`` and only gravity and the normal force act on it vertically
+        (every model's other reactions are horizontal), so ``N = m (g + a3 gamma3'')`` with
+        ``gamma3'' = s w_tau' - gamma3 w_tau^2`` and ``w_tau'`` from :meth:`flow`. NumPy only:
+        the reduction's pictures need no compiled code."""
+        b = self.body
+        _, dw = self.flow(theta, w_tau)
+        N: Real = b.m * (b.g + b.a3 * (np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau))
+        return N
+
     def uniform_drift(self) -> complex | None:
         """The centre of mass's horizontal velocity ``X' + i Y'`` in the fixed frame of
         :mod:`rollingtop.absolute` when it is constant (a model with conserved horizontal
@@ -368,7 +393,7 @@ class LevelSet:
         b = self.body
         t = np.asarray(theta, dtype=float)[..., None]
         wt = np.asarray(w_tau, dtype=float)[..., None]
-        v_tau = np.asarray(self.v_tau(theta), dtype=float)[..., None]
+        v_tau = (np.asarray(self.v_tau(theta), dtype=float) + 0.0 * wt[..., 0])[..., None]
         v: FloatArray = (v_tau * frame["tau"] - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
                          - b.R * np.sin(t) * wt * frame["e3"])  # fmt: skip
         return v

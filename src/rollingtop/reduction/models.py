@@ -13,6 +13,7 @@ model      level                     reduced energy ``h``
 =========  ========================  ======================================================
 meridian   ``M3, C1, C2``            ``E - I3 w3^2/2 - m g R`` (paper eq. 3.11)
 smooth     ``M3, C1, p_horizontal``  ``E - I3 w3^2/2 - m g R``
+rough      ``jellett, routh``        ``E - m g R``
 =========  ========================  ======================================================
 """
 
@@ -29,6 +30,7 @@ from rollingtop._layout import W
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.rough import RoughLevel, rough_integrals
 from rollingtop.reduction.smooth import SmoothLevel, smooth_integrals
 from rollingtop.reduction.variables import reduced_integrals
 
@@ -104,6 +106,9 @@ REDUCTIONS: dict[str, Reduction] = {
                   "E - I3 w3^2/2 - m g R",
                   "Lagrange's top about its centre of mass with the vertical motion's mass "
                   "(Routh, Advanced Rigid Dynamics, Sec. 242)"),
+        Reduction("rough", RoughLevel, rough_integrals, "E - m g R",
+                  "Routh's sphere: Jellett's and Routh's integrals (Routh, Advanced Rigid "
+                  "Dynamics, Sec. 243; Borisov and Mamaev, Rigid Body Dynamics)"),
     )
 }  # fmt: skip
 

@@ -145,7 +145,6 @@ def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex
 
 def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     """Describe the steady motion at the critical point ``theta``."""
-    body = level.body
     U2t = float(level.d2U(theta))
     rho = float(level.rho(theta))
     U = float(level.U(theta))
@@ -178,7 +177,7 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
         growth_rate=math.sqrt(-U2t / rho) if kind == "saddle" else math.nan,
         w_n=float(level.w_n(theta)) if abs(s) > 1e-12 else 0.0,
         v_tau=v_tau,
-        spin=level.M3 / body.I3,
+        spin=float(level.spin(theta)),
         precession_rate=psi_dot,
         com_speed=abs(v_tau) if drift is None else abs(drift),
         com_radius=(abs(v_tau / psi_dot) if psi_dot != 0 else math.inf)

@@ -107,9 +107,9 @@ def state_from_level(
     Returns
     -------
     y : ndarray, shape (18,)
-        Satisfies the meridian model's constraints; ``(M3, C1, C2, h)`` as given.
+        Satisfies the model's constraints (the level's: :attr:`LevelSet.model`); its
+        integrals and ``h`` as given.
     """
-    body = level.body
     if theta is not None:
         if not 0.0 < theta < math.pi:
             raise LevelSetError(f"theta = {theta!r} must lie strictly inside (0, pi)")
@@ -136,7 +136,7 @@ def state_from_level(
     nu = np.array([-gamma3 * gamma[0] / s, -gamma3 * gamma[1] / s, s])  # (e3 - gamma3 gamma)/s
     alpha = math.cos(psi) * nu + math.sin(psi) * tau
     beta = math.sin(psi) * nu - math.cos(psi) * tau
-    w = w_tau * tau + w_n * n + (level.M3 / body.I3) * e3
+    w = w_tau * tau + w_n * n + float(level.spin(theta)) * e3
     v = level.com_velocity(theta, w_tau, {"tau": tau, "n": n, "e3": e3, "gamma": gamma})
     y = np.empty(18)
     y[0:3], y[3:6], y[6:9], y[9:12], y[12:15] = v, w, alpha, beta, gamma
@@ -165,7 +165,6 @@ def states_on_level(level: LevelSet, gamma3: ArrayLike, w_tau: ArrayLike) -> Flo
     g3, wt = np.broadcast_arrays(np.asarray(gamma3, dtype=float), np.asarray(w_tau, dtype=float))
     if not np.all((g3 > -1.0) & (g3 < 1.0)):
         raise LevelSetError("gamma3 must lie strictly inside (-1, 1)")
-    body = level.body
     theta = np.arccos(g3)
     s = np.sin(theta)
     w_n = np.asarray(level.w_n(theta), dtype=float)
@@ -178,7 +177,7 @@ def states_on_level(level: LevelSet, gamma3: ArrayLike, w_tau: ArrayLike) -> Flo
     y[..., 0:3] = level.com_velocity(theta, wt, frame)
     y[..., 3] = -wt
     y[..., 4] = -w_n
-    y[..., 5] = level.M3 / body.I3
+    y[..., 5] = level.spin(theta)
     y[..., 7] = -g3
     y[..., 8] = s
     y[..., 9] = 1.0

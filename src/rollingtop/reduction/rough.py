@@ -1,0 +1,195 @@
+"""The rough model's reduction to one degree of freedom: Routh's sphere, rolling without slipping
+(``docs/model.md``, "Reductions of the other models").
+
+Rolling without slipping, ``v = r x w`` with the arm ``r = -R gamma - a3 e3`` from the centre of
+mass to the contact point; in the basis ``(tau, n, e3)`` of ``docs/model.md`` ("Reduced
+variables"), ``r = R s n - k e3`` with ``k = R cos(theta) + a3``. A dynamically symmetric body
+keeps its energy, Jellett's integral and Routh's (Routh, "Advanced Rigid Dynamics", Sec. 243;
+Borisov and Mamaev, "Rigid Body Dynamics", Sec. 2.4 of ch. 4):
+
+    jellett = (I w, r) = I1 R s w_n - I3 k w3,
+    routh   = w3 sqrt(f),   f = I1 I3 + m I1 R^2 s^2 + m I3 k^2,
+
+so on a level ``(jellett, routh)`` the spin and ``w_n`` are functions of ``theta``:
+
+    w3  = routh / sqrt(f),     w_n = (jellett + I3 k w3) / (I1 R s),
+
+and the energy ``h = E - m g R`` (the spin's energy is not constant here, so it stays in ``U``):
+
+    h   = rho(theta) w_tau^2 / 2 + U_r(theta),      theta' = -w_tau,
+    U_r = I1 w_n^2 / 2 + I3 w3^2 / 2 + m (R s w3 + k w_n)^2 / 2 + m g a3 cos(theta),
+    v   = (R s w3 + k w_n) tau - k w_tau n - R s w_tau e3   (so v_tau = R s w3 + k w_n),
+    rho = I1 + m (R^2 + a3^2 + 2 a3 R cos theta)   (the meridian model's: the same rolling
+                                                     along tau),
+
+from ``T = (I w, w)/2 + m |r x w|^2/2`` with ``|r x w|^2 = |r|^2 |w|^2 - (r, w)^2``.
+
+``w_n`` grows like ``1/s`` at a pole unless ``jellett + I3 k w3`` vanishes there: such a pole
+level (the vertical spin's, or a motion through the vertical) is refused for now; every other
+level has walls at both poles and its motions stay inside ``0 < theta < pi``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop.body import SphericalTop
+from rollingtop.reduction.level import (
+    ComplexArray,
+    LevelSet,
+    LevelSetError,
+    Real,
+    _Analytic,
+    _AnalyticResult,
+)
+
+__all__ = ["RoughLevel", "rough_integrals"]
+
+FloatArray = NDArray[np.float64]
+#: ``|jellett + I3 k w3|`` at a pole below this times the level's size is a pole level (refused).
+POLE_LEVEL_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class RoughLevel(LevelSet):
+    """A level set ``(jellett, routh)`` of Routh's sphere (module docstring): the methods of
+    :class:`~rollingtop.reduction.LevelSet` with the rough model's potential, spin and
+    centre-of-mass velocity. ``M3, C1, C2`` are not integrals of this model (0)."""
+
+    integrals: ClassVar[tuple[str, ...]] = ("jellett", "routh")
+    model: ClassVar[str] = "rough"
+
+    M3: float = 0.0
+    C1: float = 0.0
+    C2: float = 0.0
+    jellett: float = 0.0
+    routh: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("jellett", "routh"):
+            x = getattr(self, name)
+            if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
+                raise LevelSetError(f"level {name} = {x!r} must be a number")
+            if not math.isfinite(x):
+                raise LevelSetError(f"level {name} = {x!r} must be finite")
+            object.__setattr__(self, name, float(x))
+        for name in ("M3", "C1", "C2"):
+            object.__setattr__(self, name, 0.0)
+        if not self.body.symmetric:
+            raise LevelSetError(
+                f"the reduction needs a dynamically symmetric body (I1 = I2), got "
+                f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
+            )
+        object.__setattr__(self, "pole", None)
+        size = max(abs(self.jellett), abs(self.routh) * self.body.R, 1e-300)
+        for theta, name in ((0.0, "south (gamma3 = 1)"), (math.pi, "north (gamma3 = -1)")):
+            if abs(self._numerator(theta)) <= POLE_LEVEL_TOLERANCE * size:
+                raise LevelSetError(
+                    f"level {self.describe()} lets the {name} pole touch the plane (jellett + "
+                    "I3 k w3 = 0 there): the rough model's pole levels are not reduced yet"
+                )
+
+    def mirrored(self) -> RoughLevel:
+        """The same motions with the body axis reversed: ``theta -> pi - theta``,
+        ``a3 -> -a3``, ``w3 -> -w3`` (so ``routh -> -routh``), ``jellett`` kept."""
+        body = replace(self.body, a3=-self.body.a3)
+        return RoughLevel(body, jellett=self.jellett, routh=-self.routh)
+
+    # ---- the spin, w_n and their derivatives, complex-safe (the complex step of d2U) -------
+    def _parts(self, theta: Any) -> tuple[Any, ...]:
+        """``(s, c, k, w3, w_n)`` and their theta-derivatives ``(k', w3', w_n')``."""
+        b = self.body
+        s, c = np.sin(theta), np.cos(theta)
+        k, dk = b.R * c + b.a3, -b.R * s
+        f = b.I1 * b.I3 + b.m * b.I1 * b.R**2 * s**2 + b.m * b.I3 * k**2
+        df = 2 * b.m * b.R * s * (b.I1 * b.R * c - b.I3 * k)
+        w3 = self.routh / np.sqrt(f)
+        dw3 = -0.5 * w3 * df / f
+        N = self.jellett + b.I3 * k * w3
+        dN = b.I3 * (dw3 * k + w3 * dk)
+        w_n = N / (b.I1 * b.R * s)
+        dw_n = dN / (b.I1 * b.R * s) - w_n * c / s
+        return s, c, k, w3, w_n, dk, dw3, dw_n
+
+    def _numerator(self, theta: float) -> float:
+        """``jellett + I3 k w3`` at ``theta``: ``I1 R s w_n``, 0 at a pole of a pole level."""
+        b = self.body
+        k = b.R * math.cos(theta) + b.a3
+        s = math.sin(theta)
+        f = b.I1 * b.I3 + b.m * b.I1 * b.R**2 * s**2 + b.m * b.I3 * k**2
+        return self.jellett + b.I3 * k * self.routh / math.sqrt(f)
+
+    def spin(self, theta: Real) -> Real:
+        """``w3 = routh / sqrt(f)`` (module docstring)."""
+        out: Real = self._parts(theta)[3]
+        return out
+
+    def w_n(self, theta: Real) -> Real:
+        """``w_n = (jellett + I3 k w3) / (I1 R s)`` (module docstring)."""
+        out: Real = self._parts(theta)[4]
+        return out
+
+    def P(self, theta: Real) -> Real:
+        """``I1 v_tau``: rolling ties ``v_tau`` to the spin and ``w_n``. With ``v = r x w``,
+        ``r = R s n - k e3`` and the right-handed ``(tau, n, e3)``:
+        ``v = (R s w3 + k w_n) tau - k w_tau n - R s w_tau e3`` -- the meridian model's ``n`` and
+        ``e3`` components (:meth:`~rollingtop.reduction.LevelSet.com_velocity` serves both)."""
+        s, _, k, w3, w_n, _, _, _ = self._parts(theta)
+        out: Real = self.body.I1 * (self.body.R * s * w3 + k * w_n)
+        return out
+
+    def U(self, theta: Real) -> Real:
+        """``U_r`` (module docstring)."""
+        b = self.body
+        s, c, k, w3, w_n, _, _, _ = self._parts(theta)
+        A = b.R * s * w3 + k * w_n
+        U: Real = 0.5 * (b.I1 * w_n**2 + b.I3 * w3**2 + b.m * A**2) + b.m * b.g * b.a3 * c
+        return U
+
+    def dU(self, theta: _Analytic) -> _AnalyticResult:  # type: ignore[override]
+        """``dU_r/dtheta`` (analytic: the complex step of ``d2U`` goes through it)."""
+        b = self.body
+        s, c, k, w3, w_n, dk, dw3, dw_n = self._parts(theta)
+        A = b.R * s * w3 + k * w_n
+        dA = b.R * c * w3 + b.R * s * dw3 + dk * w_n + k * dw_n
+        out: _AnalyticResult = (b.I1 * w_n * dw_n + b.I3 * w3 * dw3 + b.m * A * dA
+                                - b.m * b.g * b.a3 * s)  # fmt: skip
+        return out
+
+    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
+        """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model)."""
+        rate: float | FloatArray = -self._parts(theta)[4] / np.sin(theta)
+        return rate
+
+    def full_energy(self, h: float) -> float:
+        """``E = h + m g R``: the spin's energy is part of ``U`` here."""
+        return h + self.body.m * self.body.g * self.body.R
+
+    #: :meth:`full_energy` in words.
+    energy_formula: ClassVar[str] = "h + m g R"
+
+    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
+        """``+-sqrt(-U''/rho)`` and 0 at the steady motion at ``gamma3`` (the reduced motion
+        ``(theta, w_tau)`` with the two integrals held)."""
+        theta = math.acos(gamma3)
+        root = np.sqrt(complex(-float(self.d2U(theta)) / float(self.rho(theta))))
+        return np.array([root, -root, 0.0], dtype=complex)
+
+    def describe(self) -> str:
+        """One line naming the level set."""
+        return f"jellett = {self.jellett:g}, routh = {self.routh:g}"
+
+
+def rough_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
+    """Jellett's and Routh's integrals and the reduced energy ``h = E - m g R`` of states ``Y``
+    (shape ``(..., 18)``) under the rough model, each of shape ``(...)``."""
+    from rollingtop.dynamics.integrals import energy, jellett, routh
+
+    Y = np.asarray(Y, dtype=float)
+    h = energy(body, Y) - body.m * body.g * body.R
+    return {"jellett": jellett(body, Y), "routh": routh(body, Y), "h": h}

@@ -1,0 +1,288 @@
+"""The reductions of the smooth and rough models (rollingtop.reduction.smooth, .rough) against
+independent sources: the full equations of tests/dynamics/reference.py integrated by solve_ivp,
+mpmath quadrature, and the integrals of the full state."""
+
+import math
+import tomllib
+from dataclasses import replace
+
+import mpmath as mp
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rollingtop import INTEGRALS, ScenarioError, initial_state
+from rollingtop.reduction import (
+    RoughLevel,
+    SmoothLevel,
+    orbits,
+    reduction_of,
+    state_from_level,
+    states_on_level,
+    steady_motions,
+)
+from rollingtop.scenario import Scenario
+
+from ..dynamics import reference
+
+FULL_RTOL = 1e-12  # solve_ivp's rtol for the full system (issue 24: <= 1e-12)
+AGREE = 1e-8  # issue 24: turning points, period and delta_psi against the full system
+QUAD_RTOL = 1e-10  # the period's quadrature against mpmath
+STEADY_DRIFT = 1e-9  # issue 24: gamma3 on a steady motion over 10 periods
+STATE_TOL = 1e-12  # integrals of a reconstructed state
+
+
+MODELS = ["smooth", "rough"]
+
+
+@pytest.fixture(params=[0.1, -0.1], ids=["com_above", "com_below"])
+def body(request, paper_body):
+    """The paper's body with its centre of mass above (a3 > 0) or below the sphere's centre."""
+    return replace(paper_body, a3=request.param)
+
+
+def _state(model, body, gamma, omega):
+    free = {"v_horizontal": (0.25, 0.0)} if model == "smooth" else None
+    return initial_state(body, model, gamma=gamma, omega=omega, free=free)
+
+
+def _random_level(model, body, rng):
+    """A level of ``model`` from a random state (every level a state can have)."""
+    while True:
+        g = rng.normal(size=3)
+        g /= np.linalg.norm(g)
+        if abs(g[2]) < 0.9:
+            y = _state(model, body, g, rng.normal(size=3))
+            return reduction_of(model).level_of_state(body, y), y
+
+
+def _full_run(model, body, y0, t_end):
+    """The full system of ``model`` (reference.rhs, not the package's kernels) by solve_ivp,
+    with the maxima and the minima of gamma3 as events."""
+    p = body.params
+
+    def f(t, y):
+        return reference.rhs(model, p, y)[0]
+
+    def top(t, y):  # gamma3' = (gamma x w)_3 turning from + to -
+        return y[12] * y[4] - y[13] * y[3]
+
+    def bottom(t, y):
+        return top(t, y)
+
+    top.direction = -1
+    bottom.direction = 1
+    return solve_ivp(f, (0.0, t_end), y0, method="DOP853", rtol=FULL_RTOL, atol=1e-13,
+                     events=(top, bottom), dense_output=True)  # fmt: skip
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_reconstructed_state_has_its_level_and_energy(model, body, rng):
+    """state_from_level: on the model's constraints, with the level's integrals, and the energy
+    computed from the full state (INTEGRALS) is the level's full_energy(h)."""
+    reduction = reduction_of(model)
+    for _ in range(20):
+        level, _ = _random_level(model, body, rng)
+        theta = rng.uniform(0.3, 2.8)
+        h = float(level.U(theta)) + rng.uniform(0.0, 1.0)
+        y = state_from_level(level, h, math.cos(theta), branch=int(rng.choice([-1, 1])),
+                             phi=rng.uniform(0, 6), psi=rng.uniform(0, 6))  # fmt: skip
+        assert np.max(np.abs(reference.residuals(model, body.params, y))) < STATE_TOL
+        E = INTEGRALS["energy"](body, y)
+        assert E == pytest.approx(level.full_energy(h), rel=STATE_TOL, abs=STATE_TOL)
+        values = reduction.integrals(body, y)
+        for name, expected in level.values().items():
+            assert values[name] == pytest.approx(expected, abs=STATE_TOL)
+        assert values["h"] == pytest.approx(h, abs=STATE_TOL)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_states_on_level_are_the_states_of_state_from_level(model, body, rng):
+    level, _ = _random_level(model, body, rng)
+    c = steady_motions(level)[0].theta
+    theta = np.array([c - 0.05, c, c + 0.05])
+    w_tau = np.array([0.3, -0.1, 0.0])
+    Y = states_on_level(level, np.cos(theta), w_tau)
+    for t, wt, y in zip(theta, w_tau, Y, strict=True):
+        h = float(level.energy(t, wt))
+        expected = state_from_level(level, h, math.cos(t), branch=1 if wt >= 0 else -1)
+        np.testing.assert_allclose(y[:15], expected[:15], atol=1e-12)
+
+
+def _mp_potential(level):
+    """The level's U and rho written again in mpmath from the module docstrings' formulas."""
+    b = level.body
+    if isinstance(level, SmoothLevel):
+        M3, C1 = level.M3, level.C1
+
+        def U(t):
+            return ((C1 - M3 * mp.cos(t)) ** 2 / (2 * b.I1 * mp.sin(t) ** 2)
+                    + b.m * b.g * b.a3 * mp.cos(t) + level.p_horizontal**2 / (2 * b.m))  # fmt: skip
+
+        def rho(t):
+            return b.I1 + b.m * b.a3**2 * mp.sin(t) ** 2
+
+        return U, rho
+    J, D = level.jellett, level.routh
+
+    def U(t):
+        s, k = mp.sin(t), b.R * mp.cos(t) + b.a3
+        w3 = D / mp.sqrt(b.I1 * b.I3 + b.m * b.I1 * b.R**2 * s**2 + b.m * b.I3 * k**2)
+        w_n = (J + b.I3 * k * w3) / (b.I1 * b.R * s)
+        return (b.I1 * w_n**2 + b.I3 * w3**2 + b.m * (b.R * s * w3 + k * w_n) ** 2) / 2 + (
+            b.m * b.g * b.a3 * mp.cos(t)
+        )
+
+    def rho(t):
+        return b.I1 + b.m * (b.R**2 + b.a3**2 + 2 * b.a3 * b.R * mp.cos(t))
+
+    return U, rho
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_period_agrees_with_mpmath(model, body, rng):
+    """T = 2 int sqrt(rho / (2 (h - U))) dtheta between the turning points, by mpmath's
+    tanh-sinh rule (which takes the endpoint singularities) at 30 digits, with U and rho
+    written again from the formulas."""
+    level, _ = _random_level(model, body, rng)
+    h = float(steady_motions(level)[0].U) + 0.3
+    o = orbits(level, h)[0]
+    U, rho = _mp_potential(level)
+    with mp.workdps(30):
+        lo = mp.findroot(lambda t: U(t) - h, o.theta_min)
+        hi = mp.findroot(lambda t: U(t) - h, o.theta_max)
+        T = 2 * mp.quad(lambda t: mp.sqrt(rho(t) / (2 * (h - U(t)))), [lo, hi])
+    assert o.theta_min == pytest.approx(float(lo), abs=1e-13)
+    assert o.theta_max == pytest.approx(float(hi), abs=1e-13)
+    assert o.period == pytest.approx(float(T), rel=QUAD_RTOL)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_orbits_from_an_initial_state_agree_with_the_full_system(model, body):
+    """Issue 24's criterion: a scenario with only [initial] has exactly one orbit through its
+    gamma3, whose turning points, period and delta_psi agree with solve_ivp on the full
+    equations to 1e-8."""
+    y0 = _state(model, body, [0.0, 0.6, 0.8], [0.7, -0.3, 2.0])
+    reduction = reduction_of(model)
+    level = reduction.level_of_state(body, y0)
+    h = reduction.reduced_energy(body, y0)
+    found = [o for o in orbits(level, h) if o.gamma3_min <= y0[14] <= o.gamma3_max]
+    assert len(found) == 1 and found[0].kind == "periodic"
+    o = found[0]
+    sol = _full_run(model, body, y0, 4.2 * o.period)
+    t_top, y_top = sol.t_events[0], sol.y_events[0]
+    assert len(t_top) >= 3
+    np.testing.assert_allclose(np.diff(t_top), o.period, rtol=AGREE)
+    np.testing.assert_allclose(y_top[:, 14], o.gamma3_max, atol=AGREE)
+    ts = np.linspace(t_top[0], t_top[1], 4001)
+    g3 = sol.sol(ts)[14]
+    assert g3.min() == pytest.approx(o.gamma3_min, abs=1e-6)  # sampled: the bound only
+    # the axis's azimuth (its horizontal projection in the fixed frame) over one period
+    psi = [math.atan2(y[11], y[8]) for y in y_top[:2]]
+    advance = sol.sol(np.linspace(t_top[0], t_top[1], 200))
+    unwrapped = np.unwrap(np.arctan2(advance[11], advance[8]))
+    dpsi = unwrapped[-1] - unwrapped[0]
+    assert math.remainder(psi[1] - psi[0] - dpsi, 2 * math.pi) == pytest.approx(0.0, abs=1e-9)
+    from rollingtop.survey import survey_orbits
+
+    (row,) = [r for r in survey_orbits(level, h) if r.orbit == o]
+    assert row.period_map is not None
+    assert row.period_map.delta_psi == pytest.approx(dpsi, abs=AGREE)
+    if model == "smooth":  # the centre of mass drifts uniformly at |v_horizontal|
+        assert row.period_map.motion == "drifting"
+        assert math.hypot(*row.period_map.drift_velocity) == pytest.approx(0.25, rel=1e-12)
+    else:  # the CoM's displacement over a period: the full system's
+        # from the lowest turning point, the map's canonical start (PeriodMap)
+        t_bottom = sol.t_events[1]
+        start, end = sol.sol(t_bottom[0]), sol.sol(t_bottom[1])
+        moved = complex(end[15] - start[15], end[16] - start[16])
+        assert abs(moved) == pytest.approx(math.hypot(*row.period_map.displacement), rel=1e-7)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_steady_motion_stays_steady(model, body, rng):
+    """Started on a centre of U (w_tau = 0), the full system keeps gamma3 within 1e-9 over 10
+    periods of the nearby orbits."""
+    level, _ = _random_level(model, body, rng)
+    m = [m for m in steady_motions(level) if m.type == "center"][0]
+    y0 = state_from_level(level, m.U, m.gamma3)
+    sol = _full_run(model, body, y0, 10 * m.period)
+    g3 = sol.sol(np.linspace(0.0, 10 * m.period, 2001))[14]
+    assert np.max(np.abs(g3 - m.gamma3)) < STEADY_DRIFT
+    # and its frequency is the small oscillations' (the limit of nearby orbits' periods)
+    near = [o for o in orbits(level, m.U + 1e-8) if o.theta_min <= m.theta <= o.theta_max][0]
+    assert near.period == pytest.approx(m.period, rel=1e-4)
+
+
+def test_a_level_table_of_the_smooth_model():
+    """[level] takes the smooth model's own integrals; C2 is refused with the right names."""
+    base = """
+[body]
+R = 1.0
+m = 1.0
+g = 1.0
+a3 = 0.1
+I1 = 0.3
+I3 = 0.5
+[contact]
+model = "smooth"
+[level]
+M3 = 1.0
+C1 = 0.5
+h = 0.8
+"""
+    sc = Scenario.from_dict(tomllib.loads(base))
+    level = sc.level_set()
+    assert isinstance(level, SmoothLevel) and level.values() == {
+        "M3": 1.0, "C1": 0.5, "p_horizontal": 0.0}  # fmt: skip
+    y0 = sc.require_state()
+    assert reduction_of("smooth").reduced_energy(sc.body, y0) == pytest.approx(0.8, abs=1e-12)
+    with pytest.raises(ScenarioError, match=r"level\.C2 for the smooth model \(its level: M3, "
+                                            r"C1, p_horizontal"):  # fmt: skip
+        Scenario.from_dict(tomllib.loads(base + "C2 = -2.0\n"))
+
+
+def test_models_without_a_reduction_are_refused_in_one_line():
+    with pytest.raises(ScenarioError, match="parallel model has no reduction.*section.*chaos"):
+        reduction_of("parallel")
+
+
+def test_every_declared_reduction_is_registered_with_the_same_names():
+    """ContactModel.reduction (the declaration the contact package makes) names what
+    rollingtop.reduction.models builds."""
+    from rollingtop.contact import MODELS
+    from rollingtop.reduction import REDUCTIONS
+
+    declared = {name: m.reduction for name, m in MODELS.items() if m.reduction}
+    assert declared == {name: r.names for name, r in REDUCTIONS.items()}
+    assert set(declared) == {"meridian", "smooth", "rough"}
+
+
+def test_a_rough_pole_level_is_refused_in_one_line(paper_body):
+    """The vertical spin's level (jellett + I3 k w3 = 0 at gamma3 = 1) is not reduced yet."""
+    b = paper_body
+    k = b.R + b.a3
+    routh = 1.0
+    w3 = routh / math.sqrt(b.I1 * b.I3 + b.m * b.I3 * k**2)
+    with pytest.raises(Exception, match="south.*pole levels are not reduced yet"):
+        RoughLevel(b, jellett=-b.I3 * k * w3, routh=routh)
+
+
+@pytest.mark.parametrize("model", ["meridian", *MODELS])
+def test_the_normal_force_of_a_level_is_the_full_systems(model, body, rng):
+    """LevelSet.normal_force (the portraits' shading, NumPy) against the contact force of the
+    full equations (reference.rhs) at the reconstructed states: its component along gamma."""
+    if model == "meridian":
+        level = reduction_of(model).level_of_state(
+            body, initial_state(body, model, gamma=[0.0, 0.6, 0.8], omega=[0.7, -0.3, 2.0])
+        )
+    else:
+        level, _ = _random_level(model, body, rng)
+    c = steady_motions(level)[0].theta
+    for theta, w_tau in ((c, 0.0), (c - 0.05, 0.4), (c + 0.05, -0.3)):
+        h = float(level.energy(theta, w_tau))
+        y = state_from_level(level, h, math.cos(theta), branch=1 if w_tau >= 0 else -1)
+        force = reference.rhs(model, body.params, y)[1]
+        assert float(level.normal_force(theta, w_tau)) == pytest.approx(
+            float(force @ y[12:15]), rel=1e-10, abs=1e-12
+        )
