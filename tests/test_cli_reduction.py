@@ -116,3 +116,27 @@ def test_level_table_errors(capsys, tmp_path):
     )
     code, _, err = run_cli(capsys, "simulate", str(tmp_path / "s.toml"))
     assert code == 2 and "no initial state" in err
+
+
+@pytest.mark.parametrize("name", ["smooth", "rough"])
+def test_orbits_json_of_the_other_reduced_models(capsys, name):
+    """Issue 24: `orbits --json` on a scenario with only [initial] lists exactly one orbit
+    through the initial gamma3, under the model's own level (its integrals by name); its
+    numbers are held to the full system in tests/reduction/test_models.py."""
+    from rollingtop.reduction import reduction_of
+    from rollingtop.scenario import load_scenario
+
+    path = str(EXAMPLES / f"{name}.toml")
+    code, out, err = run_cli(capsys, "orbits", path, "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    sc = load_scenario(path)
+    names = reduction_of(name).names
+    assert data["level"]["model"] == name and set(names) <= set(data["level"])
+    g3 = sc.require_state()[14]
+    through = [o for o in data["orbits"] if o["gamma3_min"] <= g3 <= o["gamma3_max"]]
+    assert len(through) == 1 and through[0]["kind"] == "periodic"
+    assert {"gamma3_min", "gamma3_max", "period", "period_error", "delta_psi"} <= set(through[0])
+    code, out, err = run_cli(capsys, "equilibria", path, "--json")
+    assert code == 0 and all({"gamma3", "type", "U", "frequency"} <= set(e)
+                             for e in json.loads(out)["equilibria"])  # fmt: skip
