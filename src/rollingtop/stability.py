@@ -18,7 +18,7 @@ A model whose constraint is singular at the vertical supplies its own eigenvalue
 (:attr:`~rollingtop.contact.ContactModel.vertical_eigenvalues`), or declares that they come from
 the reduction (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`: the meridian
 model, whose eigenvalues are those of the reduced motion on the pole level,
-:func:`rollingtop.reduction.level.pole_eigenvalues`; computed here, so that the contact package
+:func:`rollingtop.stability.pole_eigenvalues`; computed here, so that the contact package
 never imports the reduction). A model may also give a closed form of the threshold
 (:attr:`~rollingtop.contact.ContactModel.vertical_spin`), which is reported beside the one found
 from the eigenvalues.
@@ -42,7 +42,6 @@ from rollingtop._numdiff import central_jacobian
 from rollingtop._types import ComplexArray, FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.reduction.level import pole_eigenvalues
 
 __all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]
 
@@ -259,3 +258,21 @@ def vertical_spins(body: SphericalTop, model: str | ContactModel) -> list[Vertic
             closed = float(model.vertical_spin(body, sign))
         out.append(VerticalSpin(pole, sign * body.a3 > 0.0, _critical(body, model, pole), closed))
     return out
+
+
+def pole_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
+    """Eigenvalues of the reduced linearisation at the vertical spin ``omega3`` on the pole
+    ``pole`` (+1 south, ``gamma3 = 1``; -1 north): ``+-sqrt(-U''/rho)`` at the pole of the pole
+    level ``(M3 = I3 omega3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north, the value
+    of ``F6`` at the vertical spin); the other directions are integrals (0). The meridian model's
+    vertical spin (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`,
+    :mod:`rollingtop.stability`); ``body`` must be dynamically symmetric."""
+    M3 = body.I3 * omega3
+    C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3
+    from rollingtop.reduction.level import LevelSet
+
+    level = LevelSet(body, M3, pole * M3, C2)
+    theta = 0.0 if pole > 0 else math.pi
+    lam2 = -float(level.d2U(theta)) / float(level.rho(theta))
+    root = np.sqrt(complex(lam2))
+    return np.array([root, -root, 0.0, 0.0], dtype=complex)

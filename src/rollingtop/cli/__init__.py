@@ -6,6 +6,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._simulate`: ``simulate``;
 - :mod:`._level`: ``equilibria``, ``orbits``, ``portrait`` (the reduction);
 - :mod:`._bifurcation`: ``bifurcation`` (the classification of the reduced motions);
+- :mod:`._classification`: ``compare-classification`` (every reduced model side by side);
 - :mod:`._rotation`: ``rotation`` (rotation numbers, classes of motion in absolute space);
 - :mod:`._stability`: ``stability`` (vertical spins under one model or every one);
 - :mod:`._atlas`: ``atlas`` (the classification over a parameter grid, on Dask);
@@ -22,6 +23,7 @@ from rollingtop.cli._app import cli
 from rollingtop.cli._atlas import atlas
 from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._chaos import chaos, section
+from rollingtop.cli._classification import compare_classification
 from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
@@ -33,9 +35,9 @@ from rollingtop.cli._warmup import warmup
 
 __all__ = ["cli", "main"]
 
-for _command in (simulate, equilibria, orbits, portrait, bifurcation, rotation, stability, atlas,
-                 path, plot, compare, animate, ensemble, section, chaos, verify,
-                 warmup):  # fmt: skip
+for _command in (simulate, equilibria, orbits, portrait, bifurcation, compare_classification,
+                 rotation, stability, atlas, path, plot, compare, animate, ensemble, section,
+                 chaos, verify, warmup):  # fmt: skip
     cli.add_command(_command)
 
 

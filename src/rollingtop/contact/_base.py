@@ -131,7 +131,7 @@ class ContactModel:
         Whether the vertical spin is analysed through the reduction instead (the meridian
         model, singular at the vertical, with :attr:`has_reduction`): the eigenvalues are those
         of the reduced motion at the pole of the pole level
-        (:func:`rollingtop.reduction.level.pole_eigenvalues`), which
+        (:func:`rollingtop.stability.pole_eigenvalues`), which
         :mod:`rollingtop.stability` computes. A declaration only: the contact package
         never imports the reduction.
     carries_direction : bool

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, TypeAlias, TypeVar, overload
+from typing import Any, ClassVar, TypeAlias, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,13 +32,11 @@ from numpy.typing import NDArray
 from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
+from rollingtop.reduction._services import LevelServices, Real
 
-__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real", "near_north", "pole_eigenvalues"]
+__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real", "near_north"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
-#: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
-#: a float gives a float (a numpy float) and an array of shape ``(...)`` an array of that shape.
-Real = TypeVar("Real", float, FloatArray)
 ComplexArray: TypeAlias = NDArray[np.complex128]
 #: ``theta`` for :meth:`LevelSet.dU`, also complex (the complex step of ``d2U``).
 _Analytic: TypeAlias = float | FloatArray | ComplexArray
@@ -60,7 +58,7 @@ class LevelSetError(RollingTopError):
 
 
 @dataclass(frozen=True)
-class LevelSet:
+class LevelSet(LevelServices):
     """A level set ``(M3, C1, C2)`` of the linear integrals of the meridian model.
 
     Parameters
@@ -97,9 +95,6 @@ class LevelSet:
     inside the wall (see :meth:`_q`).
     """
 
-    #: The integrals that name the level, in order (:attr:`ContactModel.reduction`): the keys
-    #: of a ``[level]`` table and of the level in JSON output (:meth:`values`).
-    integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "C2")
     #: The contact model whose reduction this is (:mod:`rollingtop.reduction.models`).
     model: ClassVar[str] = "meridian"
 
@@ -348,74 +343,16 @@ class LevelSet:
         w_tau_dot: Real = (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
         return -w_tau, w_tau_dot
 
-    #: :meth:`full_energy` in words.
-    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
-
-    def full_energy(self, h: float) -> float:
-        """The energy ``E`` of the full system on this level at reduced energy ``h``:
-        ``h + M3^2 / (2 I3) + m g R`` (:func:`rollingtop.reduction.start.level_energy`)."""
-        b = self.body
-        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
-
-    def spin(self, theta: Real) -> Real:
-        """The spin ``w3`` at ``theta``: ``M3 / I3``, constant (Lagrange's integral)."""
-        out: Real = self.M3 / self.body.I3 + 0.0 * theta
-        return out
-
-    def normal_force(self, theta: Real, w_tau: Real) -> Real:
-        """The plane's normal force at ``(theta, w_tau)`` on the level: the centre of mass is at
-        height ``R + a3 gamma3`` and only gravity and the normal force act on it vertically
-        (every model's other reactions are horizontal), so ``N = m (g + a3 gamma3'')`` with
-        ``gamma3'' = s w_tau' - gamma3 w_tau^2`` and ``w_tau'`` from :meth:`flow`. NumPy only:
-        the reduction's pictures need no compiled code."""
-        b = self.body
-        _, dw = self.flow(theta, w_tau)
-        N: Real = b.m * (b.g + b.a3 * (np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau))
-        return N
-
-    def uniform_drift(self) -> complex | None:
-        """The centre of mass's horizontal velocity ``X' + i Y'`` in the fixed frame of
-        :mod:`rollingtop.absolute` when it is constant (a model with conserved horizontal
-        momentum), else ``None``: the meridian model's turns with the axis
-        (:func:`rollingtop.absolute.period_map`)."""
-        return None
-
-    def values(self) -> dict[str, float]:
-        """The level's integrals by name (:attr:`integrals`)."""
-        return {name: float(getattr(self, name)) for name in self.integrals}
-
-    def com_velocity(self, theta: Real, w_tau: Real, frame: dict[str, FloatArray]) -> FloatArray:
-        """The centre of mass's velocity (body frame) at ``theta`` with ``w_tau``, from the
-        constraints and :meth:`v_tau`: ``v_tau tau - (R gamma3 + a3) w_tau n - R s w_tau e3``
-        (``docs/model.md``, "Reduced variables"). ``frame`` holds the unit vectors ``tau, n, e3,
-        gamma`` (shape ``(..., 3)``, broadcast with ``theta`` and ``w_tau`` of shape ``(...)``).
-        """
-        b = self.body
-        t = np.asarray(theta, dtype=float)[..., None]
-        wt = np.asarray(w_tau, dtype=float)[..., None]
-        v_tau = (np.asarray(self.v_tau(theta), dtype=float) + 0.0 * wt[..., 0])[..., None]
-        v: FloatArray = (v_tau * frame["tau"] - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
-                         - b.R * np.sin(t) * wt * frame["e3"])  # fmt: skip
-        return v
-
     def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
         """Eigenvalues of the reduced equations (eq. 3.3) linearised at the steady motion at
         ``gamma3``, by central differences of :func:`rollingtop.reduction.reduced_rhs` at
         ``(gamma3, v_tau, w_n, 0)`` (:func:`rollingtop.reduction.steady.linearised_eigenvalues`
         says why)."""
-        from rollingtop._numdiff import DIFF_STEP, central_jacobian
-        from rollingtop.reduction.system import reduced_rhs
+        from rollingtop.reduction.system import reduced_eigenvalues
 
         theta = math.acos(gamma3)
         x0 = np.array([gamma3, float(self.v_tau(theta)), float(self.w_n(theta)), 0.0])
-        steps = DIFF_STEP * np.maximum(1.0, np.abs(x0))
-        # stay inside (-1, 1): near a pole the step in gamma3 shrinks with the distance to it
-        steps[0] = min(steps[0], 0.25 * (1.0 - abs(gamma3)))
-        D = central_jacobian(lambda x: reduced_rhs(self.body, self.M3, x), x0, steps)
-        if not np.all(np.isfinite(D)):  # a steady motion at round-off distance from a pole
-            return np.full(4, complex(math.nan, math.nan))
-        out: ComplexArray = np.linalg.eigvals(D).astype(complex)
-        return out
+        return reduced_eigenvalues(self.body, self.M3, x0)
 
     def describe(self) -> str:
         """One line naming the level set."""
@@ -432,19 +369,3 @@ def near_north(level: LevelSet) -> bool:
     """A level that is no pole case and lies nearer ``C1 = -M3`` than ``C1 = M3``: computed on
     its mirror image (:meth:`LevelSet.mirrored`)."""
     return level.pole is None and abs(level.M3 + level.C1) < abs(level.M3 - level.C1)
-
-
-def pole_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
-    """Eigenvalues of the reduced linearisation at the vertical spin ``omega3`` on the pole
-    ``pole`` (+1 south, ``gamma3 = 1``; -1 north): ``+-sqrt(-U''/rho)`` at the pole of the pole
-    level ``(M3 = I3 omega3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north, the value
-    of ``F6`` at the vertical spin); the other directions are integrals (0). The meridian model's
-    vertical spin (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`,
-    :mod:`rollingtop.stability`); ``body`` must be dynamically symmetric."""
-    M3 = body.I3 * omega3
-    C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3
-    level = LevelSet(body, M3, pole * M3, C2)
-    theta = 0.0 if pole > 0 else math.pi
-    lam2 = -float(level.d2U(theta)) / float(level.rho(theta))
-    root = np.sqrt(complex(lam2))
-    return np.array([root, -root, 0.0, 0.0], dtype=complex)

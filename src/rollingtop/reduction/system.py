@@ -26,6 +26,7 @@ from rollingtop.dynamics.integrals import F6_reduced
 __all__ = ["normal_force", "reduced_rhs", "reduced_integrals_of", "integrate_reduced"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
+ComplexArray: TypeAlias = NDArray[np.complex128]
 
 
 def reduced_rhs(body: SphericalTop, M3: float, x: FloatArray) -> FloatArray:
@@ -126,3 +127,19 @@ def integrate_reduced(
         raise RuntimeError(f"reduced integration failed: {sol.message}")
     y: FloatArray = sol.y
     return y
+
+
+def reduced_eigenvalues(body: SphericalTop, M3: float, x0: FloatArray) -> ComplexArray:
+    """Eigenvalues of :func:`reduced_rhs` linearised at the reduced state ``x0`` (shape (4,)),
+    by central differences (:meth:`rollingtop.reduction.LevelSet.linearised_eigenvalues`);
+    NaN where the differences leave the domain (round-off distance from a pole)."""
+    from rollingtop._numdiff import DIFF_STEP, central_jacobian
+
+    steps = DIFF_STEP * np.maximum(1.0, np.abs(x0))
+    # stay inside (-1, 1): near a pole the step in gamma3 shrinks with the distance to it
+    steps[0] = min(steps[0], 0.25 * (1.0 - abs(float(x0[0]))))
+    D = central_jacobian(lambda x: reduced_rhs(body, M3, x), x0, steps)
+    if not np.all(np.isfinite(D)):
+        return np.full(4, complex(np.nan, np.nan))
+    out: ComplexArray = np.linalg.eigvals(D).astype(complex)
+    return out

@@ -1,0 +1,114 @@
+"""The reduced models side by side (:func:`rollingtop.reduction.classify.classify_models`): for
+one body started one way, each integrable model's effective potential, phase portrait and
+critical values, with the state marked."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TypeAlias
+
+import numpy as np
+from matplotlib.figure import Figure
+from numpy.typing import NDArray
+
+from rollingtop.contact import get_model
+from rollingtop.reduction.classify import ModelClassification
+
+__all__ = ["classification_figure"]
+
+FloatArray: TypeAlias = NDArray[np.float64]
+#: Labels of the integrals in the figure (mathtext).
+SYMBOLS = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}",
+           "jellett": r"\mathrm{jellett}", "routh": r"\mathrm{routh}"}  # fmt: skip
+
+
+def _window(c: ModelClassification) -> tuple[float, float, float, float]:
+    """``gamma3`` and ``U`` limits: the orbit through the state and the steady motions, with a
+    margin."""
+    g = [float(c.state[14])] + [m.gamma3 for m in c.steady]
+    if c.orbit is not None:
+        g += [c.orbit.gamma3_min, c.orbit.gamma3_max]
+    lo, hi = min(g), max(g)
+    pad = max(0.15 * (hi - lo), 0.05)
+    g_lo, g_hi = max(-0.999, lo - pad), min(0.999, hi + pad)
+    u_min = min([c.h] + [m.U for m in c.steady])
+    span = max(c.h - u_min, 1e-3)
+    return g_lo, g_hi, u_min - 0.2 * span, c.h + 0.8 * span
+
+
+def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
+    """One column per model: ``U(gamma3)`` with the state's ``h``, the phase portrait
+    ``(gamma3, w_tau)`` with the orbit through the state, and the critical values of the
+    reduced energy along the model's axis integral with the state's level marked.
+
+    Parameters
+    ----------
+    classes : sequence of ModelClassification
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    n = len(classes)
+    fig = Figure(figsize=(3.6 * n + 0.4, 9.6), layout="constrained")
+    axes = fig.subplots(3, n, squeeze=False)
+    for j, c in enumerate(classes):
+        colour = get_model(c.model).colour
+        level = c.level
+        g_lo, g_hi, u_lo, u_hi = _window(c)
+        gamma3 = np.linspace(g_lo, g_hi, 600)
+        theta = np.arccos(gamma3)
+        U = np.asarray(level.U(theta), dtype=float)
+        ax = axes[0, j]
+        ax.plot(gamma3, U, color=colour, lw=1.6)
+        ax.axhline(c.h, color="0.3", lw=0.8, ls="--", label="h of the state")
+        ax.plot([c.state[14]], [c.h], "k*", ms=9, label="the state")
+        for m in c.steady:
+            ax.plot([m.gamma3], [m.U], "o" if m.type == "center" else "x", color="k", ms=5)
+        ax.set_ylim(u_lo, u_hi)
+        ax.set_xlim(g_lo, g_hi)
+        named = r",\ ".join(f"{SYMBOLS.get(k, k)}={v:.4g}" for k, v in level.values().items())
+        ax.set_title(f"{c.model}\n${named}$", fontsize=9)
+        ax.set_xlabel(r"$\gamma_3$")
+        if j == 0:
+            ax.set_ylabel(r"$U(\gamma_3)$")
+            ax.legend(fontsize=7, loc="upper center", frameon=False)
+        # the phase portrait: level curves of h on (gamma3, w_tau), the state's own in black
+        ax = axes[1, j]
+        w_top = 1.3 * math.sqrt(max(2 * (u_hi - float(np.min(U))), 1e-6) / float(
+            np.min(level.rho(theta))))  # fmt: skip
+        w = np.linspace(-w_top, w_top, 301)
+        G, Wt = np.meshgrid(gamma3, w)
+        H = np.asarray(level.energy(np.arccos(G), Wt), dtype=float)
+        ax.contour(G, Wt, H, levels=np.linspace(u_lo, u_hi, 12)[1:], colors=colour,
+                   linewidths=0.6, alpha=0.7)  # fmt: skip
+        ax.contour(G, Wt, H, levels=[c.h], colors="k", linewidths=1.5)
+        ax.plot([c.state[14]], [float(np.dot(c.state[3:6], _tau(c.state)))], "k*", ms=9)
+        ax.set_xlabel(r"$\gamma_3$")
+        if j == 0:
+            ax.set_ylabel(r"$\omega_\tau$")
+        # the critical values along the axis integral
+        ax = axes[2, j]
+        cv = c.critical
+        pts = cv.points
+        for kind, marker, label in ((1.0, "o", "centre"), (-1.0, "x", "saddle")):
+            sel = pts[:, 3] == kind
+            ax.plot(pts[sel, 0], pts[sel, 2], marker, color=colour if kind > 0 else "k", ms=2.5,
+                    ls="none", label=label)  # fmt: skip
+        ax.plot([level.values()[cv.axis]], [c.h], "k*", ms=9, label="the state's level")
+        ax.set_xlabel(f"${SYMBOLS.get(cv.axis, cv.axis)}$")
+        if j == 0:
+            ax.set_ylabel("critical values of $h$")
+            ax.legend(fontsize=7, frameon=False)
+        fixed = ", ".join(f"{k} = {v:.3g}" for k, v in cv.fixed.items())
+        ax.set_title(f"at {fixed}", fontsize=8)
+    return fig
+
+
+def _tau(y: FloatArray) -> FloatArray:
+    """``tau = e3 x gamma / s`` of the state ``y`` (body frame)."""
+    g = y[12:15]
+    s = math.hypot(g[0], g[1])
+    out: FloatArray = np.array([-g[1], g[0], 0.0]) / s
+    return out

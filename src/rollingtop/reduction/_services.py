@@ -1,0 +1,94 @@
+"""What every model's level set provides besides its potential and mass: its integrals by
+name, the full energy and the spin, the centre of mass's velocity, the normal force and a
+uniform drift (:class:`LevelServices`, a base of :class:`~rollingtop.reduction.LevelSet`).
+
+The defaults are the meridian model's; the other models' levels
+(:mod:`rollingtop.reduction.smooth`, :mod:`rollingtop.reduction.rough`) override what differs.
+Everything downstream (steady motions, orbits, portraits, starting a motion on a level, the
+motion in absolute space) asks the level through these, whatever the model.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar, TypeAlias, TypeVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rollingtop.body import SphericalTop
+
+__all__ = ["LevelServices", "Real"]
+
+FloatArray: TypeAlias = NDArray[np.float64]
+#: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
+#: a float gives a float (a numpy float) and an array of shape ``(...)`` an array of that shape.
+Real = TypeVar("Real", float, FloatArray)
+
+
+class LevelServices:
+    """The services of a level set (module docstring); a level provides ``body``, ``M3``,
+    :attr:`integrals`, ``v_tau(theta)`` and ``flow(theta, w_tau)``."""
+
+    body: SphericalTop
+    M3: float
+    #: The integrals that name the level, in order (:attr:`ContactModel.reduction`): the keys
+    #: of a ``[level]`` table and of the level in JSON output (:meth:`values`).
+    integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "C2")
+
+    def v_tau(self, theta: Any) -> Any:
+        """``v_tau`` at ``theta`` (the level's own)."""
+        raise NotImplementedError
+
+    def flow(self, theta: Any, w_tau: Any) -> tuple[Any, Any]:
+        """``(theta', w_tau')`` (the level's own)."""
+        raise NotImplementedError
+
+    #: :meth:`full_energy` in words.
+    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
+
+    def full_energy(self, h: float) -> float:
+        """The energy ``E`` of the full system on this level at reduced energy ``h``:
+        ``h + M3^2 / (2 I3) + m g R`` (:func:`rollingtop.reduction.start.level_energy`)."""
+        b = self.body
+        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
+
+    def spin(self, theta: Real) -> Real:
+        """The spin ``w3`` at ``theta``: ``M3 / I3``, constant (Lagrange's integral)."""
+        out: Real = self.M3 / self.body.I3 + 0.0 * theta
+        return out
+
+    def normal_force(self, theta: Real, w_tau: Real) -> Real:
+        """The plane's normal force at ``(theta, w_tau)`` on the level: the centre of mass is at
+        height ``R + a3 gamma3`` and only gravity and the normal force act on it vertically
+        (every model's other reactions are horizontal), so ``N = m (g + a3 gamma3'')`` with
+        ``gamma3'' = s w_tau' - gamma3 w_tau^2`` and ``w_tau'`` from :meth:`flow`. NumPy only:
+        the reduction's pictures need no compiled code."""
+        b = self.body
+        _, dw = self.flow(theta, w_tau)
+        N: Real = b.m * (b.g + b.a3 * (np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau))
+        return N
+
+    def uniform_drift(self) -> complex | None:
+        """The centre of mass's horizontal velocity ``X' + i Y'`` in the fixed frame of
+        :mod:`rollingtop.absolute` when it is constant (a model with conserved horizontal
+        momentum), else ``None``: the meridian model's turns with the axis
+        (:func:`rollingtop.absolute.period_map`)."""
+        return None
+
+    def values(self) -> dict[str, float]:
+        """The level's integrals by name (:attr:`integrals`)."""
+        return {name: float(getattr(self, name)) for name in self.integrals}
+
+    def com_velocity(self, theta: Real, w_tau: Real, frame: dict[str, FloatArray]) -> FloatArray:
+        """The centre of mass's velocity (body frame) at ``theta`` with ``w_tau``, from the
+        constraints and :meth:`v_tau`: ``v_tau tau - (R gamma3 + a3) w_tau n - R s w_tau e3``
+        (``docs/model.md``, "Reduced variables"). ``frame`` holds the unit vectors ``tau, n, e3,
+        gamma`` (shape ``(..., 3)``, broadcast with ``theta`` and ``w_tau`` of shape ``(...)``).
+        """
+        b = self.body
+        t = np.asarray(theta, dtype=float)[..., None]
+        wt = np.asarray(w_tau, dtype=float)[..., None]
+        v_tau = (np.asarray(self.v_tau(theta), dtype=float) + 0.0 * wt[..., 0])[..., None]
+        v: FloatArray = (v_tau * frame["tau"] - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
+                         - b.R * np.sin(t) * wt * frame["e3"])  # fmt: skip
+        return v

@@ -1,0 +1,218 @@
+"""The classification of every reduced model side by side: for one body and one initial state,
+each integrable model's level, the orbit through the state, its steady motions, and the
+critical values of its energy along one of its level's integrals (its bifurcation set).
+
+The meridian model's bifurcation diagram (:mod:`rollingtop.reduction.bifurcation`) follows the
+critical curves of its ``(C2, h)`` plane in closed form and names the regions between them. For
+the other models the same set is found numerically, by the model's own reduction
+(:mod:`rollingtop.reduction.models`): along a grid of one integral (:data:`AXES`: the one that
+does not fix the spin), the critical points of ``U`` (:func:`~rollingtop.reduction.steady_motions`)
+and their energies ``U``. A level between two critical values holds the same orbits; the number
+of steady motions changes where two critical values meet (a fold).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop._errors import ScenarioError
+from rollingtop._json import finite_or_none, json_ready
+from rollingtop.body import SphericalTop
+from rollingtop.contact import MODELS
+from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.models import REDUCTIONS, reduction_of
+from rollingtop.reduction.orbits import Orbit, orbits
+from rollingtop.reduction.steady import SteadyMotion, steady_motions
+
+__all__ = ["AXES", "CriticalValues", "ModelClassification", "classify_models", "critical_values"]
+
+FloatArray = NDArray[np.float64]
+
+#: The integral each model's critical values are drawn against: the one that does not fix the
+#: spin (the meridian model's ``C2``, as in its bifurcation diagram; the smooth plane's area
+#: integral; Routh's sphere's Jellett integral).
+AXES = {"meridian": "C2", "smooth": "C1", "rough": "jellett"}
+
+
+@dataclass(frozen=True)
+class CriticalValues:
+    """The critical values of a model's reduced energy along one integral of its level.
+
+    Attributes
+    ----------
+    model, axis : str
+        The model and the integral varied (:data:`AXES`).
+    fixed : dict of str to float
+        The level's other integrals.
+    x : ndarray, shape (n,)
+        The grid of the varied integral.
+    count : ndarray of int, shape (n,)
+        Steady motions at each ``x`` (-1 where the level is refused, e.g. a pole level the
+        model does not reduce).
+    points : ndarray, shape (k, 4)
+        Every steady motion found: ``x``, ``gamma3``, ``U`` (its energy ``h``) and 1 for a
+        centre, -1 for a saddle, 0 degenerate.
+    """
+
+    model: str
+    axis: str
+    fixed: dict[str, float]
+    x: FloatArray
+    count: NDArray[np.int64]
+    points: FloatArray
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return {"model": self.model, "axis": self.axis, "fixed": json_ready(self.fixed),
+                "x": _plain(self.x), "count": self.count.tolist(),
+                "points": _plain(self.points)}  # fmt: skip
+
+
+def _plain(a: NDArray[Any]) -> list[Any]:
+    """``a`` as nested lists of floats, non-finite ones as ``None`` (JSON)."""
+    if a.ndim == 1:
+        return [finite_or_none(float(v)) for v in a]
+    return [_plain(row) for row in a]
+
+
+def critical_values(
+    level: LevelSet, *, axis: str | None = None, window: tuple[float, float] | None = None,
+    n: int = 121,
+) -> CriticalValues:  # fmt: skip
+    """The critical values of ``level``'s model along the integral ``axis`` (default
+    :data:`AXES`), the others held at ``level``'s values.
+
+    Parameters
+    ----------
+    level : LevelSet
+        Any model's level (:mod:`rollingtop.reduction.models`).
+    axis : str, optional
+        One of the level's integrals (:meth:`LevelSet.values`).
+    window : (float, float), optional
+        Range of ``axis``; default: its value at ``level`` +- ``max(1, |value|)``.
+    n : int
+        Grid points (3 to 2001).
+    """
+    reduction = reduction_of(level.model)
+    values = level.values()
+    axis = AXES[level.model] if axis is None else axis
+    if axis not in values:
+        raise ScenarioError(f"axis {axis!r} is not an integral of the {level.model} model's "
+                            f"level ({', '.join(values)})")  # fmt: skip
+    if not 3 <= int(n) <= 2001:
+        raise ScenarioError(f"n = {n} must be between 3 and 2001")
+    x0 = values[axis]
+    lo, hi = window if window is not None else (x0 - max(1.0, abs(x0)), x0 + max(1.0, abs(x0)))
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise ScenarioError(f"{axis} window ({lo:g}, {hi:g}) must be finite and increasing")
+    x = np.linspace(lo, hi, int(n))
+    count = np.full(x.size, -1, dtype=np.int64)
+    points: list[tuple[float, float, float, float]] = []
+    kinds = {"center": 1.0, "saddle": -1.0}
+    for i, xi in enumerate(x):
+        try:
+            lv = reduction.level(level.body, {**values, axis: float(xi)})
+            found = steady_motions(lv)
+        except LevelSetError:
+            continue
+        count[i] = len(found)
+        points += [(float(xi), m.gamma3, m.U, kinds.get(m.type, 0.0)) for m in found]
+    fixed = {k: v for k, v in values.items() if k != axis}
+    pts = np.array(points, dtype=float).reshape(-1, 4)
+    return CriticalValues(level.model, axis, fixed, x, count, pts)
+
+
+@dataclass(frozen=True)
+class ModelClassification:
+    """One model's view of a state: its level and energy, the orbit through the state, its
+    steady motions and its critical values (:func:`critical_values`)."""
+
+    model: str
+    level: LevelSet
+    h: float
+    state: FloatArray
+    orbit: Orbit | None
+    steady: list[SteadyMotion]
+    critical: CriticalValues
+    note: str = field(default="")
+
+    @property
+    def delta_psi(self) -> float | None:
+        """The axis azimuth's advance over one period of the orbit through the state
+        (:func:`rollingtop.reduction.rotation.rotation_number`); ``None`` without an orbit."""
+        from rollingtop.reduction.rotation import rotation_number
+
+        if self.orbit is None:
+            return None
+        return 2 * math.pi * rotation_number(self.level, self.h, self.orbit)[0]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict: ``model``, ``level`` (its integrals, ``h`` and the full energy),
+        ``orbit`` (``None`` on a steady motion or a separatrix), ``equilibria``, ``critical``."""
+        return json_ready({
+            "model": self.model,
+            "level": {**self.level.values(), "h": self.h,
+                      "energy": self.level.full_energy(self.h), "pole": self.level.pole},
+            "orbit": None if self.orbit is None else {**self.orbit.to_dict(),
+                                                      "delta_psi": self.delta_psi},
+            "equilibria": [m.to_dict() for m in self.steady],
+            "critical": self.critical.to_dict(),
+            "note": self.note,
+        })  # fmt: skip
+
+
+def classify_models(
+    body: SphericalTop,
+    gamma: ArrayLike,
+    omega: ArrayLike,
+    *,
+    models: Sequence[str] | None = None,
+    n: int = 121,
+    own: tuple[str, ArrayLike] | None = None,
+) -> list[ModelClassification]:
+    """Each integrable model's classification of the motion from ``(gamma, omega)``.
+
+    The state is built under each model (:func:`rollingtop.initial_state`: the same attitude
+    and angular velocity, the centre of mass's velocity from that model's constraints, its free
+    components 0), so the models see the same body started the same way.
+
+    Parameters
+    ----------
+    body : SphericalTop
+        Dynamically symmetric.
+    gamma, omega : array_like, shape (3,)
+        Upward vertical and angular velocity, body frame.
+    models : sequence of str, optional
+        Default: every model with a reduction, in registry order.
+    n : int
+        Grid points of each model's critical values.
+    own : (str, array_like), optional
+        A model's name and a full state of it (shape (18,)) used as it is for that model (a
+        scenario's own model and state, with its free velocity components).
+    """
+    from rollingtop.dynamics.state import initial_state
+    from rollingtop.reduction.variables import reduce_state
+
+    names = [m for m in MODELS if m in REDUCTIONS] if models is None else list(models)
+    out = []
+    for name in names:
+        reduction = reduction_of(name)
+        if own is not None and own[0] == name:
+            y = np.asarray(own[1], dtype=float)
+        else:
+            y = initial_state(body, name, gamma=gamma, omega=omega)
+        level = reduction.level_of_state(body, y)
+        h = reduction.reduced_energy(body, y)
+        theta = float(reduce_state(y)["theta"])
+        found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]
+        orbit = found[0] if found and found[0].kind == "periodic" else None
+        note = "" if orbit is not None else "the state lies on a steady motion or a separatrix"
+        out.append(ModelClassification(name, level, h, y, orbit, steady_motions(level),
+                                       critical_values(level, n=n), note))  # fmt: skip
+    return out
