@@ -1,6 +1,7 @@
 """Command line for the reduction: equilibria, orbits, portrait (JSON contracts, errors)."""
 
 import json
+import math
 import re
 
 import pytest
@@ -78,10 +79,8 @@ def test_portrait_writes_each_format(capsys, tmp_path, suffix):
     [
         (["orbits", FIG5, "--h", "1.0"], "h is below the minimum of the effective potential"),
         (["equilibria", str(EXAMPLES / "parallel.toml")], "parallel model has no reduction"),
-        (
-            ["bifurcation", str(EXAMPLES / "smooth.toml")],
-            "`rollingtop bifurcation` needs the meridian",
-        ),
+        (["rotation", str(EXAMPLES / "smooth.toml")], "`rollingtop rotation` needs the meridian"),
+        (["bifurcation", str(EXAMPLES / "parallel.toml")], "parallel model has no reduction"),
         (["portrait", FIG5, "-o", "x.gif"], "unknown output format '.gif'"),
         (["portrait", FIG5, "-o", "x.png", "--h-levels", "a,b"], "expected comma-separated"),
     ],
@@ -140,3 +139,33 @@ def test_orbits_json_of_the_other_reduced_models(capsys, name):
     code, out, err = run_cli(capsys, "equilibria", path, "--json")
     assert code == 0 and all({"gamma3", "type", "U", "frequency"} <= set(e)
                              for e in json.loads(out)["equilibria"])  # fmt: skip
+
+
+@pytest.mark.parametrize("name", ["smooth", "rough"])
+def test_bifurcation_of_the_other_reduced_models(capsys, tmp_path, name):
+    """`bifurcation` on a smooth or rough scenario: the critical values along the model's axis
+    integral; each point is a critical point of that level's U (dU = 0, an independent check
+    through the level's derivative) and the counts are the points per column."""
+    from rollingtop.reduction import reduction_of
+    from rollingtop.scenario import load_scenario
+
+    path = str(EXAMPLES / f"{name}.toml")
+    out_png = tmp_path / "b.png"
+    code, out, err = run_cli(capsys, "bifurcation", path, "--json", "-o", str(out_png),
+                             "--axis-range", "-1.5,1.5")  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["model"] == name and out_png.stat().st_size > 10_000
+    assert data["x"][0] == -1.5 and data["x"][-1] == 1.5
+    sc = load_scenario(path)
+    reduction = reduction_of(name)
+    base = sc.level_set().values()
+    points = data["points"]
+    for x, count in zip(data["x"], data["count"], strict=True):
+        mine = [p for p in points if p[0] == x]
+        assert count == (len(mine) if count >= 0 else -1)
+    for x, gamma3, U, _ in points[::40]:
+        level = reduction.level(sc.body, {**base, data["axis"]: x})
+        theta = math.acos(gamma3)
+        assert abs(float(level.dU(theta))) < 1e-8 * max(1.0, abs(U))
+        assert float(level.U(theta)) == pytest.approx(U, rel=1e-12, abs=1e-12)

@@ -158,11 +158,13 @@ class Scenario:
         applies (:attr:`ContactModel.has_reduction`: the bifurcation diagrams, rotation numbers,
         atlas)."""
         if not self.model.has_reduction:
+            self._require_reduction(what)  # no reduction at all: what serves such a model
             names = " or ".join(m.name for m in MODELS.values() if m.has_reduction)
             reduced = ", ".join(m.name for m in MODELS.values() if m.reduction)
             raise ScenarioError(
-                f"{what} needs the {names} model so far, not {self.model.name!r} (the steady "
-                f"motions, orbits and portraits serve every model with a reduction: {reduced})"
+                f"{what} needs the {names} model so far, not {self.model.name!r} (every model "
+                f"with a reduction, {reduced}, has equilibria, orbits, portrait, bifurcation "
+                "and compare-classification)"
             )
 
     def require_state(self) -> NDArray[np.float64]:

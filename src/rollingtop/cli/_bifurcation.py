@@ -57,6 +57,9 @@ def _table(summary: dict[str, Any]) -> Any:
               help="h window (default: min U to above the saddles).")  # fmt: skip
 @click.option("--c1-range", default=None, metavar="LO,HI",
               help="C1 window of the steady-motion count (default +-2 max |M3|,|C1|).")  # fmt: skip
+@click.option("--axis-range", default=None, metavar="LO,HI",
+              help="Another reduced model's axis window (smooth: C1, rough: jellett; default "
+                   "its value +- max(1, |value|)).")  # fmt: skip
 def bifurcation(
     scenario: str,
     as_json: bool,
@@ -64,12 +67,17 @@ def bifurcation(
     c2_range: str | None,
     h_range: str | None,
     c1_range: str | None,
+    axis_range: str | None,
 ) -> None:
     """Bifurcation diagram of the reduced system at the scenario's (M3, C1).
 
     M3 and C1 come from [level] (its other keys are ignored), else from the initial state.
     Prints the folds (where a centre and a saddle are born) and the regions of the (C2, h) plane
     with what a level in each holds, and the number of steady motions over (C1, C2).
+
+    The other reduced models (smooth, rough) get their critical values along one integral of
+    their level instead (the smooth plane's C1, Jellett's integral), with the number of steady
+    motions along it (--axis-range; rollingtop.reduction.classify.critical_values).
     """
     from rollingtop.reduction.bifurcation import bifurcation_diagram, steady_count_map
     from rollingtop.scenario import load_scenario
@@ -82,6 +90,9 @@ def bifurcation(
 
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
+    if sc.model.reduction and not sc.model.has_reduction:
+        _other_model(sc, as_json, output, _range("--axis-range", axis_range))
+        return
     M3, C1, C2 = sc.level_integrals("`rollingtop bifurcation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=ranges["C2"], h_range=ranges["h"])
     width = 2.0 * max(abs(M3), abs(C1), 1e-3)
@@ -104,5 +115,39 @@ def bifurcation(
                       for f in summary["folds"]) or "none"  # fmt: skip
     console.print(f"folds: {folds}")
     console.print(_table(summary))
+    if output is not None:
+        click.echo(f"wrote {output}")
+
+
+def _other_model(sc: Any, as_json: bool, output: str | None,
+                 window: tuple[float, float] | None) -> None:  # fmt: skip
+    """``bifurcation`` for a reduced model other than the paper's: its critical values along
+    its axis integral (:func:`rollingtop.reduction.classify.critical_values`)."""
+    from rich.table import Table
+
+    from rollingtop.reduction.classify import critical_values
+
+    level = sc.level_set()
+    cv = critical_values(level, window=window, n=241)
+    if output is not None:
+        from rollingtop.plot import save_figure
+        from rollingtop.plot.classification import critical_values_figure
+
+        save_figure(critical_values_figure(cv, level), output)
+    if as_json:
+        click.echo(json.dumps(cv.to_dict()))
+        return
+    fixed = ", ".join(f"{k} = {v:g}" for k, v in cv.fixed.items())
+    table = Table(title=f"steady motions of the {cv.model} model along {cv.axis} ({fixed})")
+    for col in (f"{cv.axis} from", "to", "steady motions"):
+        table.add_column(col, justify="right")
+    start = 0
+    for i in range(1, cv.x.size + 1):
+        if i == cv.x.size or cv.count[i] != cv.count[start]:
+            n = int(cv.count[start])
+            table.add_row(f"{cv.x[start]:.6g}", f"{cv.x[i - 1]:.6g}",
+                          "refused (pole level)" if n < 0 else str(n))  # fmt: skip
+            start = i
+    _output.console().print(table)
     if output is not None:
         click.echo(f"wrote {output}")

@@ -6,16 +6,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import TypeAlias
+from typing import Any, TypeAlias
 
 import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from rollingtop.contact import get_model
-from rollingtop.reduction.classify import ModelClassification
+from rollingtop.reduction.classify import CriticalValues, ModelClassification
+from rollingtop.reduction.level import LevelSet
 
-__all__ = ["classification_figure"]
+__all__ = ["classification_figure", "critical_values_figure"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: Labels of the integrals in the figure (mathtext).
@@ -91,11 +92,7 @@ def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
         # the critical values along the axis integral
         ax = axes[2, j]
         cv = c.critical
-        pts = cv.points
-        for kind, marker, label in ((1.0, "o", "centre"), (-1.0, "x", "saddle")):
-            sel = pts[:, 3] == kind
-            ax.plot(pts[sel, 0], pts[sel, 2], marker, color=colour if kind > 0 else "k", ms=2.5,
-                    ls="none", label=label)  # fmt: skip
+        _draw_critical(ax, cv, colour)
         ax.plot([level.values()[cv.axis]], [c.h], "k*", ms=9, label="the state's level")
         ax.set_xlabel(f"${SYMBOLS.get(cv.axis, cv.axis)}$")
         if j == 0:
@@ -112,3 +109,31 @@ def _tau(y: FloatArray) -> FloatArray:
     s = math.hypot(g[0], g[1])
     out: FloatArray = np.array([-g[1], g[0], 0.0]) / s
     return out
+
+
+def _draw_critical(ax: Any, cv: CriticalValues, colour: str) -> None:
+    """The critical values of ``cv`` on ``ax``: centres as dots, saddles as crosses."""
+    pts = cv.points
+    for kind, marker, label in ((1.0, "o", "centre"), (-1.0, "x", "saddle")):
+        sel = pts[:, 3] == kind
+        ax.plot(pts[sel, 0], pts[sel, 2], marker, color=colour if kind > 0 else "k", ms=2.5,
+                ls="none", label=label)  # fmt: skip
+
+
+def critical_values_figure(cv: CriticalValues, level: LevelSet) -> Figure:
+    """The critical values of a reduced model's energy along its axis integral
+    (:func:`rollingtop.reduction.classify.critical_values`), the level's own value marked;
+    below, the number of steady motions along the axis."""
+    fig = Figure(figsize=(6.4, 5.6), layout="constrained")
+    ax, axn = fig.subplots(2, 1, height_ratios=[3, 1], sharex=True)
+    _draw_critical(ax, cv, get_model(cv.model).colour)
+    ax.axvline(level.values()[cv.axis], color="0.5", lw=0.8, ls="--", label="the level's value")
+    ax.set_ylabel("critical values of $h$")
+    fixed = ", ".join(f"{k} = {v:.4g}" for k, v in cv.fixed.items())
+    ax.set_title(f"{cv.model} model, at {fixed}", fontsize=10)
+    ax.legend(fontsize=8, frameon=False)
+    ok = cv.count >= 0
+    axn.step(cv.x[ok], cv.count[ok], where="mid", color="k")
+    axn.set_ylabel("steady motions")
+    axn.set_xlabel(f"${SYMBOLS.get(cv.axis, cv.axis)}$")
+    return fig
