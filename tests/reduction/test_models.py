@@ -286,3 +286,23 @@ def test_the_normal_force_of_a_level_is_the_full_systems(model, body, rng):
         assert float(level.normal_force(theta, w_tau)) == pytest.approx(
             float(force @ y[12:15]), rel=1e-10, abs=1e-12
         )
+
+
+def test_every_integral_a_reduction_uses_is_claimed_and_so_proved_by_verify():
+    """The level's integrals are among the model's claimed integrals
+    (ContactModel.integrals_symmetric), which `rollingtop verify` proves symbolically
+    (rollingtop.symbolic.claims.claims_for) and `simulate` monitors."""
+    from rollingtop.contact import get_model
+    from rollingtop.reduction import REDUCTIONS
+    from rollingtop.symbolic.claims import claims_for
+
+    uses = {"M3": ("lagrange",), "C1": ("area",), "C2": ("F6",),
+            "p_horizontal": ("momentum_x", "momentum_y"), "jellett": ("jellett",),
+            "routh": ("routh",)}  # fmt: skip
+    for name, reduction in REDUCTIONS.items():
+        claimed = get_model(name).integrals_symmetric
+        proved = " ".join(str(c) for c in claims_for(name))
+        for level_name in reduction.names:
+            for integral in uses[level_name]:
+                assert integral in claimed, (name, integral)
+                assert integral in proved, (name, integral)
