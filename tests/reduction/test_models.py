@@ -306,3 +306,20 @@ def test_every_integral_a_reduction_uses_is_claimed_and_so_proved_by_verify():
             for integral in uses[level_name]:
                 assert integral in claimed, (name, integral)
                 assert integral in proved, (name, integral)
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda b: SmoothLevel(b, 1.0, 0.5, p_horizontal=1e300), "too large for double"),
+        (lambda b: SmoothLevel(b, 1.0, 0.5, p_horizontal=-0.1), "must be finite and >= 0"),
+        (lambda b: RoughLevel(b, jellett=1e300, routh=1e300), "too large for double"),
+        (lambda b: RoughLevel(b, jellett=math.nan, routh=1.0), "must be finite"),
+    ],
+)
+def test_levels_out_of_range_are_refused_in_one_line(paper_body, make, message):
+    """Huge or invalid integrals: a LevelSetError naming the level, never an OverflowError."""
+    from rollingtop.reduction import LevelSetError
+
+    with pytest.raises(LevelSetError, match=message):
+        make(paper_body)

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.reduction.level import (
+    _MAX_U,
     ComplexArray,
     LevelSet,
     LevelSetError,
@@ -86,6 +87,14 @@ class RoughLevel(LevelSet):
                 f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
             )
         object.__setattr__(self, "pole", None)
+        with np.errstate(all="ignore"):
+            at_equator = abs(float(self.U(math.pi / 2)))
+        if not at_equator <= _MAX_U:
+            raise LevelSetError(
+                f"level {self.describe()} is too large for double precision: its effective "
+                f"potential reaches {at_equator:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale "
+                "units)"
+            )
         size = max(abs(self.jellett), abs(self.routh) * self.body.R, 1e-300)
         for theta, name in ((0.0, "south (gamma3 = 1)"), (math.pi, "north (gamma3 = -1)")):
             if abs(self._numerator(theta)) <= POLE_LEVEL_TOLERANCE * size:

@@ -87,7 +87,7 @@ class SmoothLevel(LevelSet):
         keeps it exact near a pole)."""
         b = self.body
         q1, _, _, _ = self._q(theta)
-        drift = self.p_horizontal**2 / (2 * b.m)
+        drift = self.p_horizontal * self.p_horizontal / (2 * b.m)  # inf, not OverflowError
         U: Real = q1**2 / (2 * b.I1) + b.m * b.g * b.a3 * np.cos(theta) + drift
         return U
 
