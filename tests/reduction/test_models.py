@@ -323,3 +323,16 @@ def test_levels_out_of_range_are_refused_in_one_line(paper_body, make, message):
 
     with pytest.raises(LevelSetError, match=message):
         make(paper_body)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_mirrored_level_sees_the_same_motion(model, body, rng):
+    """mirrored(): the body axis reversed (theta -> pi - theta, a3 -> -a3): U, rho and psi'
+    agree at pi - theta (what the north-pole handling relies on)."""
+    level, _ = _random_level(model, body, rng)
+    mirror = level.mirrored()
+    theta = np.linspace(0.3, 2.8, 11)
+    np.testing.assert_allclose(mirror.U(math.pi - theta), level.U(theta), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(mirror.rho(math.pi - theta), level.rho(theta), rtol=1e-14)
+    np.testing.assert_allclose(mirror.psi_dot(math.pi - theta), level.psi_dot(theta),
+                               rtol=1e-11, atol=1e-12)  # fmt: skip
