@@ -81,3 +81,43 @@ def test_compare_classification_command(capsys, tmp_path):
     code, out, err = run_cli(capsys, "compare-classification", str(EXAMPLES / "paper.toml"),
                              "-o", str(tmp_path / "x.png"), "--points", "1")  # fmt: skip
     assert code == 2 and "--points 1" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("name", ["smooth", "rough"])
+def test_a_rotation_grid_cell_is_the_full_systems_precession(name):
+    """rotation_grid: N of a cell is Delta psi / 2 pi of the full system (solve_ivp on
+    tests/dynamics/reference.py) over one period of gamma3, to 1e-8."""
+    from rollingtop.reduction import state_from_level
+    from rollingtop.reduction.classify import rotation_grid
+    from rollingtop.scenario import load_scenario
+
+    from .test_models import _full_run
+
+    sc = load_scenario(EXAMPLES / f"{name}.toml")
+    level = sc.level_set()
+    grid = rotation_grid(level, resolution=5)
+    i, j = 2, 2  # the middle column: the scenario's own level
+    assert grid.x[j] == pytest.approx(level.values()[grid.axis])
+    N = grid.N[i, j, 0]
+    assert math.isfinite(N)
+    (o, *_) = [o for o in orbits(level, float(grid.h[i])) if o.kind == "periodic"]
+    y0 = state_from_level(
+        level, float(grid.h[i]), o.gamma3_min + 1e-4 * (o.gamma3_max - o.gamma3_min)
+    )
+    sol = _full_run(name, sc.body, y0, 3.2 * o.period)
+    t0, t1 = sol.t_events[0][:2]
+    ys = sol.sol(np.linspace(t0, t1, 400))
+    psi = np.unwrap(np.arctan2(ys[11], ys[8]))
+    assert N == pytest.approx((psi[-1] - psi[0]) / (2 * math.pi), abs=1e-8)
+
+
+def test_rotation_of_another_reduced_model_on_the_command_line(capsys, tmp_path):
+    code, out, err = run_cli(capsys, "rotation", str(EXAMPLES / "rough.toml"), "--json",
+                             "--resolution", "5", "-o", str(tmp_path / "r.png"))  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["model"] == "rough" and data["axis"] == "jellett"
+    assert len(data["N"]) == 5 and len(data["N"][0]) == 5 and data["N_range"] is not None
+    assert sum(data["classes"].values()) == sum(
+        v is not None for row in data["N"] for cell in row for v in cell
+    )

@@ -21,7 +21,8 @@ __all__ = ["rotation"]
 @click.option("-o", "--output", type=click.Path(), default=None,
               help="Also draw the map and a path of each class: FIG.png, .svg, .pdf.")  # fmt: skip
 @click.option("--c2-range", default=None, metavar="LO,HI",
-              help="C2 window (default: the bifurcation diagram's).")  # fmt: skip
+              help="C2 window (default: the bifurcation diagram's); for another reduced model, "
+                   "the window of its axis integral (smooth: C1, rough: jellett).")  # fmt: skip
 @click.option("--h-range", default=None, metavar="LO,HI",
               help="h window (default: the bifurcation diagram's).")  # fmt: skip
 @click.option("--resolution", type=int, default=41, show_default=True,
@@ -55,6 +56,9 @@ def rotation(
 
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
+    if sc.model.reduction and not sc.model.has_reduction:
+        _other_model(sc, as_json, output, c2_window, h_window, resolution)
+        return
     M3, C1, C2 = sc.level_integrals("`rollingtop rotation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=c2_window, h_range=h_window)
     c2w = (float(diagram.C2_grid[0]), float(diagram.C2_grid[-1]))
@@ -92,5 +96,44 @@ def rotation(
         console.print(f"{name}: N = {ex['N']:.6g}{frac} at C2 = {ex['C2']:.6g}, h = {ex['h']:.6g}")
     for c in summary.get("centres", []):
         console.print(f"centre at gamma3 = {c['gamma3']:.6g} (C2 = {c['C2']:g}): N -> {c['N']:.6g}")
+    if output is not None:
+        click.echo(f"wrote {output}")
+
+
+def _other_model(sc: Any, as_json: bool, output: str | None, window: Any, h_window: Any,
+                 resolution: int) -> None:  # fmt: skip
+    """``rotation`` for a reduced model other than the paper's: ``N`` over its axis integral and
+    ``h`` (:func:`rollingtop.reduction.classify.rotation_grid`)."""
+    import numpy as np
+
+    from rollingtop.reduction.classify import rotation_grid
+    from rollingtop.reduction.rotation import classify_rotation
+
+    level = sc.level_set()
+    with _output.counting("rotation numbers", resolution) as progress:
+        grid = rotation_grid(level, window=window, h_range=h_window, resolution=resolution,
+                             progress=progress)  # fmt: skip
+    summary = grid.to_dict()
+    if summary["N_range"] is None:
+        raise BadInput(f"no periodic orbit in the window of {grid.axis} and h: widen "
+                       "--h-range or --c2-range")  # fmt: skip
+    finite = grid.N[np.isfinite(grid.N)]
+    kinds = [classify_rotation(float(n))["class"] for n in finite]
+    summary["classes"] = {k: kinds.count(k) for k in sorted(set(kinds))}
+    if output is not None:
+        from rollingtop.plot import save_figure
+        from rollingtop.plot.classification import rotation_grid_figure
+
+        save_figure(rotation_grid_figure(grid), output)
+    if as_json:
+        click.echo(json.dumps(summary))
+        return
+    lo, hi = summary["N_range"]
+    counts = ", ".join(f"{v} {k}" for k, v in summary["classes"].items())
+    _output.console().print(
+        f"rotation number N of the {grid.model} model over {grid.axis} in "
+        f"[{grid.x[0]:.5g}, {grid.x[-1]:.5g}], h in [{grid.h[0]:.5g}, {grid.h[-1]:.5g}]: "
+        f"N from {lo:.6g} to {hi:.6g}; orbits by class: {counts}"
+    )
     if output is not None:
         click.echo(f"wrote {output}")

@@ -13,10 +13,10 @@ from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from rollingtop.contact import get_model
-from rollingtop.reduction.classify import CriticalValues, ModelClassification
+from rollingtop.reduction.classify import CriticalValues, ModelClassification, RotationGrid
 from rollingtop.reduction.level import LevelSet
 
-__all__ = ["classification_figure", "critical_values_figure"]
+__all__ = ["classification_figure", "critical_values_figure", "rotation_grid_figure"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: Labels of the integrals in the figure (mathtext).
@@ -136,4 +136,18 @@ def critical_values_figure(cv: CriticalValues, level: LevelSet) -> Figure:
     axn.step(cv.x[ok], cv.count[ok], where="mid", color="k")
     axn.set_ylabel("steady motions")
     axn.set_xlabel(f"${SYMBOLS.get(cv.axis, cv.axis)}$")
+    return fig
+
+
+def rotation_grid_figure(grid: RotationGrid) -> Figure:
+    """The rotation number ``N`` of the first periodic orbit of each level over the model's axis
+    integral and ``h`` (:func:`rollingtop.reduction.classify.rotation_grid`)."""
+    fig = Figure(figsize=(6.4, 5.0), layout="constrained")
+    ax = fig.subplots()
+    mesh = ax.pcolormesh(grid.x, grid.h, grid.N[:, :, 0], shading="nearest", cmap="viridis")
+    fig.colorbar(mesh, ax=ax, label=r"$N = \Delta\psi / 2\pi$ (first orbit)")
+    ax.set_xlabel(f"${SYMBOLS.get(grid.axis, grid.axis)}$")
+    ax.set_ylabel("$h$")
+    fixed = ", ".join(f"{k} = {v:.4g}" for k, v in grid.fixed.items())
+    ax.set_title(f"{grid.model} model, at {fixed}", fontsize=10)
     return fig

@@ -14,7 +14,7 @@ of steady motions changes where two critical values meet (a fold).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,7 +30,15 @@ from rollingtop.reduction.models import REDUCTIONS, reduction_of
 from rollingtop.reduction.orbits import Orbit, orbits
 from rollingtop.reduction.steady import SteadyMotion, steady_motions
 
-__all__ = ["AXES", "CriticalValues", "ModelClassification", "classify_models", "critical_values"]
+__all__ = [
+    "AXES",
+    "CriticalValues",
+    "ModelClassification",
+    "RotationGrid",
+    "classify_models",
+    "critical_values",
+    "rotation_grid",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -216,3 +224,87 @@ def classify_models(
         out.append(ModelClassification(name, level, h, y, orbit, steady_motions(level),
                                        critical_values(level, n=n), note))  # fmt: skip
     return out
+
+
+@dataclass(frozen=True)
+class RotationGrid:
+    """Rotation numbers ``N = Delta psi / 2 pi`` of a reduced model over a grid of its axis
+    integral and the reduced energy (:func:`rotation_grid`).
+
+    Attributes
+    ----------
+    model, axis : str
+    fixed : dict of str to float
+        The level's other integrals.
+    x : ndarray, shape (nx,)
+    h : ndarray, shape (nh,)
+    N : ndarray, shape (nh, nx, 2)
+        ``N`` of the first two periodic orbits of each level (by ``gamma3``); NaN where there
+        is none (below the minimum of ``U``, a refused pole level).
+    """
+
+    model: str
+    axis: str
+    fixed: dict[str, float]
+    x: FloatArray
+    h: FloatArray
+    N: FloatArray
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict, with ``N_range`` (``None`` without a periodic orbit)."""
+        finite = self.N[np.isfinite(self.N)]
+        span = None if finite.size == 0 else [float(finite.min()), float(finite.max())]
+        return {"model": self.model, "axis": self.axis, "fixed": json_ready(self.fixed),
+                "x": _plain(self.x), "h": _plain(self.h),
+                "N": [[_plain(cell) for cell in row] for row in self.N],
+                "N_range": span}  # fmt: skip
+
+
+def rotation_grid(
+    level: LevelSet,
+    *,
+    window: tuple[float, float] | None = None,
+    h_range: tuple[float, float] | None = None,
+    resolution: int = 41,
+    progress: Callable[[int, int], None] | None = None,
+) -> RotationGrid:
+    """Rotation numbers of ``level``'s model over its axis integral (:data:`AXES`, ``window``
+    as in :func:`critical_values`) and ``h`` (default: from the lowest critical value to
+    above the highest in the window), by the quadrature of ``psi'`` over a period
+    (:func:`rollingtop.reduction.rotation.rotation_number`).
+
+    ``progress(done, total)`` after each column of the axis.
+    """
+    from rollingtop.reduction.rotation import rotation_number
+
+    if not 3 <= int(resolution) <= 1000:
+        raise ScenarioError(f"resolution = {resolution} must be between 3 and 1000")
+    cv = critical_values(level, window=window, n=int(resolution))
+    reduction = reduction_of(level.model)
+    values = level.values()
+    if h_range is None:
+        if cv.points.size == 0:
+            raise ScenarioError(f"no steady motion of the {level.model} model in the window: "
+                                "give the h range")  # fmt: skip
+        lo, hi = float(cv.points[:, 2].min()), float(cv.points[:, 2].max())
+        h_range = (lo + 1e-6 * max(1.0, abs(lo)), hi + 0.5 * (hi - lo) + 1e-3)
+    h_lo, h_hi = h_range
+    if not (math.isfinite(h_lo) and math.isfinite(h_hi) and h_lo < h_hi):
+        raise ScenarioError(f"h range ({h_lo:g}, {h_hi:g}) must be finite and increasing")
+    h = np.linspace(h_lo, h_hi, int(resolution))
+    N = np.full((h.size, cv.x.size, 2), np.nan)
+    for j, xj in enumerate(cv.x):
+        try:
+            lv = reduction.level(level.body, {**values, cv.axis: float(xj)})
+        except LevelSetError:
+            continue
+        for i, hi_ in enumerate(h):
+            try:
+                found = [o for o in orbits(lv, float(hi_)) if o.kind == "periodic"]
+            except LevelSetError:
+                continue  # below the minimum of U
+            for k, o in enumerate(found[:2]):
+                N[i, j, k] = rotation_number(lv, float(hi_), o)[0]
+        if progress is not None:
+            progress(j + 1, cv.x.size)
+    return RotationGrid(level.model, cv.axis, cv.fixed, cv.x, h, N)
