@@ -79,7 +79,9 @@ def reconstruct(
     rtol: float = 1e-13,
     atol: float = 1e-14,
 ) -> dict[str, FloatArray]:
-    """Reconstruct the motion on the plane from the reduced one.
+    """Reconstruct the motion on the plane from the reduced one (a level whose centre of mass
+    drifts uniformly, :meth:`~rollingtop.reduction.LevelSet.uniform_drift`, is refused: the
+    drift's direction is not part of it).
 
     Integrates ``(theta, w_tau)`` of the one-degree-of-freedom system together with the
     quadratures for ``psi``, ``X`` and ``Y`` (module docstring) with ``solve_ivp`` (DOP853).
@@ -101,6 +103,10 @@ def reconstruct(
     dict
         ``t, theta, gamma3, w_tau, psi, position (n, 2), contact_point (n, 2)``.
     """
+    if level.uniform_drift() is not None:
+        raise LevelSetError(f"the {level.model} model's centre of mass drifts uniformly in a "
+                            "direction its level does not fix: reconstruct its path from a full "
+                            "state (rollingtop simulate)")  # fmt: skip
     t = np.asarray(t, dtype=float)
     z0 = [theta0, w_tau0, psi0, float(position0[0]), float(position0[1])]
     sol = solve_ivp(_path_rhs(level), (t[0], t[-1]), z0, method="DOP853", rtol=rtol, atol=atol,
@@ -139,7 +145,7 @@ class PeriodMap:
         Estimated absolute error of ``delta_psi`` (two quadrature levels).
     displacement : (float, float)
         CoM displacement over one period from the canonical start.
-    motion : {"bounded", "drifting"}
+    motion : {"bounded", "drifting", "uniform drift"}
     center, radius : (float, float) and float, or None
         Circle on which the once-per-period CoM positions lie (bounded motion).
     drift_velocity : (float, float) or None
@@ -159,6 +165,9 @@ class PeriodMap:
     near_resonant: bool
     start_theta: float
     delta_psi_error: float = math.nan
+    #: The speed of a uniform drift (``motion == "uniform drift"``: the smooth plane's centre
+    #: of mass, whose direction the level does not fix), else ``None``.
+    drift_speed: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
@@ -196,16 +205,16 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
         raise LevelSetError(f"no per-period map for a {orbit.kind} orbit ({orbit.note})")
     T = orbit.period
     drift = level.uniform_drift()
-    if drift is not None:  # the CoM moves uniformly whatever the axis does: a translation
+    if drift is not None:  # the CoM drifts uniformly whatever the axis does (smooth plane)
         turns, turns_err = rotation_number(level, h, orbit)
-        D = drift * T
         theta0 = start_theta(orbit)
         dpsi, dpsi_err = 2 * math.pi * turns, 2 * math.pi * turns_err
-        if drift == 0:
+        if drift == 0:  # at rest: the CoM stays where it is
             return PeriodMap(T, dpsi, (0.0, 0.0), "bounded", (0.0, 0.0), 0.0, None, False,
                              theta0, dpsi_err)  # fmt: skip
-        return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None,
-                         (drift.real, drift.imag), False, theta0, dpsi_err)  # fmt: skip
+        # its direction is the horizontal momentum's, not part of the level: only its speed
+        return PeriodMap(T, dpsi, (math.nan, math.nan), "uniform drift", None, None, None,
+                         False, theta0, dpsi_err, drift_speed=drift)  # fmt: skip
     if level.pole == "both":  # no spin: the axis does not precess (rollingtop.reduction.no_spin)
         dpsi, dpsi_err = 0.0, 0.0
         theta0, w_tau0 = start_theta(orbit), 0.0

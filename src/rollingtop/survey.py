@@ -43,7 +43,8 @@ class OrbitSurvey:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict: the orbit's, with ``near_pole`` and, for a periodic orbit, the
         map's ``delta_psi, delta_psi_error, motion, near_resonant, displacement`` and either
-        ``center, radius`` (bounded) or ``drift_velocity`` (drifting)."""
+        ``center, radius`` (bounded), ``drift_velocity`` (drifting) or ``drift_speed`` (a uniform
+        drift, the smooth plane's: no displacement)."""
         row: dict[str, Any] = self.orbit.to_dict()
         row["near_pole"] = None if self.near_pole is None else self.near_pole.to_dict()
         pm = self.period_map
@@ -58,6 +59,8 @@ class OrbitSurvey:
             if pm.motion == "bounded":
                 assert pm.center is not None
                 row.update(center=list(pm.center), radius=pm.radius)
+            elif pm.motion == "uniform drift":  # a speed: the direction is not the level's
+                row.update(displacement=None, drift_speed=pm.drift_speed)
             else:
                 assert pm.drift_velocity is not None
                 row.update(drift_velocity=list(pm.drift_velocity))

@@ -45,7 +45,8 @@ def test_every_reduced_model_is_classified_with_its_own_level(classes):
 
 def test_critical_values_are_the_extrema_of_U_on_a_dense_grid(classes):
     """At each grid value of the axis, the centres' critical values are the local minima of U
-    found by brute force on 200001 points of theta (an independent search: no root finding)."""
+    and the saddles' its local maxima, found by brute force on 200001 points of theta (an
+    independent search: no root finding)."""
     found, _ = classes
     theta = np.linspace(1e-3, math.pi - 1e-3, 200001)
     compared = 0
@@ -58,12 +59,14 @@ def test_critical_values_are_the_extrema_of_U_on_a_dense_grid(classes):
             except (LevelSetError, ScenarioError):  # a pole level the model does not reduce
                 continue
             U = np.asarray(level.U(theta))
-            inner = (U[1:-1] < U[:-2]) & (U[1:-1] < U[2:])
-            brute = np.sort(U[1:-1][inner])
-            centres = np.sort(cv.points[(cv.points[:, 0] == x) & (cv.points[:, 3] == 1.0), 2])
-            assert brute.size == centres.size
-            np.testing.assert_allclose(centres, brute, atol=BRUTE_U, rtol=BRUTE_U)
-            compared += centres.size
+            here = cv.points[cv.points[:, 0] == x]
+            for kind, inner in ((1.0, (U[1:-1] < U[:-2]) & (U[1:-1] < U[2:])),
+                                (-1.0, (U[1:-1] > U[:-2]) & (U[1:-1] > U[2:]))):  # fmt: skip
+                brute = np.sort(U[1:-1][inner])  # local minima: centres; maxima: saddles
+                found = np.sort(here[here[:, 3] == kind, 2])
+                assert brute.size == found.size
+                np.testing.assert_allclose(found, brute, atol=BRUTE_U, rtol=BRUTE_U)
+                compared += found.size
     assert compared >= 15
 
 
@@ -121,3 +124,27 @@ def test_rotation_of_another_reduced_model_on_the_command_line(capsys, tmp_path)
     assert sum(data["classes"].values()) == sum(
         v is not None for row in data["N"] for cell in row for v in cell
     )
+
+
+def test_a_model_that_refuses_the_state_leaves_the_others(capsys, tmp_path):
+    """A vertical spin is a pole level of Routh's sphere, not reduced yet: compare-classification
+    classifies the other models and names the refused one (JSON "refused", one stderr line)."""
+    path = tmp_path / "vertical.toml"
+    path.write_text("""
+[body]
+R = 1.0
+m = 1.0
+g = 1.0
+a3 = 0.1
+I1 = 0.3
+I3 = 0.5
+[initial]
+gamma = [0.0, 0.0, 1.0]
+omega = [0.0, 0.0, 3.0]
+""")
+    code, out, err = run_cli(capsys, "compare-classification", str(path), "-o",
+                             str(tmp_path / "v.png"), "--json", "--points", "5")  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    assert [m["model"] for m in data["models"]] == ["meridian", "smooth"]
+    assert set(data["refused"]) == {"rough"} and "pole" in data["refused"]["rough"]

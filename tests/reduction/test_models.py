@@ -189,14 +189,19 @@ def test_orbits_from_an_initial_state_agree_with_the_full_system(model, body):
     assert row.period_map is not None
     assert row.period_map.delta_psi == pytest.approx(dpsi, abs=AGREE)
     if model == "smooth":  # the centre of mass drifts uniformly at |v_horizontal|
-        assert row.period_map.motion == "drifting"
-        assert math.hypot(*row.period_map.drift_velocity) == pytest.approx(0.25, rel=1e-12)
-    else:  # the CoM's displacement over a period: the full system's
-        # from the lowest turning point, the map's canonical start (PeriodMap)
+        assert row.period_map.motion == "uniform drift" and row.to_dict()["displacement"] is None
+        assert row.period_map.drift_speed == pytest.approx(0.25, rel=1e-12)
+    else:  # the CoM's displacement over a period: the full system's, as a vector
+        # from the lowest turning point, the map's canonical start (PeriodMap: the CoM at the
+        # origin and the axis azimuth 0 there)
         t_bottom = sol.t_events[1]
         start, end = sol.sol(t_bottom[0]), sol.sol(t_bottom[1])
-        moved = complex(end[15] - start[15], end[16] - start[16])
-        assert abs(moved) == pytest.approx(math.hypot(*row.period_map.displacement), rel=1e-7)
+        psi0 = math.atan2(start[11], start[8])
+        moved = complex(end[15] - start[15], end[16] - start[16]) * complex(
+            math.cos(psi0), -math.sin(psi0)
+        )
+        D = complex(*row.period_map.displacement)
+        assert abs(moved - D) < 1e-7 * max(1.0, abs(D))
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -336,3 +341,43 @@ def test_the_mirrored_level_sees_the_same_motion(model, body, rng):
     np.testing.assert_allclose(mirror.rho(math.pi - theta), level.rho(theta), rtol=1e-14)
     np.testing.assert_allclose(mirror.psi_dot(math.pi - theta), level.psi_dot(theta),
                                rtol=1e-11, atol=1e-12)  # fmt: skip
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_dU_and_d2U_are_the_derivatives_of_U(model, body, rng):
+    """The analytic dU (and d2U, its complex step) against mpmath's derivatives of U written
+    again from the formulas (_mp_potential)."""
+    level, _ = _random_level(model, body, rng)
+    U, _ = _mp_potential(level)
+    with mp.workdps(30):
+        for theta in (0.4, 1.1, 1.9, 2.6):
+            assert float(level.dU(theta)) == pytest.approx(float(mp.diff(U, theta)),
+                                                           rel=1e-10, abs=1e-10)  # fmt: skip
+            assert float(level.d2U(theta)) == pytest.approx(float(mp.diff(U, theta, 2)),
+                                                            rel=1e-9, abs=1e-9)  # fmt: skip
+
+
+def test_no_meridian_pole_limits_are_given_for_the_other_models(paper_body):
+    """Near a pole level of the smooth or rough model, no near-pole limit is reported (the
+    meridian model's limits and reactions do not apply); the orbits are still computed."""
+    from rollingtop.survey import survey_orbits
+
+    smooth = SmoothLevel(paper_body, 1.0, 0.999)
+    b = paper_body
+    k = b.R + b.a3
+    routh = 1.0
+    pole_j = -b.I3 * k * routh / math.sqrt(b.I1 * b.I3 + b.m * b.I3 * k**2)
+    rough = RoughLevel(paper_body, jellett=pole_j + 0.01, routh=routh)
+    for level in (smooth, rough):
+        h = steady_motions(level)[0].U + 0.3
+        rows = survey_orbits(level, h)
+        assert rows and all(r.near_pole is None for r in rows)
+
+
+def test_a_uniformly_drifting_level_has_no_reconstructed_path(paper_body):
+    from rollingtop.absolute import reconstruct
+    from rollingtop.reduction import LevelSetError
+
+    level = SmoothLevel(paper_body, 1.0, 0.5, p_horizontal=0.2)
+    with pytest.raises(LevelSetError, match="drifts uniformly"):
+        reconstruct(level, [0.0, 1.0], theta0=1.0, w_tau0=0.0)

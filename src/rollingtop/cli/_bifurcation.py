@@ -91,8 +91,16 @@ def bifurcation(
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
     if sc.model.reduction and not sc.model.has_reduction:
+        given = [f for f, v in (("--c2-range", c2_range), ("--h-range", h_range),
+                                ("--c1-range", c1_range)) if v is not None]  # fmt: skip
+        if given:
+            raise BadInput(f"{', '.join(given)}: the paper's model's windows; the "
+                           f"{sc.model.name} model's is --axis-range")  # fmt: skip
         _other_model(sc, as_json, output, _range("--axis-range", axis_range))
         return
+    if axis_range is not None:
+        raise BadInput("--axis-range: another reduced model's window; the meridian model's are "
+                       "--c2-range, --h-range and --c1-range")  # fmt: skip
     M3, C1, C2 = sc.level_integrals("`rollingtop bifurcation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=ranges["C2"], h_range=ranges["h"])
     width = 2.0 * max(abs(M3), abs(C1), 1e-3)

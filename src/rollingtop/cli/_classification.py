@@ -46,11 +46,17 @@ def compare_classification(scenario: str, output: str, as_json: bool, points: in
                        "every model from)")  # fmt: skip
     y0 = sc.require_state()
     own = (sc.model.name, y0) if sc.model.reduction else None
-    classes = classify_models(sc.body, y0[12:15], y0[3:6], n=points, own=own)
+    refused: dict[str, str] = {}
+    classes = classify_models(sc.body, y0[12:15], y0[3:6], n=points, own=own, refused=refused)
+    if not classes:
+        reasons = "; ".join(f"{k}: {v}" for k, v in refused.items())
+        raise BadInput(f"compare-classification: no model reduces this state ({reasons})")
     save_figure(classification_figure(classes), output)
     if as_json:
-        click.echo(json.dumps({"models": [c.to_dict() for c in classes]}))
+        click.echo(json.dumps({"models": [c.to_dict() for c in classes], "refused": refused}))
         return
+    for name, reason in refused.items():
+        click.echo(f"{name}: not classified ({reason})", err=True)
     from rich.table import Table
 
     table = Table(title="the same body and state under each reduced model")

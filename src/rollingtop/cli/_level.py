@@ -91,6 +91,8 @@ def _orbits_table(level: LevelSet, h: float, survey: Sequence[OrbitSurvey]) -> T
                 "bounded" + (" (near-resonant)" if pm.near_resonant else ""),
                 f"r = {pm.radius:.6g} about ({cx:.4g}, {cy:.4g})",
             )
+        elif pm.motion == "uniform drift":
+            extra = (f"{pm.delta_psi:.10g}", "uniform drift", f"|v| = {pm.drift_speed:.6g}")
         else:
             vx, vy = pm.drift_velocity or (math.nan, math.nan)
             extra = (f"{pm.delta_psi:.10g}", "drifting", f"v = ({vx:.6g}, {vy:.6g})")

@@ -85,7 +85,7 @@ def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
         ax.contour(G, Wt, H, levels=np.linspace(u_lo, u_hi, 12)[1:], colors=colour,
                    linewidths=0.6, alpha=0.7)  # fmt: skip
         ax.contour(G, Wt, H, levels=[c.h], colors="k", linewidths=1.5)
-        ax.plot([c.state[14]], [float(np.dot(c.state[3:6], _tau(c.state)))], "k*", ms=9)
+        ax.plot([c.state[14]], [_w_tau(c.state)], "k*", ms=9)
         ax.set_xlabel(r"$\gamma_3$")
         if j == 0:
             ax.set_ylabel(r"$\omega_\tau$")
@@ -103,12 +103,12 @@ def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
     return fig
 
 
-def _tau(y: FloatArray) -> FloatArray:
-    """``tau = e3 x gamma / s`` of the state ``y`` (body frame)."""
+def _w_tau(y: FloatArray) -> float:
+    """``w_tau = (w, tau)``, ``tau = e3 x gamma / s``, of the state ``y`` (body frame); 0 at a
+    vertical axis (``s = 0``, where the orbit is a point)."""
     g = y[12:15]
     s = math.hypot(g[0], g[1])
-    out: FloatArray = np.array([-g[1], g[0], 0.0]) / s
-    return out
+    return 0.0 if s == 0.0 else float((-g[1] * y[3] + g[0] * y[4]) / s)
 
 
 def _draw_critical(ax: Any, cv: CriticalValues, colour: str) -> None:

@@ -68,10 +68,10 @@ class LevelServices:
         N: Real = b.m * (b.g + b.a3 * (np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau))
         return N
 
-    def uniform_drift(self) -> complex | None:
-        """The centre of mass's horizontal velocity ``X' + i Y'`` in the fixed frame of
-        :mod:`rollingtop.absolute` when it is constant (a model with conserved horizontal
-        momentum), else ``None``: the meridian model's turns with the axis
+    def uniform_drift(self) -> float | None:
+        """The speed of the centre of mass when it drifts uniformly whatever the axis does (a
+        model with conserved horizontal momentum: its direction is not part of the level),
+        else ``None``: the meridian model's velocity turns with the axis
         (:func:`rollingtop.absolute.period_map`)."""
         return None
 

@@ -183,6 +183,7 @@ def classify_models(
     models: Sequence[str] | None = None,
     n: int = 121,
     own: tuple[str, ArrayLike] | None = None,
+    refused: dict[str, str] | None = None,
 ) -> list[ModelClassification]:
     """Each integrable model's classification of the motion from ``(gamma, omega)``.
 
@@ -203,7 +204,11 @@ def classify_models(
     own : (str, array_like), optional
         A model's name and a full state of it (shape (18,)) used as it is for that model (a
         scenario's own model and state, with its free velocity components).
+    refused : dict, optional
+        Filled with the models whose level of the state is refused (a pole level a model does
+        not reduce yet) and why; the other models are classified all the same.
     """
+    refused = {} if refused is None else refused
     from rollingtop.dynamics.state import initial_state
     from rollingtop.reduction.variables import reduce_state
 
@@ -215,7 +220,11 @@ def classify_models(
             y = np.asarray(own[1], dtype=float)
         else:
             y = initial_state(body, name, gamma=gamma, omega=omega)
-        level = reduction.level_of_state(body, y)
+        try:
+            level = reduction.level_of_state(body, y)
+        except LevelSetError as err:  # e.g. a level the model does not reduce: the others go on
+            refused[name] = str(err)
+            continue
         h = reduction.reduced_energy(body, y)
         theta = float(reduce_state(y)["theta"])
         found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]

@@ -140,11 +140,12 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[flo
 
 
 def near_pole(level: LevelSet, h: float, orbit: Orbit) -> NearPole | None:
-    """The limits of ``orbit`` on the pole level it is near (module docstring), or ``None``
-    when the level is not within :data:`NEAR_POLE` of a pole level or the orbit does not reach
-    the wall (its end is not within ``WALL_RATIO`` of its width from the pole)."""
-    if level.pole is not None or orbit.kind != "periodic":
-        return None
+    """The limits of ``orbit`` on the pole level it is near (module docstring), or ``None``:
+    for another model's level (its own limits are not derived), when the level is not within
+    :data:`NEAR_POLE` of a pole level, or when the orbit does not reach the wall (its end is
+    not within ``WALL_RATIO`` of its width from the pole)."""
+    if level.pole is not None or orbit.kind != "periodic" or level.model != "meridian":
+        return None  # the limits are the meridian model's (its pole levels, its reactions)
     M3, C1 = level.M3, level.C1
     north = near_north(level)
     offset = C1 + M3 if north else C1 - M3

@@ -121,11 +121,10 @@ class SmoothLevel(LevelSet):
         out: FloatArray = b.a3 * s * wt * frame["gamma"] + self.p_horizontal / b.m * frame["tau"]
         return out
 
-    def uniform_drift(self) -> complex:
-        """``-i p_horizontal / m``: the constant velocity of the centre of mass, along ``tau``
-        at the start (:meth:`com_velocity`), which is ``-i exp(i psi)`` in the fixed frame of
-        :mod:`rollingtop.absolute`, with ``psi = 0`` at the canonical start."""
-        return complex(0.0, -self.p_horizontal / self.body.m)
+    def uniform_drift(self) -> float:
+        """``p_horizontal / m``: the centre of mass drifts uniformly at this speed, in a
+        direction the level does not fix (the horizontal momentum's)."""
+        return self.p_horizontal / self.body.m
 
     def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
         """Eigenvalues of the reduced motion ``(gamma3, w_n, w_tau)`` linearised at the steady

@@ -24,13 +24,18 @@ from rollingtop.reduction.variables import reduced_integrals, state_from_level
 __all__ = ["level_energy", "level_of_state", "reduced_energy", "start_on_level"]
 
 
-def level_of_state(body: SphericalTop, y: ArrayLike) -> LevelSet:
-    """The level set ``(M3, C1, C2)`` of the state ``y`` (shape (18,)).
+def level_of_state(body: SphericalTop, y: ArrayLike, model: str = "meridian") -> LevelSet:
+    """The level set ``(M3, C1, C2)`` of the state ``y`` (shape (18,)) of the meridian model;
+    another ``model``'s own level (:meth:`rollingtop.reduction.models.Reduction.level_of_state`).
 
     The values come from :func:`~rollingtop.reduction.reduced_integrals`; ``|I w|`` of the state
     is the round-off scale of ``M3`` and ``C1`` in the pole decision
     (:class:`~rollingtop.reduction.LevelSet`, ``scale``).
     """
+    if model != "meridian":
+        from rollingtop.reduction.models import reduction_of
+
+        return reduction_of(model).level_of_state(body, y)
     y = np.asarray(y, dtype=float)
     ints = reduced_integrals(body, y)
     scale = float(np.linalg.norm(body.inertia * y[W]))
@@ -38,8 +43,14 @@ def level_of_state(body: SphericalTop, y: ArrayLike) -> LevelSet:
                     scale=scale)  # fmt: skip
 
 
-def reduced_energy(body: SphericalTop, y: ArrayLike) -> float:
-    """The reduced energy ``h = E - I3 w3^2/2 - m g R`` of the state ``y`` (shape (18,))."""
+def reduced_energy(body: SphericalTop, y: ArrayLike, model: str = "meridian") -> float:
+    """The reduced energy ``h = E - I3 w3^2/2 - m g R`` of the state ``y`` (shape (18,)) of the
+    meridian model; another ``model``'s own ``h``
+    (:meth:`rollingtop.reduction.models.Reduction.reduced_energy`)."""
+    if model != "meridian":
+        from rollingtop.reduction.models import reduction_of
+
+        return reduction_of(model).reduced_energy(body, y)
     return float(reduced_integrals(body, np.asarray(y, dtype=float))["h"])
 
 

@@ -176,10 +176,10 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
         period=2 * math.pi / omega if kind == "center" else math.nan,
         growth_rate=math.sqrt(-U2t / rho) if kind == "saddle" else math.nan,
         w_n=float(level.w_n(theta)) if abs(s) > 1e-12 else 0.0,
-        v_tau=v_tau,
+        v_tau=v_tau if drift is None else math.nan,  # a drift's (v, tau) is not the level's
         spin=float(level.spin(theta)),
         precession_rate=psi_dot,
-        com_speed=abs(v_tau) if drift is None else abs(drift),
+        com_speed=abs(v_tau) if drift is None else drift,
         com_radius=(abs(v_tau / psi_dot) if psi_dot != 0 else math.inf)
         if drift is None
         else (math.inf if drift else 0.0),
