@@ -97,6 +97,9 @@ class LevelSet(LevelServices):
 
     #: The contact model whose reduction this is (:mod:`rollingtop.reduction.models`).
     model: ClassVar[str] = "meridian"
+    #: Whether :func:`rollingtop.reduction.near_pole.near_pole` knows this model's limits on
+    #: its pole levels (the meridian model's only, so far).
+    near_pole_limits: ClassVar[bool] = True
 
     body: SphericalTop
     M3: float

@@ -144,7 +144,7 @@ def near_pole(level: LevelSet, h: float, orbit: Orbit) -> NearPole | None:
     for another model's level (its own limits are not derived), when the level is not within
     :data:`NEAR_POLE` of a pole level, or when the orbit does not reach the wall (its end is
     not within ``WALL_RATIO`` of its width from the pole)."""
-    if level.pole is not None or orbit.kind != "periodic" or level.model != "meridian":
+    if level.pole is not None or orbit.kind != "periodic" or not level.near_pole_limits:
         return None  # the limits are the meridian model's (its pole levels, its reactions)
     M3, C1 = level.M3, level.C1
     north = near_north(level)

@@ -64,6 +64,7 @@ class RoughLevel(LevelSet):
 
     integrals: ClassVar[tuple[str, ...]] = ("jellett", "routh")
     model: ClassVar[str] = "rough"
+    near_pole_limits: ClassVar[bool] = False
 
     M3: float = 0.0
     C1: float = 0.0

@@ -55,6 +55,7 @@ class SmoothLevel(LevelSet):
 
     integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "p_horizontal")
     model: ClassVar[str] = "smooth"
+    near_pole_limits: ClassVar[bool] = False
 
     C2: float = 0.0
     #: The size ``m |v_horizontal|`` of the horizontal momentum (its direction is free).

@@ -24,15 +24,16 @@ from rollingtop.reduction.variables import reduced_integrals, state_from_level
 __all__ = ["level_energy", "level_of_state", "reduced_energy", "start_on_level"]
 
 
-def level_of_state(body: SphericalTop, y: ArrayLike, model: str = "meridian") -> LevelSet:
+def level_of_state(body: SphericalTop, y: ArrayLike, model: str | None = None) -> LevelSet:
     """The level set ``(M3, C1, C2)`` of the state ``y`` (shape (18,)) of the meridian model;
-    another ``model``'s own level (:meth:`rollingtop.reduction.models.Reduction.level_of_state`).
+    with ``model``, that model's own level
+    (:meth:`rollingtop.reduction.models.Reduction.level_of_state`).
 
     The values come from :func:`~rollingtop.reduction.reduced_integrals`; ``|I w|`` of the state
     is the round-off scale of ``M3`` and ``C1`` in the pole decision
     (:class:`~rollingtop.reduction.LevelSet`, ``scale``).
     """
-    if model != "meridian":
+    if model is not None:
         from rollingtop.reduction.models import reduction_of
 
         return reduction_of(model).level_of_state(body, y)
@@ -43,11 +44,11 @@ def level_of_state(body: SphericalTop, y: ArrayLike, model: str = "meridian") ->
                     scale=scale)  # fmt: skip
 
 
-def reduced_energy(body: SphericalTop, y: ArrayLike, model: str = "meridian") -> float:
+def reduced_energy(body: SphericalTop, y: ArrayLike, model: str | None = None) -> float:
     """The reduced energy ``h = E - I3 w3^2/2 - m g R`` of the state ``y`` (shape (18,)) of the
-    meridian model; another ``model``'s own ``h``
+    meridian model; with ``model``, that model's own ``h``
     (:meth:`rollingtop.reduction.models.Reduction.reduced_energy`)."""
-    if model != "meridian":
+    if model is not None:
         from rollingtop.reduction.models import reduction_of
 
         return reduction_of(model).reduced_energy(body, y)
