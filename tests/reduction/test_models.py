@@ -381,3 +381,27 @@ def test_a_uniformly_drifting_level_has_no_reconstructed_path(paper_body):
     level = SmoothLevel(paper_body, 1.0, 0.5, p_horizontal=0.2)
     with pytest.raises(LevelSetError, match="drifts uniformly"):
         reconstruct(level, [0.0, 1.0], theta0=1.0, w_tau0=0.0)
+
+
+def test_a_rough_level_near_its_north_pole_level_is_computed_on_its_mirror(paper_body):
+    """Jellett's integral 1e-6 from the north pole level: the level is mirrored (near_north,
+    from its own pole offsets), and its orbit's turning points and period agree with mpmath's
+    quadrature of U written again from the formulas."""
+    from rollingtop.reduction.level import near_north
+
+    b = paper_body
+    k = -b.R + b.a3  # at the north pole, gamma3 = -1
+    routh = 1.0
+    pole_j = -b.I3 * k * routh / math.sqrt(b.I1 * b.I3 + b.m * b.I3 * k**2)
+    level = RoughLevel(b, jellett=pole_j + 1e-6, routh=routh)
+    assert near_north(level)
+    h = steady_motions(level)[0].U + 0.3
+    (o,) = orbits(level, h)
+    U, rho = _mp_potential(level)
+    with mp.workdps(40):
+        lo = mp.findroot(lambda t: U(t) - h, (o.theta_min + o.theta_max) / 2 - 0.3)
+        hi = mp.findroot(lambda t: U(t) - h, (o.theta_max - 1e-7, o.theta_max + 1e-9),
+                         solver="anderson")  # fmt: skip
+        T = 2 * mp.quad(lambda t: mp.sqrt(rho(t) / (2 * (h - U(t)))), [lo, hi])
+    assert o.theta_max == pytest.approx(float(hi), abs=1e-12)
+    assert o.period == pytest.approx(float(T), rel=QUAD_RTOL)

@@ -139,6 +139,11 @@ class LevelSet(LevelServices):
                 f"potential reaches {size:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale units)"
             )
 
+    def pole_offsets(self) -> tuple[float, float]:
+        """How far the level is from its south and north pole levels: ``C1 - M3`` and
+        ``C1 + M3`` (:func:`near_north`)."""
+        return self.C1 - self.M3, self.C1 + self.M3
+
     def mirrored(self) -> LevelSet:
         """The same motions seen with the body axis reversed (``e3 -> -e3``): ``theta -> pi -
         theta``, ``a3 -> -a3``, ``M3 -> -M3``, ``C1`` kept, ``C2 -> -C2 - pi M3 a3``.
@@ -369,6 +374,8 @@ class LevelSet(LevelServices):
 
 
 def near_north(level: LevelSet) -> bool:
-    """A level that is no pole case and lies nearer ``C1 = -M3`` than ``C1 = M3``: computed on
-    its mirror image (:meth:`LevelSet.mirrored`)."""
-    return level.pole is None and abs(level.M3 + level.C1) < abs(level.M3 - level.C1)
+    """A level that is no pole case and lies nearer its north pole level than its south one
+    (:meth:`LevelSet.pole_offsets`; the meridian model's: ``C1 = -M3`` and ``C1 = M3``): computed
+    on its mirror image (:meth:`LevelSet.mirrored`)."""
+    south, north = level.pole_offsets()
+    return level.pole is None and abs(north) < abs(south)

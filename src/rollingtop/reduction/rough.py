@@ -104,6 +104,11 @@ class RoughLevel(LevelSet):
                     "I3 k w3 = 0 there): the rough model's pole levels are not reduced yet"
                 )
 
+    def pole_offsets(self) -> tuple[float, float]:
+        """``jellett + I3 k w3`` at the south and north poles: 0 on a pole level
+        (:func:`~rollingtop.reduction.level.near_north` mirrors a level nearer the north one)."""
+        return self._numerator(0.0), self._numerator(math.pi)
+
     def mirrored(self) -> RoughLevel:
         """The same motions with the body axis reversed: ``theta -> pi - theta``,
         ``a3 -> -a3``, ``w3 -> -w3`` (so ``routh -> -routh``), ``jellett`` kept."""
