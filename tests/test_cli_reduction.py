@@ -80,6 +80,11 @@ def test_portrait_writes_each_format(capsys, tmp_path, suffix):
         (["orbits", FIG5, "--h", "1.0"], "h is below the minimum of the effective potential"),
         (["equilibria", str(EXAMPLES / "parallel.toml")], "parallel model has no reduction"),
         (["rotation", str(EXAMPLES / "parallel.toml")], "parallel model has no reduction"),
+        (
+            ["rotation", str(EXAMPLES / "rough.toml"), "--c2-range", "0,1"],
+            "the rough model's is --axis-range",
+        ),
+        (["bifurcation", FIG5, "--axis-range", "0,1"], "--axis-range: another reduced model's"),
         (["bifurcation", str(EXAMPLES / "parallel.toml")], "parallel model has no reduction"),
         (["portrait", FIG5, "-o", "x.gif"], "unknown output format '.gif'"),
         (["portrait", FIG5, "-o", "x.png", "--h-levels", "a,b"], "expected comma-separated"),

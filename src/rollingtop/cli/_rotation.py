@@ -21,8 +21,10 @@ __all__ = ["rotation"]
 @click.option("-o", "--output", type=click.Path(), default=None,
               help="Also draw the map and a path of each class: FIG.png, .svg, .pdf.")  # fmt: skip
 @click.option("--c2-range", default=None, metavar="LO,HI",
-              help="C2 window (default: the bifurcation diagram's); for another reduced model, "
-                   "the window of its axis integral (smooth: C1, rough: jellett).")  # fmt: skip
+              help="C2 window (default: the bifurcation diagram's).")  # fmt: skip
+@click.option("--axis-range", default=None, metavar="LO,HI",
+              help="Another reduced model's axis window (smooth: C1, rough: jellett; default "
+                   "its value +- max(1, |value|)).")  # fmt: skip
 @click.option("--h-range", default=None, metavar="LO,HI",
               help="h window (default: the bifurcation diagram's).")  # fmt: skip
 @click.option("--resolution", type=int, default=41, show_default=True,
@@ -34,6 +36,7 @@ def rotation(
     c2_range: str | None,
     h_range: str | None,
     resolution: int,
+    axis_range: str | None,
 ) -> None:
     """Rotation numbers N = Delta psi / 2 pi over the (C2, h) plane at the scenario's (M3, C1):
     where the body drifts (N an integer), where its paths close (N = p/q) and where they fill
@@ -57,8 +60,15 @@ def rotation(
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
     if sc.model.reduction and not sc.model.has_reduction:
-        _other_model(sc, as_json, output, c2_window, h_window, resolution)
+        if c2_range is not None:
+            raise BadInput(f"--c2-range: the paper's model's window; the {sc.model.name} "
+                           "model's is --axis-range")  # fmt: skip
+        _other_model(sc, as_json, output, _range("--axis-range", axis_range), h_window,
+                     resolution)  # fmt: skip
         return
+    if axis_range is not None:
+        raise BadInput("--axis-range: another reduced model's window; the meridian model's is "
+                       "--c2-range")  # fmt: skip
     M3, C1, C2 = sc.level_integrals("`rollingtop rotation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=c2_window, h_range=h_window)
     c2w = (float(diagram.C2_grid[0]), float(diagram.C2_grid[-1]))
