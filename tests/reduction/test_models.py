@@ -405,3 +405,26 @@ def test_a_rough_level_near_its_north_pole_level_is_computed_on_its_mirror(paper
         T = 2 * mp.quad(lambda t: mp.sqrt(rho(t) / (2 * (h - U(t)))), [lo, hi])
     assert o.theta_max == pytest.approx(float(hi), abs=1e-12)
     assert o.period == pytest.approx(float(T), rel=QUAD_RTOL)
+
+
+@pytest.mark.parametrize("pole", [1, -1], ids=["south", "north"])
+def test_the_smooth_reduction_has_the_vertical_spins_threshold(paper_body, pole):
+    """On the smooth plane's pole level (C1 = +-M3) the vertical spin is the critical point at
+    the pole; U'' there changes sign at the closed-form threshold of the contact model
+    (ContactModel.vertical_spin: Lagrange's top about the centre of mass, 2 sqrt(I1 m g a)/I3
+    with a = pole a3): a centre above it, a saddle below (both sides within 1 %)."""
+    from rollingtop.contact import get_model
+
+    for a3 in (0.1, -0.1):
+        b = replace(paper_body, a3=a3)
+        critical = get_model("smooth").vertical_spin(b, pole)
+        if critical == 0.0:  # a <= 0: stable at every spin; check one
+            spins = [0.5]
+        else:
+            spins = [0.99 * critical, 1.01 * critical]
+        for w3 in spins:
+            M3 = b.I3 * w3
+            level = SmoothLevel(b, M3, pole * M3)
+            theta = 0.0 if pole > 0 else math.pi
+            stable = float(level.d2U(theta)) > 0
+            assert stable == (w3 > critical), (a3, w3, critical)
