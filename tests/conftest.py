@@ -1,5 +1,6 @@
 """Shared fixtures. Reference values cite their source; tolerances are named where used."""
 
+import contextlib
 from pathlib import Path
 
 import mpmath
@@ -89,11 +90,30 @@ def admissible_omega(model, gamma, omega):
 
 
 @pytest.fixture(scope="session", autouse=True)
-def kernels_compiled_in_parallel():
+def kernels_compiled_in_parallel(request):
     """Compile (or load) every model's integrator and ensemble kernels before the first test,
     one process per model on every core (:func:`rollingtop.warmup`): on a cold numba cache the
     tests would otherwise compile them one after the other, on one core. A warm cache loads in
-    seconds."""
+    seconds. Says so on the terminal, and each model as it is done: a cold start is about 45 s
+    of otherwise silent work on 2 cores."""
+    import time
+
     from rollingtop import warmup
 
-    warmup()
+    reporter = request.config.pluginmanager.get_plugin("terminalreporter")
+    capture = request.config.pluginmanager.get_plugin("capturemanager")
+
+    def say(text):
+        if reporter is None:
+            return
+        with capture.global_and_fixture_disabled() if capture else contextlib.nullcontext():
+            reporter.write_line(text)
+
+    start = time.perf_counter()
+    say(
+        "rollingtop: compiling or loading every model's kernels before the first test (a cold "
+        "numba cache: about 45 s on 2 cores, one process per model; a warm one: seconds)"
+    )
+    warmup(progress=lambda model, seconds: say(
+        f"  {model}: {sum(seconds.values()):.1f} s"))  # fmt: skip
+    say(f"rollingtop: kernels ready in {time.perf_counter() - start:.1f} s")
