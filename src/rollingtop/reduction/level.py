@@ -362,15 +362,26 @@ class LevelSet(LevelServices):
         x0 = np.array([gamma3, float(self.v_tau(theta)), float(self.w_n(theta)), 0.0])
         return reduced_eigenvalues(self.body, self.M3, x0)
 
-    def describe(self) -> str:
-        """One line naming the level set."""
-        pole = {
+    def curvature_eigenvalues(self, gamma3: float) -> ComplexArray:
+        """``+-sqrt(-U''/rho)`` and 0 at the steady motion at ``gamma3``: the one degree of
+        freedom ``(theta, w_tau)`` linearised, the level's integrals held (a model without the
+        reduced equations of :meth:`linearised_eigenvalues`)."""
+        theta = math.acos(gamma3)
+        root = np.sqrt(complex(-float(self.d2U(theta)) / float(self.rho(theta))))
+        return np.array([root, -root, 0.0], dtype=complex)
+
+    def pole_label(self) -> str:
+        """The pole case in words, for :meth:`describe` (empty for no pole case)."""
+        return {
             None: "",
             "south": " (south pole case)",
             "north": " (north pole case)",
             "both": " (no spin: both poles)",
         }[self.pole]
-        return f"M3 = {self.M3:g}, C1 = {self.C1:g}, C2 = {self.C2:g}{pole}"
+
+    def describe(self) -> str:
+        """One line naming the level set."""
+        return f"M3 = {self.M3:g}, C1 = {self.C1:g}, C2 = {self.C2:g}{self.pole_label()}"
 
 
 def near_north(level: LevelSet) -> bool:

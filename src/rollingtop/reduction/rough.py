@@ -189,11 +189,9 @@ class RoughLevel(LevelSet):
     energy_formula: ClassVar[str] = "h + m g R"
 
     def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
-        """``+-sqrt(-U''/rho)`` and 0 at the steady motion at ``gamma3`` (the reduced motion
-        ``(theta, w_tau)`` with the two integrals held)."""
-        theta = math.acos(gamma3)
-        root = np.sqrt(complex(-float(self.d2U(theta)) / float(self.rho(theta))))
-        return np.array([root, -root, 0.0], dtype=complex)
+        """Eigenvalues of the reduced motion linearised at the steady motion at ``gamma3``:
+        :meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`."""
+        return self.curvature_eigenvalues(gamma3)
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -128,18 +128,14 @@ class SmoothLevel(LevelSet):
         return self.p_horizontal / self.body.m
 
     def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
-        """Eigenvalues of the reduced motion ``(gamma3, w_n, w_tau)`` linearised at the steady
-        motion at ``gamma3``: ``+-sqrt(-U''/rho)`` and 0 (the area integral)."""
-        theta = math.acos(gamma3)
-        root = np.sqrt(complex(-float(self.d2U(theta)) / float(self.rho(theta))))
-        return np.array([root, -root, 0.0], dtype=complex)
+        """Eigenvalues of the reduced motion linearised at the steady motion at ``gamma3``:
+        :meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`."""
+        return self.curvature_eigenvalues(gamma3)
 
     def describe(self) -> str:
         """One line naming the level set."""
-        pole = {None: "", "south": " (south pole case)", "north": " (north pole case)",
-                "both": " (no spin: both poles)"}[self.pole]  # fmt: skip
         drift = f", p_horizontal = {self.p_horizontal:g}" if self.p_horizontal else ""
-        return f"M3 = {self.M3:g}, C1 = {self.C1:g}{drift}{pole}"
+        return f"M3 = {self.M3:g}, C1 = {self.C1:g}{drift}{self.pole_label()}"
 
 
 def smooth_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
