@@ -197,3 +197,75 @@ def test_too_many_local_workers_are_refused(tmp_path):
     with pytest.raises(AtlasError, match="per core"):
         atlas(spec, tmp_path / "a.nc", workers=100 * (os.cpu_count() or 1))
     assert list(tmp_path.iterdir()) == []
+
+
+# ---- a model axis (issue 24): each model's level of one initial state ----------------------
+
+STATE = {"gamma": [0.0, 0.6, 0.8], "omega": [0.7, -0.3, 2.0]}
+MODEL_AXES = {"model": ["meridian", "smooth", "rough", "rubber"], "a3": [-0.2, 0.1],
+              "I3": [0.5, 0.7]}  # fmt: skip
+
+
+def state_spec_dict(axes, model="meridian"):
+    return {"body": dict(BODY), "contact": {"model": model}, "initial": dict(STATE),
+            "axes": axes}  # fmt: skip
+
+
+def test_a_model_axis_classifies_each_models_level_of_the_state(client, tmp_path):
+    """Each cell's counts and centres are those of compare-classification's construction
+    (classify_models: the same state under each model, rubber's omega projected), computed here
+    independently of the atlas; the Dask run equals the in-process one and the NetCDF keeps the
+    model names; an inadmissible body is a cell (status 1), whatever the model."""
+    from rollingtop.reduction.classify import classify_models
+
+    spec = atlas_spec_from_dict(state_spec_dict(MODEL_AXES))
+    assert spec.models == ("meridian", "smooth", "rough", "rubber")
+    expected = classify_in_process(spec)
+    ds = atlas(spec, tmp_path / "m.nc", client=client, chunk=3)
+    assert ds.identical(expected)
+    with xr.open_dataset(tmp_path / "m.nc") as f:
+        assert f["model"].values.tolist() == MODEL_AXES["model"]
+        assert f["n_steady"].equals(expected["n_steady"])
+    for a3 in MODEL_AXES["a3"]:
+        body = SphericalTop(**{**BODY, "a3": a3})
+        classes = {c.model: c for c in classify_models(body, STATE["gamma"], STATE["omega"],
+                                                       n=3)}  # fmt: skip
+        for model in MODEL_AXES["model"]:
+            cell = ds.sel(model=model, a3=a3, I3=0.5)
+            motions = classes[model].steady
+            assert int(cell["status"]) == 0
+            assert int(cell["n_steady"]) == len(motions)
+            assert int(cell["n_centres"]) == sum(m.type == "center" for m in motions)
+            centres = [m for m in motions if m.type == "center"]
+            for k, m in enumerate(centres):
+                assert float(cell["centre_gamma3"][k]) == pytest.approx(m.gamma3, abs=1e-12)
+                assert float(cell["rotation_centre"][k]) == pytest.approx(
+                    m.precession_rate / m.frequency, rel=1e-12)  # fmt: skip
+            assert (int(cell["n_folds"]) >= 0) == (model == "meridian")
+            assert int(ds.sel(model=model, a3=a3, I3=0.7)["status"]) == 1  # I3 > 2 I1
+
+
+def test_a_model_other_than_the_meridian_one_is_an_atlas_of_its_own():
+    """No model axis: the scenario's model (rough), its level from the state."""
+    spec = atlas_spec_from_dict(state_spec_dict({"a3": [0.1]}, model="rough"))
+    assert spec.models == ("rough",)
+    assert int(classify_in_process(spec)["status"].values[0]) == 0
+
+
+@pytest.mark.parametrize(
+    ("axes", "model", "initial", "message"),
+    [
+        ({"model": ["meridian", "parallel"]}, "meridian", True, "not a model with a reduction"),
+        ({"model": ["rough", "rough"]}, "meridian", True, "twice"),
+        ({"model": "rough"}, "meridian", True, "non-empty list"),
+        ({"model": ["rough"], "C2": [0.0]}, "meridian", True, "takes body keys and model"),
+        ({"model": ["rough"]}, "meridian", False, "needs an \\[initial\\] table"),
+        ({"a3": [0.1]}, "parallel", True, "parallel model has no reduction"),
+    ],
+)
+def test_bad_model_axes_are_refused_in_one_line(axes, model, initial, message):
+    data = state_spec_dict(axes, model=model)
+    if not initial:
+        del data["initial"]
+    with pytest.raises(AtlasError, match=message):
+        atlas_spec_from_dict(data)

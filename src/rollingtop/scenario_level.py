@@ -19,7 +19,9 @@ __all__ = ["LevelSpec", "level_from_table"]
 
 #: Where a motion starts on a level, after the level's own integrals (ContactModel.reduction).
 _LEVEL_PLACEMENT = ("h", "gamma3", "branch", "phi", "psi")
-_LEVEL_KEYS = ("M3", "C1", "C2", "p_horizontal", "jellett", "routh", *_LEVEL_PLACEMENT)
+_LEVEL_KEYS = (
+    "M3", "C1", "C2", "p_horizontal", "jellett", "routh", "rubber_spin", *_LEVEL_PLACEMENT
+)  # fmt: skip
 #: Integrals a [level] may leave out: C2 (``rollingtop bifurcation`` scans it), p_horizontal
 #: (the smooth model's drift: 0).
 _LEVEL_OPTIONAL = {"C2": None, "p_horizontal": 0.0}
@@ -44,6 +46,7 @@ class LevelSpec:
     p_horizontal: float | None = None
     jellett: float | None = None
     routh: float | None = None
+    rubber_spin: float | None = None
     h: float | None = None
     gamma3: float | None = None
     branch: int = 1
@@ -58,6 +61,7 @@ class LevelSpec:
             "p_horizontal",
             "jellett",
             "routh",
+            "rubber_spin",
             "h",
             "gamma3",
             "phi",

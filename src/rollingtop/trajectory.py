@@ -52,6 +52,7 @@ _UNITS = {
     "momentum_x": "M L T-1",
     "momentum_y": "M L T-1",
     "routh": "M L2 T-1",
+    "rubber_spin": "M L2 T-1",
 }
 
 

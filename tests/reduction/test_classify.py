@@ -29,7 +29,10 @@ def classes():
 
 def test_every_reduced_model_is_classified_with_its_own_level(classes):
     found, y0 = classes
-    assert [c.model for c in found] == ["meridian", "smooth", "rough"]
+    assert [c.model for c in found] == ["meridian", "smooth", "rough", "rubber"]
+    # rubber rolling starts from omega's horizontal part (the paper's state spins about gamma)
+    assert found[3].note == "omega projected onto (omega, gamma) = 0"
+    np.testing.assert_allclose(found[3].state[3:6] @ found[3].state[12:15], 0.0, atol=1e-15)
     for c in found:
         reduction = reduction_of(c.model)
         assert c.level.values() == pytest.approx(
@@ -76,7 +79,7 @@ def test_compare_classification_command(capsys, tmp_path):
                              "-o", str(out_png), "--json", "--points", "11")  # fmt: skip
     assert code == 0, err
     data = json.loads(out)
-    assert [m["model"] for m in data["models"]] == ["meridian", "smooth", "rough"]
+    assert [m["model"] for m in data["models"]] == ["meridian", "smooth", "rough", "rubber"]
     for m in data["models"]:
         assert {"gamma3_min", "gamma3_max", "period", "delta_psi"} <= set(m["orbit"])
         assert len(m["critical"]["x"]) == 11
@@ -146,5 +149,9 @@ omega = [0.0, 0.0, 3.0]
                              str(tmp_path / "v.png"), "--json", "--points", "5")  # fmt: skip
     assert code == 0, err
     data = json.loads(out)
-    assert [m["model"] for m in data["models"]] == ["meridian", "smooth"]
+    assert [m["model"] for m in data["models"]] == ["meridian", "smooth", "rubber"]
     assert set(data["refused"]) == {"rough"} and "pole" in data["refused"]["rough"]
+    # rubber rolling cannot spin about the vertical: its part of omega is the rest at the pole
+    rubber = data["models"][2]
+    assert rubber["level"]["rubber_spin"] == 0.0 and rubber["orbit"] is None
+    assert "omega projected" in rubber["note"]

@@ -1,4 +1,5 @@
-"""The reductions of the smooth and rough models (rollingtop.reduction.smooth, .rough) against
+"""The reductions of the smooth, rough and rubber models (rollingtop.reduction.smooth, .rough,
+.rubber) against
 independent sources: the full equations of tests/dynamics/reference.py integrated by solve_ivp,
 mpmath quadrature, and the integrals of the full state."""
 
@@ -14,6 +15,7 @@ from scipy.integrate import solve_ivp
 from rollingtop import INTEGRALS, ScenarioError, initial_state
 from rollingtop.reduction import (
     RoughLevel,
+    RubberLevel,
     SmoothLevel,
     orbits,
     reduction_of,
@@ -32,7 +34,7 @@ STEADY_DRIFT = 1e-9  # issue 24: gamma3 on a steady motion over 10 periods
 STATE_TOL = 1e-12  # integrals of a reconstructed state
 
 
-MODELS = ["smooth", "rough"]
+MODELS = ["smooth", "rough", "rubber"]
 
 
 @pytest.fixture(params=[0.1, -0.1], ids=["com_above", "com_below"])
@@ -43,6 +45,9 @@ def body(request, paper_body):
 
 def _state(model, body, gamma, omega):
     free = {"v_horizontal": (0.25, 0.0)} if model == "smooth" else None
+    if model == "rubber":  # no spin about the normal: the horizontal part of omega
+        g = np.asarray(gamma, dtype=float) / np.linalg.norm(gamma)
+        omega = np.asarray(omega, dtype=float) - np.dot(omega, g) * g
     return initial_state(body, model, gamma=gamma, omega=omega, free=free)
 
 
@@ -121,6 +126,21 @@ def _mp_potential(level):
 
         def rho(t):
             return b.I1 + b.m * b.a3**2 * mp.sin(t) ** 2
+
+        return U, rho
+    if isinstance(level, RubberLevel):  # T of a horizontal w with w_tau = 0, w = Omega nu
+
+        def U(t):
+            s, c, k = mp.sin(t), mp.cos(t), b.R * mp.cos(t) + b.a3
+            J = b.I1 * c**2 + b.I3 * s**2 + b.m * (b.R + b.a3 * c) ** 2
+            w3 = level.rubber_spin / mp.sqrt(b.I3 * J)
+            w_n = w3 * c / s
+            return (b.I1 * w_n**2 + b.I3 * w3**2 + b.m * (b.R * s * w3 + k * w_n) ** 2) / 2 + (
+                b.m * b.g * b.a3 * c
+            )
+
+        def rho(t):
+            return b.I1 + b.m * (b.R**2 + b.a3**2 + 2 * b.a3 * b.R * mp.cos(t))
 
         return U, rho
     J, D = level.jellett, level.routh
@@ -260,7 +280,7 @@ def test_every_declared_reduction_is_registered_with_the_same_names():
 
     declared = {name: m.reduction for name, m in MODELS.items() if m.reduction}
     assert declared == {name: r.names for name, r in REDUCTIONS.items()}
-    assert set(declared) == {"meridian", "smooth", "rough"}
+    assert set(declared) == {"meridian", "smooth", "rough", "rubber"}
 
 
 def test_a_rough_pole_level_is_refused_in_one_line(paper_body):
@@ -303,7 +323,7 @@ def test_every_integral_a_reduction_uses_is_claimed_and_so_proved_by_verify():
 
     uses = {"M3": ("lagrange",), "C1": ("area",), "C2": ("F6",),
             "p_horizontal": ("momentum_x", "momentum_y"), "jellett": ("jellett",),
-            "routh": ("routh",)}  # fmt: skip
+            "routh": ("routh",), "rubber_spin": ("rubber_spin",)}  # fmt: skip
     for name, reduction in REDUCTIONS.items():
         claimed = get_model(name).integrals_symmetric
         proved = " ".join(str(c) for c in claims_for(name))
@@ -320,6 +340,9 @@ def test_every_integral_a_reduction_uses_is_claimed_and_so_proved_by_verify():
         (lambda b: SmoothLevel(b, 1.0, 0.5, p_horizontal=-0.1), "must be finite and >= 0"),
         (lambda b: RoughLevel(b, jellett=1e300, routh=1e300), "too large for double"),
         (lambda b: RoughLevel(b, jellett=math.nan, routh=1.0), "must be finite"),
+        (lambda b: RubberLevel(b, rubber_spin=1e200), "too large for double"),
+        (lambda b: RubberLevel(b, rubber_spin=math.inf), "must be finite"),
+        (lambda b: RubberLevel(b, rubber_spin="1"), "must be a number"),
     ],
 )
 def test_levels_out_of_range_are_refused_in_one_line(paper_body, make, message):
@@ -428,3 +451,65 @@ def test_the_smooth_reduction_has_the_vertical_spins_threshold(paper_body, pole)
             theta = 0.0 if pole > 0 else math.pi
             stable = float(level.d2U(theta)) > 0
             assert stable == (w3 > critical), (a3, w3, critical)
+
+
+def test_the_rubber_pole_level_rocks_through_the_vertical_as_the_full_system(body):
+    """rubber_spin = 0 (no spin: w along tau): the body rolls in a vertical plane through the
+    pole below its centre of mass (U = m g a3 cos theta on the whole circle). The orbit's far
+    turning point and its period (two passes of that turning point) agree with solve_ivp on the
+    full equations to 1e-8."""
+    pole = -1.0 if body.a3 > 0 else 1.0  # the centre of mass's low side
+    gamma = [0.0, 0.6, 0.8 * pole]
+    tau = np.cross([0.0, 0.0, 1.0], gamma) / 0.6
+    y0 = _state("rubber", body, gamma, 0.3 * tau)
+    reduction = reduction_of("rubber")
+    level = reduction.level_of_state(body, y0)
+    assert level.pole == "both" and level.rubber_spin == 0.0
+    (o,) = orbits(level, reduction.reduced_energy(body, y0))
+    assert o.kind == "periodic" and o.pole_passage
+    far = o.gamma3_min if pole > 0 else o.gamma3_max
+    assert abs(far) < 0.8
+    sol = _full_run("rubber", body, y0, 2.2 * o.period)
+    events = sol.y_events[1] if pole > 0 else sol.y_events[0]
+    times = sol.t_events[1] if pole > 0 else sol.t_events[0]
+    assert len(times) >= 3
+    np.testing.assert_allclose(events[:, 14], far, atol=AGREE)
+    np.testing.assert_allclose(np.diff(times), o.period / 2, rtol=AGREE)
+    assert np.max(np.abs(INTEGRALS["rubber_spin"](body, sol.y.T))) < 1e-12
+
+
+def test_rubber_rolling_has_one_centre_on_every_level(body, rng):
+    """U' = 0 reads F^2 cos = -m g a3 I3 sin^4 (module docstring of rollingtop.reduction.rubber):
+    one root in (0, pi), a centre, on the side of the axis away from the centre of mass
+    (gamma3 a3 < 0); the steady motion found satisfies the closed form to 1e-12."""
+    for F in rng.uniform(0.05, 3.0, size=8) * rng.choice([-1, 1], size=8):
+        level = RubberLevel(body, rubber_spin=float(F))
+        (m,) = steady_motions(level)
+        assert m.type == "center" and m.gamma3 * body.a3 < 0
+        s2 = 1 - m.gamma3**2
+        lhs, rhs = F**2 * m.gamma3, -body.m * body.g * body.a3 * body.I3 * s2**2
+        assert lhs == pytest.approx(rhs, rel=1e-12, abs=1e-14)
+
+
+@pytest.mark.parametrize("F", [1e-3, 1e-5])
+def test_a_rubber_level_near_its_pole_level_keeps_its_period(body, F):
+    """A small rubber_spin puts a wall of width ~ F / sqrt(I3 h) next to each pole: an orbit
+    that almost rolls over (both turning points beside a pole) and one that rocks beside the low
+    pole; turning points and periods against mpmath (40 digits) of U written again from the
+    kinetic energy (_mp_potential), to QUAD_RTOL."""
+    level = RubberLevel(body, rubber_spin=F)
+    U, rho = _mp_potential(level)
+    b = body
+    for h in (abs(b.m * b.g * b.a3) * 1.5, abs(b.m * b.g * b.a3) * 0.5):
+        (o,) = orbits(level, h)
+        with mp.workdps(40):
+            lo = mp.findroot(lambda t, h=h: U(t) - h, (o.theta_min * 0.999, o.theta_min * 1.001),
+                             solver="anderson")  # fmt: skip
+            hi = mp.findroot(lambda t, h=h: U(t) - h, (o.theta_max - 1e-9 * (mp.pi - o.theta_max),
+                                                  o.theta_max + 1e-9 * (mp.pi - o.theta_max)),
+                             solver="anderson")  # fmt: skip
+            T = 2 * mp.quad(lambda t, h=h: mp.sqrt(rho(t) / (2 * (h - U(t)))),
+                            [lo, (lo + hi) / 2, hi])  # fmt: skip
+        assert o.theta_min == pytest.approx(float(lo), rel=1e-9)
+        assert math.pi - o.theta_max == pytest.approx(float(mp.pi - hi), rel=1e-6)
+        assert o.period == pytest.approx(float(T), rel=QUAD_RTOL)

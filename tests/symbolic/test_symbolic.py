@@ -165,3 +165,33 @@ def test_verify_shows_the_lost_integrals_vary(model, lost):
     energy = next(c for c in claims_for(model) if c.name == "energy integral conserved")
     wrong = dataclasses.replace(energy, name="energy not conserved", vanishes=False)
     assert check(wrong).result == "failed"
+
+
+def test_rubber_rollings_linear_integral_and_its_ode_are_proved():
+    """Rubber rolling's integral beyond the energy (rollingtop.reduction.rubber): the rate of
+    Omega = (w, nu) is A(gamma3) gamma3' Omega along the full equations (a linear ODE in gamma3),
+    f = s sqrt(J) solves f' = -A f, and rubber_spin = w3 sqrt(I3 J) is conserved (its square).
+    The same claims with J built on (I gamma, gamma) instead of (I nu, nu), or the ODE's
+    coefficient without its J'/(2J) term, fail: the proofs can tell."""
+    from rollingtop.symbolic.rubber import ode_coefficient
+
+    claims = {c.name: c for c in claims_for("rubber")}
+    names = [n for n in claims if "rubber_spin" in n or "ODE" in n or "f = s sqrt" in n
+             or "kinetic energy" in n]  # fmt: skip
+    assert len(names) == 4, names
+    for name in names:
+        assert check(claims[name]).result == "proved", name
+    S = SYMBOLS
+    g1, g2, g3 = S.gamma
+    I = sp.diag(S.I1, S.I1, S.I3)
+    r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
+    wrong_J = S.gamma.dot(I * S.gamma) + S.m * r.dot(S.gamma) ** 2
+    assert check(Claim("w3^2 I3 (I gamma, gamma)-J", "rubber",
+                       S.w[2] ** 2 * S.I3 * wrong_J)).result == "failed"  # fmt: skip
+    omega = (S.w[2] - g3 * S.w.dot(S.gamma)) / s_sym
+    g3_dot = g1 * S.w[1] - g2 * S.w[0]
+    A = ode_coefficient(g3)
+    A_wrong = g3 / s_sym**2
+    assert A != A_wrong
+    wrong = Claim("ODE without J'/(2J)", "rubber", (omega, A_wrong * g3_dot * omega), "reduced")
+    assert check(wrong).result == "failed"

@@ -14,6 +14,12 @@ from rollingtop.body import SphericalTop
 
 BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3")
 LEVEL_KEYS = ("M3", "C1", "C2")
+#: The models an atlas classifies (those with a reduction, :mod:`rollingtop.reduction.models`):
+#: a ``model`` axis holds indices into this tuple (its coordinate in the Dataset: the names).
+ATLAS_MODELS = ("meridian", "smooth", "rough", "rubber")
+#: The initial state a cell's level is read from under each model (a ``model`` axis, or a model
+#: other than the meridian one): the attitude and the angular velocity.
+STATE_KEYS = ("gamma1", "gamma2", "gamma3", "omega1", "omega2", "omega3")
 #: Centres whose rotation number is kept per cell.
 MAX_CENTRES = 3
 
@@ -61,6 +67,9 @@ def classify_cells(
         except BodyError:
             out["status"][n] = 1
             continue
+        if "gamma1" in p:  # each model's level of the initial state
+            _classify_state(body, p, out, n)
+            continue
         try:
             level = LevelSet(body, p["M3"], p["C1"], p["C2"])
         except LevelSetError:
@@ -85,3 +94,52 @@ def classify_cells(
 
 
 # ---- running it on Dask, resumably --------------------------------------------------------------
+
+
+def _classify_state(
+    body: SphericalTop, p: Mapping[str, float], out: dict[str, np.ndarray], n: int
+) -> None:
+    """Cell ``n`` of a spec with an initial state: the level of the state ``p[STATE_KEYS]``
+    under the model ``ATLAS_MODELS[p["model"]]`` (as ``rollingtop compare-classification``
+    builds it: the centre of mass's velocity from the model's constraints, ``omega``'s part
+    along a constraint on the angular velocity dropped), classified by the model's own
+    reduction. ``n_folds`` is the meridian model's alone (-1 for the others)."""
+    from rollingtop._errors import RollingTopError
+    from rollingtop.contact import get_model
+    from rollingtop.dynamics.state import initial_state
+    from rollingtop.reduction.classify import _admissible_omega
+    from rollingtop.reduction.level import LevelSetError, PoleLevelError
+    from rollingtop.reduction.models import reduction_of
+    from rollingtop.reduction.rotation import centre_rotation_number
+    from rollingtop.reduction.steady import steady_motions
+
+    name = ATLAS_MODELS[int(p["model"])]
+    gamma = np.array([p[key] for key in STATE_KEYS[:3]])
+    omega, _ = _admissible_omega(name, gamma, [p[key] for key in STATE_KEYS[3:]])
+    try:
+        y = initial_state(body, name, gamma=gamma, omega=omega)
+        level = reduction_of(name).level_of_state(body, y)
+    except PoleLevelError:
+        out["status"][n] = 2
+        return
+    except LevelSetError:
+        out["status"][n] = 3
+        return
+    except RollingTopError:
+        out["status"][n] = 4
+        return
+    if level.pole is not None:
+        out["status"][n] = 2
+        return
+    motions = steady_motions(level)
+    out["status"][n] = 0
+    out["n_steady"][n] = len(motions)
+    out["n_centres"][n] = sum(m.type == "center" for m in motions)
+    out["n_saddles"][n] = sum(m.type == "saddle" for m in motions)
+    if get_model(name).has_reduction:  # the whole of the paper's reduction: its fold curves
+        out["n_folds"][n] = _fold_count(*(float(getattr(body, key)) for key in BODY_KEYS),
+                                        level.M3, level.C1)  # fmt: skip
+    centres = [m for m in motions if m.type == "center"][:MAX_CENTRES]
+    for c, m in enumerate(centres):
+        out["centre_gamma3"][n, c] = m.gamma3
+        out["rotation_centre"][n, c] = centre_rotation_number(m)

@@ -17,24 +17,26 @@ import numpy as np
 from rollingtop._checks import short_repr
 from rollingtop._errors import RollingTopError, ScenarioError
 from rollingtop._types import FloatArray
-from rollingtop.atlas._cells import BODY_KEYS, LEVEL_KEYS
+from rollingtop.atlas._cells import ATLAS_MODELS, BODY_KEYS, LEVEL_KEYS, STATE_KEYS
+from rollingtop.contact import MODELS, get_model
 from rollingtop.io import read_input_text
 
 __all__ = ["AtlasError", "AtlasSpec", "atlas_spec_from_dict", "load_atlas_spec"]
 
-AXIS_KEYS = BODY_KEYS + LEVEL_KEYS
+AXIS_KEYS = (*BODY_KEYS, *LEVEL_KEYS, "model")
 #: Largest number of cells of one atlas.
 MAX_CELLS = 10_000_000
 #: Cells per Dask task (a chunk, and a file of the partial folder).
 DEFAULT_CHUNK = 200
 #: Bumped when the classification changes: partial results of another version are not reused.
-ATLAS_VERSION = 1
+ATLAS_VERSION = 2
 #: Status of a cell.
 STATUS = {
     0: "classified",
     1: "inadmissible body",
     2: "pole level (C1 = +-M3)",
     3: "level too large",
+    4: "state refused by the model",
 }
 #: Most worker processes per core of the embedded local cluster.
 MAX_WORKERS_PER_CORE = 4
@@ -60,6 +62,12 @@ class AtlasSpec:
 
     fixed: dict[str, float]
     axes: dict[str, FloatArray]
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The models classified: a ``model`` axis's names, or the one model of the spec."""
+        indices = self.axes["model"] if "model" in self.axes else [self.fixed.get("model", 0.0)]
+        return tuple(ATLAS_MODELS[int(i)] for i in indices)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -129,10 +137,15 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
     for key in axes_t:
         if key not in AXIS_KEYS:
             raise AtlasError(f"unknown axis {short_repr(key)} (allowed: {', '.join(AXIS_KEYS)})")
-    axes = {key: _axis(key, value) for key, value in axes_t.items()}
+    axes = {key: _model_axis(value) if key == "model" else _axis(key, value)
+            for key, value in axes_t.items()}  # fmt: skip
     size = int(np.prod([len(v) for v in axes.values()], dtype=float))
     if size > MAX_CELLS:
         raise AtlasError(f"the atlas has {size} cells, more than {MAX_CELLS}")
+    contact = data.get("contact", {})
+    model = contact.get("model", "meridian") if isinstance(contact, dict) else "meridian"
+    if "model" in axes or not (model in MODELS and get_model(model).has_reduction):
+        return _state_spec(data, axes, model)
     # the fixed values: the scenario's, with each axis at its first value
     level_t = dict(data.get("level", {})) if isinstance(data.get("level", {}), dict) else {}
     for key in LEVEL_KEYS:
@@ -157,6 +170,61 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
                          f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
     fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
     fixed.update({k: float(level_t[k]) for k in LEVEL_KEYS})
+    return AtlasSpec(fixed, axes)
+
+
+def _model_axis(value: object) -> FloatArray:
+    """A ``model`` axis: a list of model names with a reduction, as indices into
+    :data:`~rollingtop.atlas._cells.ATLAS_MODELS`."""
+    if not isinstance(value, list) or not value:
+        raise AtlasError(f"axes.model must be a non-empty list of model names, got "
+                         f"{short_repr(value)}")  # fmt: skip
+    out = []
+    for name in value:
+        if name not in ATLAS_MODELS:
+            raise AtlasError(f"axes.model: {short_repr(name)} is not a model with a reduction "
+                             f"({', '.join(ATLAS_MODELS)})")  # fmt: skip
+        if ATLAS_MODELS.index(name) in out:
+            raise AtlasError(f"axes.model names {name!r} twice")
+        out.append(ATLAS_MODELS.index(name))
+    return np.array(out, dtype=float)
+
+
+def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object) -> AtlasSpec:
+    """The spec of an atlas whose cells' levels are the ``[initial]`` state's under each model
+    (a ``model`` axis, or a model other than the meridian one): body keys and ``model`` as
+    axes, the state fixed."""
+    from rollingtop.reduction.models import reduction_of
+    from rollingtop.scenario import Scenario
+
+    on_level = [key for key in axes if key in LEVEL_KEYS]
+    if on_level:
+        raise AtlasError(f"axes {', '.join(on_level)}: with a model axis or a model other than "
+                         "the meridian one, each cell's level is the [initial] state's under "
+                         "its model; [axes] takes body keys and model")  # fmt: skip
+    if not isinstance(data.get("initial"), dict):
+        raise AtlasError("an atlas with a model axis or a model other than the meridian one "
+                         "needs an [initial] table (gamma, omega): each model's level is that "
+                         "state's")  # fmt: skip
+    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    for key in BODY_KEYS:
+        if key in axes:
+            body_t[key] = float(axes[key][0])
+    data["body"] = body_t
+    data.pop("level", None)
+    sc = Scenario.from_dict(data)
+    if "model" not in axes:
+        try:
+            reduction_of(sc.model)
+        except ScenarioError as exc:
+            raise AtlasError(f"the atlas classifies a reduction: {exc}") from None
+    if not sc.body.symmetric:
+        raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
+                         f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
+    y0 = sc.require_state()
+    fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
+    fixed.update(zip(STATE_KEYS, (float(x) for x in (*y0[12:15], *y0[3:6])), strict=True))
+    fixed["model"] = float(ATLAS_MODELS.index(model)) if model in ATLAS_MODELS else 0.0
     return AtlasSpec(fixed, axes)
 
 

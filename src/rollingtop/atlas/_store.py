@@ -12,11 +12,12 @@ import shutil
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rollingtop._errors import RollingTopError
+from rollingtop.atlas._cells import ATLAS_MODELS
 from rollingtop.atlas._spec import AtlasError, AtlasSpec
 from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
 
@@ -66,11 +67,13 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
               for key in parts[min(parts)]}  # fmt: skip
     data_vars = {}
     docs = {
-        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large",
+        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large, "
+        "4 state refused by the model",
         "n_steady": "steady motions (critical points of U in (-1, 1)); -1: not classified",
         "n_centres": "steady motions that are centres (U'' > 0)",
         "n_saddles": "steady motions that are saddles (U'' < 0)",
-        "n_folds": "folds of the (C2, h) bifurcation diagram of (M3, C1)",
+        "n_folds": "folds of the (C2, h) bifurcation diagram of (M3, C1) (the meridian "
+        "model's; -1 for the others)",
         "rotation_centre": "rotation number psi'/omega at each centre (in order of gamma3)",
         "centre_gamma3": "gamma3 of each centre",
     }
@@ -81,9 +84,13 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
             data_vars[key] = ((*dims, "centre"), values.reshape((*spec.shape, values.shape[1])),
                               {"description": docs[key]})  # fmt: skip
     attrs = {"fixed_json": json.dumps(spec.fixed), "axes": " ".join(dims),
-             "description": "rollingtop atlas: classification of the meridian model's reduced "
-                            "motions over body parameters and integrals (issue 14)"}  # fmt: skip
-    return xr.Dataset(data_vars, coords={k: v for k, v in spec.axes.items()}, attrs=attrs)
+             "models": " ".join(spec.models),
+             "description": "rollingtop atlas: classification of the reduced motions over body "
+                            "parameters and integrals or models (issues 14, 24)"}  # fmt: skip
+    coords: dict[str, Any] = dict(spec.axes)
+    if "model" in coords:  # indices into ATLAS_MODELS: the names
+        coords["model"] = np.array([ATLAS_MODELS[int(i)] for i in coords["model"]], dtype=str)
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
 def _write(ds: xr.Dataset, output: Path) -> None:

@@ -146,7 +146,8 @@ def _other_model(sc: Any, as_json: bool, output: str | None,
         click.echo(json.dumps(cv.to_dict()))
         return
     fixed = ", ".join(f"{k} = {v:g}" for k, v in cv.fixed.items())
-    table = Table(title=f"steady motions of the {cv.model} model along {cv.axis} ({fixed})")
+    table = Table(title=f"steady motions of the {cv.model} model along {cv.axis}"
+                        + (f" ({fixed})" if fixed else ""))  # fmt: skip
     for col in (f"{cv.axis} from", "to", "steady motions"):
         table.add_column(col, justify="right")
     start = 0

@@ -25,10 +25,11 @@ def compare_classification(scenario: str, output: str, as_json: bool, points: in
 
     The body and the initial attitude and angular velocity come from the scenario's [initial]
     table (the scenario's own model keeps its whole state; the others get the centre of mass's
-    velocity from their constraints). For each model with a reduction (meridian, smooth,
-    rough): U(gamma3) and the state's energy, the phase portrait with the orbit through the
-    state, and the critical values of the reduced energy along one integral of its level (the
-    bifurcation set), the state's level marked. Prints each model's level, orbit and steady
+    velocity from their constraints, and rubber rolling drops omega's part along the normal).
+    For each model with a reduction (meridian, smooth, rough, rubber): U(gamma3) and the
+    state's energy, the phase portrait with the orbit through the state, and the critical
+    values of the reduced energy along one integral of its level (the bifurcation set), the
+    state's level marked. Prints each model's level, orbit and steady
     motions.
     """
     from rollingtop.io import check_output_path
@@ -73,4 +74,7 @@ def compare_classification(scenario: str, output: str, as_json: bool, points: in
                         (f"{o.gamma3_min:.8g}", f"{o.gamma3_max:.8g}", f"{o.period:.10g}")),
                       "-" if dpsi is None else f"{dpsi:.8g}", kinds or "none")  # fmt: skip
     _output.console().print(table)
+    for c in classes:
+        if c.note:
+            click.echo(f"{c.model}: {c.note}")
     click.echo(f"wrote {output}")

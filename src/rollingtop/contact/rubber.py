@@ -7,7 +7,10 @@ contact force of :func:`rollingtop._compiled._kernel.reaction` is the no-slip ro
 bias is ``(gamma', w) = (gamma x w, w) = 0``. Neither reaction does work (``vp = 0``,
 ``(w, gamma) = 0``): the energy is conserved; the torque changes the angular momentum about the
 normal, so the rough model's Jellett integral and the area and Lagrange integrals are lost
-(``rollingtop verify`` proves the energy and shows the others vary, ``tests/symbolic``).
+(``rollingtop verify`` proves the energy and shows the others vary, ``tests/symbolic``). A body
+of revolution keeps an integral linear in ``w``, ``rubber_spin = w3 sqrt(I3 J)``, through which
+the model reduces to one degree of freedom (:mod:`rollingtop.reduction.rubber`; proved by
+:mod:`rollingtop.symbolic.rubber`).
 
 A body rolling this way cannot spin about a vertical symmetry axis: at ``gamma = (0, 0, +-1)``
 the fourth row is ``w3 = 0`` (:attr:`~rollingtop.contact.ContactModel.has_vertical_spin`).
@@ -179,12 +182,14 @@ MODEL = ContactModel(
         "no spin (w, gamma) = 0",
     ),
     free_velocity={},
-    integrals_symmetric=("energy",),
+    integrals_symmetric=("energy", "rubber_spin"),
+    reduction=("rubber_spin",),
     integrals_general=("energy",),
     velocity=_velocity,
     symbolic_directions=_symbolic_directions,
     symbolic_velocity=_symbolic_velocity,
     spin_directions=_spin_directions,
     symbolic_omega=_symbolic_omega,
+    symbolic_claims="rollingtop.symbolic.rubber:claims",
     colour="#ff7f0e",
 )

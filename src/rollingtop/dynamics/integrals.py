@@ -215,6 +215,18 @@ def routh(body: SphericalTop, Y: FloatArray) -> FloatArray:
     return routh_
 
 
+def rubber_spin(body: SphericalTop, Y: FloatArray) -> FloatArray:
+    """The rubber model's integral ``w3 sqrt(I3 J)``, ``J = (I nu, nu) + m (r, gamma)^2`` with
+    ``nu`` the axis's horizontal projection, ``(I nu, nu) = I1 + I3 - (I gamma, gamma)`` for a
+    symmetric body (rolling without slipping or spinning, :mod:`rollingtop.reduction.rubber`)."""
+    gamma = Y[..., GAMMA]
+    Ig = np.sum(body.inertia * gamma * gamma, axis=-1)
+    rg = np.sum(_arm(body, Y) * gamma, axis=-1)
+    J = body.I1 + body.I3 - Ig + body.m * rg * rg
+    value: FloatArray = Y[..., 5] * np.sqrt(body.I3 * J)
+    return value
+
+
 def slip_nu(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """The contact point's slip along the carried direction ``nu``: ``(v_P, nu)``.
 
@@ -236,7 +248,18 @@ def slip_nu(body: SphericalTop, Y: FloatArray) -> FloatArray:
 #: Every integral by name.
 INTEGRALS: dict[str, Integral] = {
     f.__name__: f
-    for f in (energy, lagrange, jellett, area, F6, momentum_x, momentum_y, routh, slip_nu)
+    for f in (
+        energy,
+        lagrange,
+        jellett,
+        area,
+        F6,
+        momentum_x,
+        momentum_y,
+        routh,
+        rubber_spin,
+        slip_nu,
+    )
 }
 
 

@@ -21,7 +21,8 @@ __all__ = ["classification_figure", "critical_values_figure", "rotation_grid_fig
 FloatArray: TypeAlias = NDArray[np.float64]
 #: Labels of the integrals in the figure (mathtext).
 SYMBOLS = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}",
-           "jellett": r"\mathrm{jellett}", "routh": r"\mathrm{routh}"}  # fmt: skip
+           "jellett": r"\mathrm{jellett}", "routh": r"\mathrm{routh}",
+           "rubber_spin": r"\mathrm{rubber\_spin}"}  # fmt: skip
 
 
 def _window(c: ModelClassification) -> tuple[float, float, float, float]:
@@ -99,7 +100,8 @@ def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
             ax.set_ylabel("critical values of $h$")
             ax.legend(fontsize=7, frameon=False)
         fixed = ", ".join(f"{k} = {v:.3g}" for k, v in cv.fixed.items())
-        ax.set_title(f"at {fixed}", fontsize=8)
+        ax.set_title(f"at {fixed}" if fixed else f"{cv.axis}: the level's only integral",
+                     fontsize=8)  # fmt: skip
     return fig
 
 
@@ -130,7 +132,7 @@ def critical_values_figure(cv: CriticalValues, level: LevelSet) -> Figure:
     ax.axvline(level.values()[cv.axis], color="0.5", lw=0.8, ls="--", label="the level's value")
     ax.set_ylabel("critical values of $h$")
     fixed = ", ".join(f"{k} = {v:.4g}" for k, v in cv.fixed.items())
-    ax.set_title(f"{cv.model} model, at {fixed}", fontsize=10)
+    ax.set_title(f"{cv.model} model" + (f", at {fixed}" if fixed else ""), fontsize=10)
     ax.legend(fontsize=8, frameon=False)
     ok = cv.count >= 0
     axn.step(cv.x[ok], cv.count[ok], where="mid", color="k")
@@ -149,5 +151,5 @@ def rotation_grid_figure(grid: RotationGrid) -> Figure:
     ax.set_xlabel(f"${SYMBOLS.get(grid.axis, grid.axis)}$")
     ax.set_ylabel("$h$")
     fixed = ", ".join(f"{k} = {v:.4g}" for k, v in grid.fixed.items())
-    ax.set_title(f"{grid.model} model, at {fixed}", fontsize=10)
+    ax.set_title(f"{grid.model} model" + (f", at {fixed}" if fixed else ""), fontsize=10)
     return fig

@@ -187,7 +187,7 @@ def phase_portrait(
     pole = {None: "", "south": ", south pole case", "north": ", north pole case",
             "both": ", no spin: both poles"}[level.pole]  # fmt: skip
     symbols = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}"}
-    upright = {k: r"\mathrm{" + k + "}" for k in level.values()}
+    upright = {k: r"\mathrm{" + k.replace("_", r"\_") + "}" for k in level.values()}
     named = r",\ ".join(f"{symbols.get(k, upright[k])}={v:g}" for k, v in level.values().items())
     ax.set_title(
         rf"{level.model} model: ${named}${pole}"

@@ -1,6 +1,6 @@
 """Reduction of the meridian model to one degree of freedom (paper Sec. 3), and of the other
-models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, and the rough
-model's, :mod:`.rough`).
+models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, the rough model's,
+:mod:`.rough`, and the rubber model's, :mod:`.rubber`).
 
 - :mod:`.variables`: full state <-> reduced variables and integrals.
 - :mod:`.system`: the reduced system (eq. 3.3).
@@ -16,6 +16,7 @@ from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
 from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
 from rollingtop.reduction.orbits import Orbit, orbits
 from rollingtop.reduction.rough import RoughLevel
+from rollingtop.reduction.rubber import RubberLevel
 from rollingtop.reduction.smooth import SmoothLevel
 from rollingtop.reduction.steady import SteadyMotion, steady_motions
 from rollingtop.reduction.system import integrate_reduced, reduced_integrals_of, reduced_rhs
@@ -35,6 +36,7 @@ __all__ = [
     "REDUCTIONS",
     "Reduction",
     "RoughLevel",
+    "RubberLevel",
     "SmoothLevel",
     "SteadyMotion",
     "euler_angles",

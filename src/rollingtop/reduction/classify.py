@@ -44,8 +44,8 @@ FloatArray = NDArray[np.float64]
 
 #: The integral each model's critical values are drawn against: the one that does not fix the
 #: spin (the meridian model's ``C2``, as in its bifurcation diagram; the smooth plane's area
-#: integral; Routh's sphere's Jellett integral).
-AXES = {"meridian": "C2", "smooth": "C1", "rough": "jellett"}
+#: integral; Routh's sphere's Jellett integral; rubber rolling's only one).
+AXES = {"meridian": "C2", "smooth": "C1", "rough": "jellett", "rubber": "rubber_spin"}
 
 
 @dataclass(frozen=True)
@@ -216,10 +216,12 @@ def classify_models(
     out = []
     for name in names:
         reduction = reduction_of(name)
+        projected = ""
         if own is not None and own[0] == name:
             y = np.asarray(own[1], dtype=float)
         else:
-            y = initial_state(body, name, gamma=gamma, omega=omega)
+            w, projected = _admissible_omega(name, gamma, omega)
+            y = initial_state(body, name, gamma=gamma, omega=w)
         try:
             level = reduction.level_of_state(body, y)
         except LevelSetError as err:  # e.g. a level the model does not reduce: the others go on
@@ -230,9 +232,35 @@ def classify_models(
         found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]
         orbit = found[0] if found and found[0].kind == "periodic" else None
         note = "" if orbit is not None else "the state lies on a steady motion or a separatrix"
+        note = "; ".join(x for x in (projected, note) if x)
         out.append(ModelClassification(name, level, h, y, orbit, steady_motions(level),
                                        critical_values(level, n=n), note))  # fmt: skip
     return out
+
+
+def _admissible_omega(name: str, gamma: ArrayLike, omega: ArrayLike) -> tuple[FloatArray, str]:
+    """``omega`` under the model ``name``'s constraints on the angular velocity alone
+    (:attr:`~rollingtop.contact.ContactModel.spin_directions`; rubber rolling's
+    ``(omega, gamma) = 0``): its parts along them dropped, and a note saying so (empty when
+    nothing is dropped). The models side by side start from the same attitude and, as far as
+    each allows, the same angular velocity."""
+    from rollingtop.contact import get_model
+
+    w = np.asarray(omega, dtype=float).copy()
+    directions = get_model(name).spin_directions
+    if directions is None:
+        return w, ""
+    g = np.asarray(gamma, dtype=float)
+    g = g / np.linalg.norm(g)
+    dropped = []
+    for label, d in directions(g).items():
+        d = np.asarray(d, dtype=float)
+        part = float(w @ d) / float(d @ d)
+        if abs(part) > 1e-12 * max(1.0, float(np.linalg.norm(w))):
+            w = w - part * d
+            dropped.append(label)
+    note = f"omega projected onto {', '.join(dropped)}" if dropped else ""
+    return w, note
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
 from rollingtop.reduction._services import LevelServices, Real
 
-__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "Real", "near_north"]
+__all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "PoleLevelError", "Real", "near_north"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 ComplexArray: TypeAlias = NDArray[np.complex128]
@@ -55,6 +55,10 @@ _COMPLEX_STEP = 1e-30
 
 class LevelSetError(RollingTopError):
     """Inconsistent level set, or a level with no motion."""
+
+
+class PoleLevelError(LevelSetError):
+    """A pole level the model's reduction does not reduce (yet): the rough model's."""
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ model      level                     reduced energy ``h``
 meridian   ``M3, C1, C2``            ``E - I3 w3^2/2 - m g R`` (paper eq. 3.11)
 smooth     ``M3, C1, p_horizontal``  ``E - I3 w3^2/2 - m g R``
 rough      ``jellett, routh``        ``E - m g R``
+rubber     ``rubber_spin``           ``E - m g R``
 =========  ========================  ======================================================
 """
 
@@ -31,6 +32,7 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.reduction.level import LevelSet
 from rollingtop.reduction.rough import RoughLevel, rough_integrals
+from rollingtop.reduction.rubber import RubberLevel, rubber_integrals
 from rollingtop.reduction.smooth import SmoothLevel, smooth_integrals
 from rollingtop.reduction.variables import reduced_integrals
 
@@ -109,6 +111,9 @@ REDUCTIONS: dict[str, Reduction] = {
         Reduction("rough", RoughLevel, rough_integrals, "E - m g R",
                   "Routh's sphere: Jellett's and Routh's integrals (Routh, Advanced Rigid "
                   "Dynamics, Sec. 243; Borisov and Mamaev, Rigid Body Dynamics)"),
+        Reduction("rubber", RubberLevel, rubber_integrals, "E - m g R",
+                  "rolling without slipping or spinning: the integral linear in w "
+                  "(Borisov, Mamaev and Bizyaev 2013; rollingtop.reduction.rubber)"),
     )
 }  # fmt: skip
 

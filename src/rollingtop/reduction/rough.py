@@ -44,6 +44,7 @@ from rollingtop.reduction.level import (
     ComplexArray,
     LevelSet,
     LevelSetError,
+    PoleLevelError,
     Real,
     _Analytic,
     _AnalyticResult,
@@ -99,7 +100,7 @@ class RoughLevel(LevelSet):
         size = max(abs(self.jellett), abs(self.routh) * self.body.R, 1e-300)
         for theta, name in ((0.0, "south (gamma3 = 1)"), (math.pi, "north (gamma3 = -1)")):
             if abs(self._numerator(theta)) <= POLE_LEVEL_TOLERANCE * size:
-                raise LevelSetError(
+                raise PoleLevelError(
                     f"level {self.describe()} lets the {name} pole touch the plane (jellett + "
                     "I3 k w3 = 0 there): the rough model's pole levels are not reduced yet"
                 )

@@ -39,6 +39,8 @@ EXACT_OPS_LIMIT = 4000
 N_POINTS = 4
 #: The classical integrals of a rolling top: each one a model does not claim is shown to vary.
 LOST_CANDIDATES = ("lagrange", "jellett", "area")
+#: Integrals with a square root, proved through their square (rational).
+SQUARED = ("routh", "rubber_spin")
 
 S = SYMBOLS
 # extra symbols: s = sqrt(gamma1^2 + gamma2^2) and theta = arccos(gamma3) as variables with
@@ -180,6 +182,11 @@ def _integrals() -> dict[str, Any]:
         "area": Iw.dot(S.gamma),
         "F6": F6,
         "routh^2": S.w[2] ** 2 * Q,  # Routh's integral w3 sqrt(Q), squared: rational
+        # rubber rolling's w3 sqrt(I3 J), J = (I nu, nu) + m (r, gamma)^2 with the axis's
+        # horizontal projection nu: (I nu, nu) = I1 + I3 - (I gamma, gamma); squared
+        "rubber_spin^2": S.w[2] ** 2
+        * S.I3
+        * (S.I1 + S.I3 - S.gamma.dot(I * S.gamma) + S.m * r.dot(S.gamma) ** 2),
         "momentum_x": S.m * S.v.dot(S.alpha),
         "momentum_y": S.m * S.v.dot(S.beta),
     }
@@ -245,11 +252,11 @@ def claims_for(model: str) -> list[Claim]:
         return _model_claims(model)
     F = _integrals()
     out = []
-    # the integrals the model claims (the routh integral is proved through its square)
-    names = [n + "^2" if n == "routh" else n for n in get_model(model).integrals_symmetric]
+    # the integrals the model claims (those with a square root through their square)
+    names = [n + "^2" if n in SQUARED else n for n in get_model(model).integrals_symmetric]
     for name in names:
-        label = "routh integral conserved (its square)" if name == "routh^2" else (
-            f"{name} integral conserved")  # fmt: skip
+        label = (f"{name[:-2]} integral conserved (its square)" if name.endswith("^2")
+                 else f"{name} integral conserved")  # fmt: skip
         out.append(Claim(label, model, F[name]))
     out.append(Claim("energy integral conserved, general body (I1 != I2)", model, F["energy"],
                      symmetric=False))  # fmt: skip
