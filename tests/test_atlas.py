@@ -255,7 +255,8 @@ def test_a_model_other_than_the_meridian_one_is_an_atlas_of_its_own():
 @pytest.mark.parametrize(
     ("axes", "model", "initial", "message"),
     [
-        ({"model": ["meridian", "parallel"]}, "meridian", True, "not a model with a reduction"),
+        ({"model": ["meridian", "parallel"]}, "meridian", True, "not a model the atlas"),
+        ({"model": ["shell-rotor"]}, "meridian", True, "not a model the atlas"),
         ({"model": ["rough", "rough"]}, "meridian", True, "twice"),
         ({"model": "rough"}, "meridian", True, "non-empty list"),
         ({"model": ["rough"], "C2": [0.0]}, "meridian", True, "takes body keys and model"),

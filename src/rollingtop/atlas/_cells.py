@@ -14,8 +14,9 @@ from rollingtop.body import SphericalTop
 
 BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3")
 LEVEL_KEYS = ("M3", "C1", "C2")
-#: The models an atlas classifies (those with a reduction, :mod:`rollingtop.reduction.models`):
-#: a ``model`` axis holds indices into this tuple (its coordinate in the Dataset: the names).
+#: The models an atlas classifies (those with a reduction, :mod:`rollingtop.reduction.models`,
+#: for a body without a shell: the shell-rotor pair's shell is not among the axes): a ``model``
+#: axis holds indices into this tuple (its coordinate in the Dataset: the names).
 ATLAS_MODELS = ("meridian", "smooth", "rough", "rubber")
 #: The initial state a cell's level is read from under each model (a ``model`` axis, or a model
 #: other than the meridian one): the attitude and the angular velocity.

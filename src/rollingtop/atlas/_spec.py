@@ -182,8 +182,9 @@ def _model_axis(value: object) -> FloatArray:
     out = []
     for name in value:
         if name not in ATLAS_MODELS:
-            raise AtlasError(f"axes.model: {short_repr(name)} is not a model with a reduction "
-                             f"({', '.join(ATLAS_MODELS)})")  # fmt: skip
+            raise AtlasError(f"axes.model: {short_repr(name)} is not a model the atlas "
+                             f"classifies ({', '.join(ATLAS_MODELS)}: those with a reduction, "
+                             "for a body without a shell)")  # fmt: skip
         if ATLAS_MODELS.index(name) in out:
             raise AtlasError(f"axes.model names {name!r} twice")
         out.append(ATLAS_MODELS.index(name))
@@ -218,6 +219,9 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
             reduction_of(sc.model)
         except ScenarioError as exc:
             raise AtlasError(f"the atlas classifies a reduction: {exc}") from None
+        if sc.model.name not in ATLAS_MODELS:  # the shell-rotor pair: no shell keys on the axes
+            raise AtlasError(f"the atlas classifies {', '.join(ATLAS_MODELS)} (a body without a "
+                             f"shell), not the {sc.model.name} model")  # fmt: skip
     if not sc.body.symmetric:
         raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
                          f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip

@@ -345,6 +345,7 @@ MODEL = ContactModel(
     constraints=("contact (vp, gamma) = 0", "no slip of the rotor along nu (vp, nu) = 0"),
     free_velocity={"v_tau": 1},
     integrals_symmetric=("energy", "lagrange", "jellett", "F6"),
+    reduction=("M3", "jellett", "C2"),
     integrals_general=("energy",),
     velocity=_velocity,
     symbolic_directions=_symbolic_directions,

@@ -9,7 +9,7 @@ Which integrals hold for which model and body is declared by the contact models
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import TypeAlias
+from typing import Any, TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -161,22 +161,32 @@ def F6_reduced(
     return F6
 
 
-def _f6_pair(body: SphericalTop, Y: FloatArray) -> FloatArray:
-    """The shell-rotor pair's ``F6``: ``Omega3 sqrt(N) + R I3 w3 Phi(gamma3)``
-    (:func:`rollingtop.symbolic.shell_rotor.f6_pair`, where it is derived and proved)."""
-    R, m, a3, I1, I3 = body.R, body.m, body.a3, body.I1, body.I3
+def pair_weight(body: SphericalTop, g3: Any) -> tuple[Any, Any]:
+    """The shell-rotor pair's ``N(gamma3)`` and ``Phi(gamma3)`` of its ``F6``
+    (:func:`rollingtop.symbolic.shell_rotor.f6_pair`, where they are derived and proved):
+    ``Phi' = ((m + ms) R gamma3 + m a3) / sqrt(N)``. Real arrays (``arccos``'s argument is
+    clipped to ``[-1, 1]``, round-off at the poles) or complex ones (the complex step of the
+    reduction's ``d2U``: not clipped)."""
+    R, m, a3, I1 = body.R, body.m, body.a3, body.I1
     ms, Js = body.shell_mass, body.shell_inertia
-    g3 = Y[..., 14]
     K = (m + ms) * I1 + m * ms * a3**2
     alpha = Js * (I1 + Js + ms * R**2 + m * R**2 + m * a3**2) + R**2 * K
     beta = 2.0 * Js * m * R * a3
     kappa = R**2 * K
     N = alpha + beta * g3 - kappa * g3**2
     p = (m + ms) * R
-    arc = np.arccos(np.clip((2 * kappa * g3 - beta) / np.sqrt(beta**2 + 4 * alpha * kappa), -1, 1))
+    x = (2 * kappa * g3 - beta) / np.sqrt(beta**2 + 4 * alpha * kappa)
+    arc = np.arccos(x if np.iscomplexobj(x) else np.clip(x, -1, 1))
     phi = -p / kappa * np.sqrt(N) - (m * a3 + p * beta / (2 * kappa)) / np.sqrt(kappa) * arc
+    return N, phi
+
+
+def _f6_pair(body: SphericalTop, Y: FloatArray) -> FloatArray:
+    """The shell-rotor pair's ``F6``: ``Omega3 sqrt(N) + R I3 w3 Phi(gamma3)``
+    (:func:`pair_weight`)."""
+    N, phi = pair_weight(body, Y[..., 14])
     w3 = Y[..., 5]
-    f6: FloatArray = (w3 + Y[..., PSI_NU]) * np.sqrt(N) + R * I3 * w3 * phi
+    f6: FloatArray = (w3 + Y[..., PSI_NU]) * np.sqrt(N) + body.R * body.I3 * w3 * phi
     return f6
 
 

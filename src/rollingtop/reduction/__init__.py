@@ -17,6 +17,7 @@ from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
 from rollingtop.reduction.orbits import Orbit, orbits
 from rollingtop.reduction.rough import RoughLevel
 from rollingtop.reduction.rubber import RubberLevel
+from rollingtop.reduction.shell_rotor import ShellRotorLevel
 from rollingtop.reduction.smooth import SmoothLevel
 from rollingtop.reduction.steady import SteadyMotion, steady_motions
 from rollingtop.reduction.system import integrate_reduced, reduced_integrals_of, reduced_rhs
@@ -37,6 +38,7 @@ __all__ = [
     "Reduction",
     "RoughLevel",
     "RubberLevel",
+    "ShellRotorLevel",
     "SmoothLevel",
     "SteadyMotion",
     "euler_angles",

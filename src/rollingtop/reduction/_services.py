@@ -68,6 +68,12 @@ class LevelServices:
         N: Real = b.m * (b.g + b.a3 * (np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau))
         return N
 
+    def last_slot(self, theta: Real, psi: float) -> Real:
+        """The state's last entry at ``theta``: the carried direction's azimuth, ``psi`` (the
+        shell-rotor pair's level puts its shell's relative spin there)."""
+        out: Real = psi + 0.0 * theta
+        return out
+
     def uniform_drift(self) -> float | None:
         """The speed of the centre of mass when it drifts uniformly whatever the axis does (a
         model with conserved horizontal momentum: its direction is not part of the level),

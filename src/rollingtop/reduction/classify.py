@@ -45,7 +45,13 @@ FloatArray = NDArray[np.float64]
 #: The integral each model's critical values are drawn against: the one that does not fix the
 #: spin (the meridian model's ``C2``, as in its bifurcation diagram; the smooth plane's area
 #: integral; Routh's sphere's Jellett integral; rubber rolling's only one).
-AXES = {"meridian": "C2", "smooth": "C1", "rough": "jellett", "rubber": "rubber_spin"}
+AXES = {
+    "meridian": "C2",
+    "smooth": "C1",
+    "rough": "jellett",
+    "rubber": "rubber_spin",
+    "shell-rotor": "C2",
+}
 
 
 @dataclass(frozen=True)
@@ -198,7 +204,8 @@ def classify_models(
     gamma, omega : array_like, shape (3,)
         Upward vertical and angular velocity, body frame.
     models : sequence of str, optional
-        Default: every model with a reduction, in registry order.
+        Default: every model with a reduction that takes this body, in registry order (a body
+        with a shell: the shell-rotor pair alone; without: the others).
     n : int
         Grid points of each model's critical values.
     own : (str, array_like), optional
@@ -212,7 +219,10 @@ def classify_models(
     from rollingtop.dynamics.state import initial_state
     from rollingtop.reduction.variables import reduce_state
 
-    names = [m for m in MODELS if m in REDUCTIONS] if models is None else list(models)
+    # the models of this body: a shell-rotor pair's under the pair's model, a bare body's under
+    # the others (ContactModel.own_inertia)
+    names = ([m for m, c in MODELS.items() if m in REDUCTIONS and c.own_inertia == body.has_shell]
+             if models is None else list(models))  # fmt: skip
     out = []
     for name in names:
         reduction = reduction_of(name)
@@ -228,7 +238,9 @@ def classify_models(
             refused[name] = str(err)
             continue
         h = reduction.reduced_energy(body, y)
-        theta = float(reduce_state(y)["theta"])
+        # the shell-rotor pair's last slot is its shell's spin, not a carried direction: the
+        # geometric one then (reduced_components on 17 components)
+        theta = float(reduce_state(y[:17] if MODELS[name].own_inertia else y)["theta"])
         found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]
         orbit = found[0] if found and found[0].kind == "periodic" else None
         note = "" if orbit is not None else "the state lies on a steady motion or a separatrix"

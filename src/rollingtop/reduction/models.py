@@ -15,6 +15,8 @@ meridian   ``M3, C1, C2``            ``E - I3 w3^2/2 - m g R`` (paper eq. 3.11)
 smooth     ``M3, C1, p_horizontal``  ``E - I3 w3^2/2 - m g R``
 rough      ``jellett, routh``        ``E - m g R``
 rubber     ``rubber_spin``           ``E - m g R``
+shell-     ``M3, jellett, C2``       ``E - M3^2/(2 I3) - m g R``
+rotor
 =========  ========================  ======================================================
 """
 
@@ -33,6 +35,7 @@ from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.reduction.level import LevelSet
 from rollingtop.reduction.rough import RoughLevel, rough_integrals
 from rollingtop.reduction.rubber import RubberLevel, rubber_integrals
+from rollingtop.reduction.shell_rotor import ShellRotorLevel, shell_rotor_integrals
 from rollingtop.reduction.smooth import SmoothLevel, smooth_integrals
 from rollingtop.reduction.variables import reduced_integrals
 
@@ -114,6 +117,10 @@ REDUCTIONS: dict[str, Reduction] = {
         Reduction("rubber", RubberLevel, rubber_integrals, "E - m g R",
                   "rolling without slipping or spinning: the integral linear in w "
                   "(Borisov, Mamaev and Bizyaev 2013; rollingtop.reduction.rubber)"),
+        Reduction("shell-rotor", ShellRotorLevel, shell_rotor_integrals,
+                  "E - I3 w3^2/2 - m g R",
+                  "the pair's Lagrange, Jellett and F6 integrals (rollingtop.symbolic.shell_rotor;"
+                  " the meridian model's reduction as the shell's mass and inertia vanish)"),
     )
 }  # fmt: skip
 

@@ -141,7 +141,7 @@ def state_from_level(
     y = np.empty(18)
     y[0:3], y[3:6], y[6:9], y[9:12], y[12:15] = v, w, alpha, beta, gamma
     y[15:17] = position
-    y[17] = psi
+    y[17] = float(level.last_slot(theta, psi))
     return y
 
 
@@ -183,4 +183,5 @@ def states_on_level(level: LevelSet, gamma3: ArrayLike, w_tau: ArrayLike) -> Flo
     y[..., 9] = 1.0
     y[..., 13] = s
     y[..., 14] = g3
+    y[..., 17] = level.last_slot(theta, 0.0)
     return y

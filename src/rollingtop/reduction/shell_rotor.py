@@ -1,0 +1,242 @@
+"""The shell-rotor pair's reduction to one degree of freedom (``docs/model.md``, "Reductions of
+the other models"; the pair: :mod:`rollingtop.contact.shell_rotor`).
+
+The rotor obeys the meridian model's kinematics whatever the shell's relative spin ``delta``; the
+shell turns with ``Omega = w + delta e3``. In the basis ``(tau, n, e3)`` of ``docs/model.md``
+("Reduced variables") the pair's kinetic energy has no cross term in ``w_tau`` (derived with
+sympy; ``k_p = (m + ms) R cos + m a3``, ``Omega3 = w3 + delta``):
+
+    2 T = rho_p w_tau^2 + A w_n^2 + 2 R s k_p w_n Omega3 + I3 w3^2
+          + (Js + (m + ms) R^2 s^2) Omega3^2,
+    rho_p = I1 + Js + ms R^2 + m (R^2 + a3^2 + 2 a3 R cos),
+    A     = I1 + Js + (m + ms) R^2 cos^2 + 2 m R a3 cos + m a3^2,
+
+and its integrals (proved by :mod:`rollingtop.symbolic.shell_rotor`) are Lagrange's
+``M3 = I3 w3``, a Jellett integral and the pair's ``F6 = C2``, linear in ``w_n`` and ``Omega3``:
+
+    (m + ms) jellett = R s (K + (m + ms) Js) w_n - k_p (M3 + Js Omega3),
+    C2 = Omega3 sqrt(N) + R M3 Phi(cos),       K = (m + ms) I1 + m ms a3^2
+
+(``N``, ``Phi``: :func:`rollingtop.dynamics.integrals.pair_weight`). On a level
+``(M3, jellett, C2)`` they give ``Omega3(theta)`` and then ``w_n(theta)``, and
+
+    h = rho_p w_tau^2 / 2 + U(theta),    theta' = -w_tau,    h = E - M3^2/(2 I3) - m g R,
+    U = A w_n^2 / 2 + R s k_p w_n Omega3 + (Js + (m + ms) R^2 s^2) Omega3^2 / 2 + m g a3 cos.
+
+With ``ms = Js = 0`` this is the meridian model's reduction. The rotor's velocity along ``tau``
+is ``v_tau = (R cos + a3) w_n + R s Omega3``; along ``n`` and ``e3`` it is the meridian model's.
+``w_n`` grows like ``1/s`` at a pole unless ``(m + ms) jellett + k_p (M3 + Js Omega3)``
+vanishes there: such pole levels are refused (not reduced yet), as the rough model's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop.body import SphericalTop
+from rollingtop.dynamics.integrals import pair_weight
+from rollingtop.reduction.level import (
+    _MAX_U,
+    ComplexArray,
+    LevelSet,
+    LevelSetError,
+    PoleLevelError,
+    Real,
+    _Analytic,
+    _AnalyticResult,
+)
+
+__all__ = ["ShellRotorLevel", "shell_rotor_integrals"]
+
+FloatArray = NDArray[np.float64]
+#: The pole numerator below this times the level's size is a pole level (refused).
+POLE_LEVEL_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class ShellRotorLevel(LevelSet):
+    """A level set ``(M3, jellett, C2)`` of the shell-rotor pair (module docstring); ``C1`` is
+    not an integral of the pair (0)."""
+
+    integrals: ClassVar[tuple[str, ...]] = ("M3", "jellett", "C2")
+    model: ClassVar[str] = "shell-rotor"
+    near_pole_limits: ClassVar[bool] = False
+
+    M3: float = 0.0
+    C1: float = 0.0
+    C2: float = 0.0
+    jellett: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("M3", "jellett", "C2"):
+            x = getattr(self, name)
+            if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
+                raise LevelSetError(f"level {name} = {x!r} must be a number")
+            if not math.isfinite(x):
+                raise LevelSetError(f"level {name} = {x!r} must be finite")
+            object.__setattr__(self, name, float(x))
+        object.__setattr__(self, "C1", 0.0)
+        b = self.body
+        if not b.symmetric:
+            raise LevelSetError(
+                f"the reduction needs a dynamically symmetric body (I1 = I2), got "
+                f"I1 = {b.I1:g}, I2 = {b.I2:g}"
+            )
+        if not b.has_shell:
+            raise LevelSetError("the shell-rotor reduction needs a shell (shell_mass, "
+                                "shell_inertia > 0)")  # fmt: skip
+        object.__setattr__(self, "pole", None)
+        with np.errstate(all="ignore"):
+            at_equator = abs(float(self.U(math.pi / 2)))
+        if not at_equator <= _MAX_U:
+            raise LevelSetError(
+                f"level {self.describe()} is too large for double precision: its effective "
+                f"potential reaches {at_equator:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale "
+                "units)"
+            )
+        size = max(abs(self.jellett) * (b.m + b.shell_mass), abs(self.M3) * b.R,
+                   abs(self.C2), 1e-300)  # fmt: skip
+        for value, name in zip(self.pole_offsets(), ("south (gamma3 = 1)", "north (gamma3 = -1)"),
+                               strict=True):  # fmt: skip
+            if abs(value) <= POLE_LEVEL_TOLERANCE * size:
+                raise PoleLevelError(
+                    f"level {self.describe()} lets the {name} pole touch the plane: the "
+                    "shell-rotor pair's pole levels are not reduced yet"
+                )
+
+    # ---- the pair's coefficients and the level's Omega3, w_n (complex-safe) -----------------
+    def _parts(self, theta: Any) -> tuple[Any, ...]:
+        """``(s, c, k_p, Omega3, w_n)`` and the theta-derivatives ``(k_p', Omega3', w_n')``."""
+        b = self.body
+        M, ms, Js = b.m + b.shell_mass, b.shell_mass, b.shell_inertia
+        s, c = np.sin(theta), np.cos(theta)
+        N, phi = pair_weight(b, c)
+        K = M * b.I1 + b.m * ms * b.a3**2
+        beta = 2.0 * Js * b.m * b.R * b.a3
+        dN_dc = beta - 2.0 * b.R**2 * K * c
+        kp, dkp = M * b.R * c + b.m * b.a3, -M * b.R * s
+        sqrtN = np.sqrt(N)
+        omega3 = (self.C2 - b.R * self.M3 * phi) / sqrtN
+        # N dOmega3/dc = -(N'/2 Omega3 + R M3 k_p) (the pair's F6, proved), dc/dtheta = -s
+        domega3 = s * (0.5 * dN_dc * omega3 + b.R * self.M3 * kp) / N
+        D0 = K + M * Js
+        num = M * self.jellett + kp * (self.M3 + Js * omega3)
+        dnum = dkp * (self.M3 + Js * omega3) + kp * Js * domega3
+        w_n = num / (b.R * s * D0)
+        dw_n = dnum / (b.R * s * D0) - w_n * c / s
+        return s, c, kp, omega3, w_n, dkp, domega3, dw_n
+
+    def pole_offsets(self) -> tuple[float, float]:
+        """``(m + ms) jellett + k_p (M3 + Js Omega3)`` at the south and north poles: 0 on a pole
+        level."""
+        b = self.body
+        out = []
+        for c in (1.0, -1.0):
+            N, phi = pair_weight(b, c)
+            omega3 = (self.C2 - b.R * self.M3 * float(phi)) / math.sqrt(float(N))
+            kp = (b.m + b.shell_mass) * b.R * c + b.m * b.a3
+            out.append((b.m + b.shell_mass) * self.jellett
+                       + kp * (self.M3 + b.shell_inertia * omega3))  # fmt: skip
+        return out[0], out[1]
+
+    def mirrored(self) -> ShellRotorLevel:
+        """The same motions with the rotor's axis reversed: ``theta -> pi - theta``,
+        ``a3 -> -a3``, ``w3, Omega3 -> -w3, -Omega3``, ``jellett`` kept; ``C2`` becomes
+        ``-C2 - R M3 (Phi_mirror(-c) - Phi(c))`` (a constant: both ``Phi`` have the derivative
+        ``k_p / sqrt(N)``)."""
+        body = replace(self.body, a3=-self.body.a3)
+        shift = float(pair_weight(body, 0.0)[1]) - float(pair_weight(self.body, 0.0)[1])
+        return ShellRotorLevel(body, -self.M3, 0.0, -self.C2 - self.body.R * self.M3 * shift,
+                               jellett=self.jellett)  # fmt: skip
+
+    def omega3(self, theta: Real) -> Real:
+        """The shell's spin about the axis, ``Omega3 = (C2 - R M3 Phi) / sqrt(N)``."""
+        out: Real = self._parts(theta)[3]
+        return out
+
+    def w_n(self, theta: Real) -> Real:
+        """``w_n`` from the Jellett integral (module docstring)."""
+        out: Real = self._parts(theta)[4]
+        return out
+
+    def last_slot(self, theta: Real, psi: float) -> Real:
+        """The shell's relative spin ``delta = Omega3 - w3`` (the pair's last state entry)."""
+        out: Real = self.omega3(theta) - self.M3 / self.body.I3
+        return out
+
+    def P(self, theta: Real) -> Real:
+        """``I1 v_tau = I1 ((R cos + a3) w_n + R s Omega3)``: the rotor's velocity along
+        ``tau``."""
+        b = self.body
+        s, c, _, omega3, w_n, _, _, _ = self._parts(theta)
+        out: Real = b.I1 * ((b.R * c + b.a3) * w_n + b.R * s * omega3)
+        return out
+
+    def U(self, theta: Real) -> Real:
+        """``U`` (module docstring)."""
+        b = self.body
+        M = b.m + b.shell_mass
+        s, c, kp, omega3, w_n, _, _, _ = self._parts(theta)
+        A = b.I1 + b.shell_inertia + M * b.R**2 * c * c + 2 * b.m * b.R * b.a3 * c + b.m * b.a3**2
+        U: Real = (0.5 * A * w_n * w_n + b.R * s * kp * w_n * omega3
+                   + 0.5 * (b.shell_inertia + M * b.R**2 * s * s) * omega3 * omega3
+                   + b.m * b.g * b.a3 * c)  # fmt: skip
+        return U
+
+    def dU(self, theta: _Analytic) -> _AnalyticResult:  # type: ignore[override]
+        """``dU/dtheta`` (analytic: the complex step of ``d2U`` goes through it)."""
+        b = self.body
+        M = b.m + b.shell_mass
+        s, c, kp, om, wn, dkp, dom, dwn = self._parts(theta)
+        A = b.I1 + b.shell_inertia + M * b.R**2 * c * c + 2 * b.m * b.R * b.a3 * c + b.m * b.a3**2
+        dA = -s * (2 * M * b.R**2 * c + 2 * b.m * b.R * b.a3)
+        B, dB = b.R * s * kp, b.R * (c * kp + s * dkp)
+        W, dW = b.shell_inertia + M * b.R**2 * s * s, 2 * M * b.R**2 * s * c
+        out: _AnalyticResult = (0.5 * dA * wn * wn + A * wn * dwn + dB * wn * om
+                                + B * (dwn * om + wn * dom) + 0.5 * dW * om * om + W * om * dom
+                                - b.m * b.g * b.a3 * s)  # fmt: skip
+        return out
+
+    def rho(self, theta: Real) -> Real:
+        """``rho_p = I1 + Js + ms R^2 + m |r|^2``: the reduced motion's mass."""
+        b = self.body
+        out: Real = b.rho(np.cos(theta)) + b.shell_inertia + b.shell_mass * b.R**2
+        return out
+
+    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
+        """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model)."""
+        rate: float | FloatArray = -self._parts(theta)[4] / np.sin(theta)
+        return rate
+
+    def normal_force(self, theta: Real, w_tau: Real) -> Real:
+        """``N = (m + ms) g + m a3 gamma3''``: the shell's centre stays at height ``R``, the
+        rotor's centre of mass at ``R + a3 gamma3``."""
+        b = self.body
+        _, dw = self.flow(theta, w_tau)
+        N: Real = (b.m + b.shell_mass) * b.g + b.m * b.a3 * (
+            np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau)  # fmt: skip
+        return N
+
+    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
+        """:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues` at ``gamma3``."""
+        return self.curvature_eigenvalues(gamma3)
+
+    def describe(self) -> str:
+        """One line naming the level set."""
+        return f"M3 = {self.M3:g}, jellett = {self.jellett:g}, C2 = {self.C2:g}"
+
+
+def shell_rotor_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
+    """``M3 = I3 w3``, the pair's Jellett integral and ``C2 = F6`` and the reduced energy
+    ``h = E - M3^2/(2 I3) - m g R`` of states ``Y`` (shape ``(..., 18)``)."""
+    from rollingtop.dynamics.integrals import F6, energy, jellett, lagrange
+
+    Y = np.asarray(Y, dtype=float)
+    M3 = lagrange(body, Y)
+    h = energy(body, Y) - M3**2 / (2 * body.I3) - body.m * body.g * body.R
+    return {"M3": M3, "jellett": jellett(body, Y), "C2": F6(body, Y), "h": h}
