@@ -44,14 +44,31 @@ RESONANCE_TOLERANCE = 1e-9
 NEAR_RESONANT = 100.0
 
 FloatArray: TypeAlias = NDArray[np.float64]
+#: Most evaluations of the path's right-hand side in one :func:`reconstruct` (about a second):
+#: beyond them the axis passes so close to the vertical that its azimuth swings faster than the
+#: path can be followed (rubber rolling next to its pole level: ``psi' ~ h / rubber_spin``).
+MAX_PATH_EVALUATIONS = 60_000
+
+
+class PathUnresolvedError(LevelSetError):
+    """The reconstruction would need more than :data:`MAX_PATH_EVALUATIONS` evaluations."""
 
 
 def _path_rhs(level: LevelSet) -> Callable[[float, FloatArray], list[float]]:
     """The right-hand side for ``solve_ivp`` of ``z = (theta, w_tau, psi, X, Y)`` (module
-    docstring): :meth:`LevelSet.flow` with the quadratures for ``psi``, ``X`` and ``Y``."""
+    docstring): :meth:`LevelSet.flow` with the quadratures for ``psi``, ``X`` and ``Y``; raises
+    :class:`PathUnresolvedError` past :data:`MAX_PATH_EVALUATIONS` calls."""
     b = level.body
+    calls = [0]
 
     def f(t: float, z: FloatArray) -> list[float]:
+        calls[0] += 1
+        if calls[0] > MAX_PATH_EVALUATIONS:
+            raise PathUnresolvedError(
+                f"the path on {level.describe()} is not reconstructed: the axis passes so close "
+                "to the vertical that its azimuth swings faster than the path can be followed "
+                f"({MAX_PATH_EVALUATIONS} evaluations)"
+            )
         theta, w_tau, psi = z[0], z[1], z[2]
         theta_dot, w_tau_dot = level.flow(theta, w_tau)
         k = (b.R + b.a3 * np.cos(theta)) * w_tau
@@ -145,7 +162,7 @@ class PeriodMap:
         Estimated absolute error of ``delta_psi`` (two quadrature levels).
     displacement : (float, float)
         CoM displacement over one period from the canonical start.
-    motion : {"bounded", "drifting", "uniform drift"}
+    motion : {"bounded", "drifting", "uniform drift", "unresolved"}
     center, radius : (float, float) and float, or None
         Circle on which the once-per-period CoM positions lie (bounded motion).
     drift_velocity : (float, float) or None
@@ -215,6 +232,27 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
         # its direction is the horizontal momentum's, not part of the level: only its speed
         return PeriodMap(T, dpsi, (math.nan, math.nan), "uniform drift", None, None, None,
                          False, theta0, dpsi_err, drift_speed=drift)  # fmt: skip
+    try:
+        dpsi, dpsi_err, theta0, D = _displacement(level, h, orbit)
+    except PathUnresolvedError:  # Delta psi by quadrature all the same; no displacement
+        turns, turns_err = rotation_number(level, h, orbit)
+        return PeriodMap(T, 2 * math.pi * turns, (math.nan, math.nan), "unresolved", None, None,
+                         None, False, start_theta(orbit), 2 * math.pi * turns_err)  # fmt: skip
+    turns = dpsi / (2 * math.pi)
+    if abs(turns - round(turns)) < RESONANCE_TOLERANCE:
+        v = D / T
+        return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None, (v.real, v.imag),
+                         False, theta0, dpsi_err)  # fmt: skip
+    c = D / (1 - cmath.exp(1j * dpsi))
+    radius = abs(c)
+    return PeriodMap(T, dpsi, (D.real, D.imag), "bounded", (c.real, c.imag), radius, None,
+                     radius > NEAR_RESONANT * level.body.R, theta0, dpsi_err)  # fmt: skip
+
+
+def _displacement(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, float, float, complex]:
+    """``(Delta psi, its error, theta0, D)``: the quadrature of ``psi'`` and the CoM's
+    displacement over one period from the canonical start (:func:`reconstruct`)."""
+    T = orbit.period
     if level.pole == "both":  # no spin: the axis does not precess (rollingtop.reduction.no_spin)
         dpsi, dpsi_err = 0.0, 0.0
         theta0, w_tau0 = start_theta(orbit), 0.0
@@ -234,13 +272,4 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
             # is resolved in theta; the same physical motion has psi + pi and theta -> pi - theta
             start = exact_orbit.theta_min if theta0 == orbit.theta_max else exact_orbit.theta_max
             path = reconstruct(exact_level, [0.0, T], theta0=start, w_tau0=0.0, psi0=math.pi)
-    D = complex(*path["position"][-1])
-    turns = dpsi / (2 * math.pi)
-    if abs(turns - round(turns)) < RESONANCE_TOLERANCE:
-        v = D / T
-        return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None, (v.real, v.imag),
-                         False, theta0, dpsi_err)  # fmt: skip
-    c = D / (1 - cmath.exp(1j * dpsi))
-    radius = abs(c)
-    return PeriodMap(T, dpsi, (D.real, D.imag), "bounded", (c.real, c.imag), radius, None,
-                     radius > NEAR_RESONANT * level.body.R, theta0, dpsi_err)  # fmt: skip
+    return dpsi, dpsi_err, theta0, complex(*path["position"][-1])

@@ -61,6 +61,8 @@ class OrbitSurvey:
                 row.update(center=list(pm.center), radius=pm.radius)
             elif pm.motion == "uniform drift":  # a speed: the direction is not the level's
                 row.update(displacement=None, drift_speed=pm.drift_speed)
+            elif pm.motion == "unresolved":  # too close to the vertical to follow the path
+                row.update(displacement=None)
             else:
                 assert pm.drift_velocity is not None
                 row.update(drift_velocity=list(pm.drift_velocity))

@@ -587,3 +587,36 @@ def test_a_rubber_level_near_its_pole_level_keeps_its_period(body, F):
         assert o.theta_min == pytest.approx(float(lo), rel=1e-9)
         assert math.pi - o.theta_max == pytest.approx(float(mp.pi - hi), rel=1e-6)
         assert o.period == pytest.approx(float(T), rel=QUAD_RTOL)
+
+
+def test_a_path_too_close_to_the_vertical_is_unresolved_not_a_hang(paper_body):
+    """rubber_spin = 1e-12: the axis passes within ~1e-12 of the vertical, where its azimuth
+    swings at ~h / rubber_spin. The orbit and its delta_psi (quadrature) are given; the path's
+    displacement is reported unresolved after a bounded number of evaluations
+    (absolute.MAX_PATH_EVALUATIONS), never integrated for hours."""
+    from rollingtop.survey import survey_orbits
+
+    level = RubberLevel(paper_body, rubber_spin=1e-12)
+    (row,) = survey_orbits(level, 0.5)
+    assert row.orbit.kind == "periodic" and row.orbit.theta_min < 1e-11
+    assert row.period_map.motion == "unresolved"
+    data = row.to_dict()
+    assert data["displacement"] is None and math.isfinite(data["delta_psi"])
+
+
+def test_a_level_table_starts_a_rolling_over_motion(paper_body):
+    """[level] without [initial] on a level whose orbit rolls over (no turning point: the
+    meridian model's no-spin level above the upright energy) starts at gamma3 = 0 with the
+    level's energy; near a pole (rubber_spin = 1e-12) the turning point beside the pole is kept
+    as an angle (cos would round it onto the pole)."""
+    from rollingtop.reduction import LevelSet
+    from rollingtop.reduction.start import start_on_level
+
+    level = LevelSet(paper_body, 0.0, 0.0, 0.0)
+    y = start_on_level(level, 0.5)
+    assert y[14] == pytest.approx(0.0, abs=1e-15)
+    assert INTEGRALS["energy"](paper_body, y) == pytest.approx(level.full_energy(0.5), rel=1e-14)
+    rubber = RubberLevel(paper_body, rubber_spin=1e-12)
+    y = start_on_level(rubber, 0.5)
+    assert 1e-13 < math.hypot(y[12], y[13]) < 1e-11  # off the pole by the wall's width
+    assert reduction_of("rubber").reduced_energy(paper_body, y) == pytest.approx(0.5, rel=1e-9)

@@ -101,5 +101,11 @@ def start_on_level(
         No motion on the level with this ``h`` (or at this ``gamma3``).
     """
     if gamma3 is None:  # a turning point of the first orbit, on the branch 0 < theta < pi
-        gamma3 = math.cos(orbits(level, h)[0].start_theta)
+        first = orbits(level, h)[0]
+        theta = first.start_theta
+        if first.rolls_over or not 0.0 < theta < math.pi:  # no turning point on that branch
+            theta = math.pi / 2
+        # theta itself: a turning point beside a pole keeps its distance from it (cos rounds)
+        return state_from_level(level, h, math.cos(theta), branch=branch, phi=phi, psi=psi,
+                                theta=theta)  # fmt: skip
     return state_from_level(level, h, gamma3, branch=branch, phi=phi, psi=psi)
