@@ -155,3 +155,19 @@ omega = [0.0, 0.0, 3.0]
     rubber = data["models"][2]
     assert rubber["level"]["rubber_spin"] == 0.0 and rubber["orbit"] is None
     assert "omega projected" in rubber["note"]
+
+
+@pytest.mark.parametrize("omega", [[1e-7, 1.8, 2.4000001], [1e-6, 3e-13, 4e-13]],
+                         ids=["almost_along_gamma", "slow"])  # fmt: skip
+def test_rubber_rolling_takes_the_horizontal_part_of_any_omega(paper_body, omega):
+    """omega almost along gamma, or slow: its projection onto (omega, gamma) = 0 is admitted
+    (residual at round-off of what is left), and a model that refuses a state never stops the
+    others."""
+    from rollingtop.reduction.classify import classify_models
+
+    refused: dict[str, str] = {}
+    found = classify_models(paper_body, [0.0, 0.6, 0.8], omega, n=3, refused=refused)
+    rubber = [c for c in found if c.model == "rubber"]
+    assert "rubber" not in refused and len(rubber) == 1
+    w, g = rubber[0].state[3:6], rubber[0].state[12:15]
+    assert abs(w @ g) <= 1e-9 * np.linalg.norm(w)

@@ -144,6 +144,8 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
         raise AtlasError(f"the atlas has {size} cells, more than {MAX_CELLS}")
     contact = data.get("contact", {})
     model = contact.get("model", "meridian") if isinstance(contact, dict) else "meridian"
+    if not isinstance(model, str):
+        raise AtlasError(f"contact.model = {short_repr(model)} must be a model name")
     if "model" in axes or not (model in MODELS and get_model(model).has_reduction):
         return _state_spec(data, axes, model)
     # the fixed values: the scenario's, with each axis at its first value
@@ -225,6 +227,9 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
     if not sc.body.symmetric:
         raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
                          f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
+    if sc.body.has_shell:
+        raise AtlasError("the atlas classifies bodies without a shell: the shell's mass and "
+                         "inertia are not among its axes")  # fmt: skip
     y0 = sc.require_state()
     fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
     fixed.update(zip(STATE_KEYS, (float(x) for x in (*y0[12:15], *y0[3:6])), strict=True))

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rollingtop._errors import ScenarioError
+from rollingtop._errors import RollingTopError, ScenarioError
 from rollingtop._json import finite_or_none, json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS
@@ -231,10 +231,11 @@ def classify_models(
             y = np.asarray(own[1], dtype=float)
         else:
             w, projected = _admissible_omega(name, gamma, omega)
-            y = initial_state(body, name, gamma=gamma, omega=w)
         try:
+            if own is None or own[0] != name:
+                y = initial_state(body, name, gamma=gamma, omega=w)
             level = reduction.level_of_state(body, y)
-        except LevelSetError as err:  # e.g. a level the model does not reduce: the others go on
+        except RollingTopError as err:  # e.g. a level the model does not reduce: others go on
             refused[name] = str(err)
             continue
         h = reduction.reduced_energy(body, y)
@@ -265,11 +266,13 @@ def _admissible_omega(name: str, gamma: ArrayLike, omega: ArrayLike) -> tuple[Fl
     g = np.asarray(gamma, dtype=float)
     g = g / np.linalg.norm(g)
     dropped = []
+    size = float(np.linalg.norm(w))
     for label, d in directions(g).items():
         d = np.asarray(d, dtype=float)
         part = float(w @ d) / float(d @ d)
-        if abs(part) > 1e-12 * max(1.0, float(np.linalg.norm(w))):
-            w = w - part * d
+        w = w - part * d  # always: what is left is round-off of w's size
+        w = w - float(w @ d) / float(d @ d) * d  # again: round-off of what is left
+        if abs(part) * float(np.linalg.norm(d)) > 1e-12 * size:
             dropped.append(label)
     note = f"omega projected onto {', '.join(dropped)}" if dropped else ""
     return w, note

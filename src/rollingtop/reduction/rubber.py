@@ -30,10 +30,11 @@ revolution). The kinetic energy ``T = (I w, w)/2 + m |r x w|^2 / 2`` splits into
     U   = F^2 / (2 I3 sin^2 theta) + m g a3 cos theta,
     rho = I1 + m (R^2 + a3^2 + 2 a3 R cos theta)   (the meridian model's),
 
-whatever the body's moments: they enter only the spin ``w3 = F / sqrt(I3 J)`` and so the
-precession and the path, not the nutation. ``U' = 0`` reads ``F^2 cos = -m g a3 I3 sin^4``: one
-steady motion, a centre, on every level with ``F != 0`` (the axis tilted to the side away from
-the centre of mass), the vertical rest when ``F = 0`` and ``a3 < 0``.
+where ``I1`` enters through ``rho`` and ``I3`` through the scaling of ``F``; the spin
+``w3 = F / sqrt(I3 J)`` carries the rest of the moments into the precession and the path.
+``U' = 0`` reads ``F^2 cos = -m g a3 I3 sin^4``: one steady motion, a centre, on every level
+with ``F != 0`` (the axis tilted to the side away from the centre of mass), and on ``F = 0``
+the rests at the poles (a centre at the pole below the centre of mass).
 
 ``F = 0`` is the pole level: ``Omega = 0``, the body rolls in a vertical plane through both poles
 (``U = m g a3 cos theta``, the meridian model's no-spin level with ``C2 = 0``), reduced on the
@@ -178,7 +179,7 @@ class RubberLevel(LevelSet):
         return out
 
     def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
-        """Precession rate ``psi' = -w_n / s = -Omega cos^2 / sin`` (kinematics; 0 on
+        """Precession rate ``psi' = -w_n / s = -Omega cos / sin`` (kinematics; 0 on
         ``F = 0``)."""
         if self.pole == "both":
             return np.zeros_like(np.asarray(theta, dtype=float))
