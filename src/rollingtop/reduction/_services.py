@@ -10,19 +10,71 @@ motion in absolute space) asks the level through these, whatever the model.
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar, TypeAlias, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
 
-__all__ = ["LevelServices", "Real"]
+__all__ = [
+    "LevelServices",
+    "LevelSetError",
+    "PoleLevelError",
+    "Real",
+    "check_level_size",
+    "check_level_values",
+]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
 #: a float gives a float (a numpy float) and an array of shape ``(...)`` an array of that shape.
 Real = TypeVar("Real", float, FloatArray)
+
+
+class LevelSetError(RollingTopError):
+    """Inconsistent level set, or a level with no motion."""
+
+
+class PoleLevelError(LevelSetError):
+    """A pole level the model's reduction does not reduce (yet): the rough model's."""
+
+
+#: Largest effective potential a level may reach at ``gamma3 = 0``: beyond it ``U``, its
+#: derivatives and ``h - U`` would overflow (or lose every digit) in double precision.
+_MAX_U = 1e100
+
+
+def check_level_values(level: Any, names: tuple[str, ...]) -> None:
+    """Each integral ``names`` of ``level`` a finite number (stored as a float), and its body
+    dynamically symmetric; a :class:`~rollingtop.reduction.LevelSetError` in one line if not
+    (every model's level, at construction)."""
+    for name in names:
+        x = getattr(level, name)
+        if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
+            raise LevelSetError(f"level {name} = {x!r} must be a number")
+        if not math.isfinite(x):
+            raise LevelSetError(f"level {name} = {x!r} must be finite")
+        object.__setattr__(level, name, float(x))
+    b = level.body
+    if not b.symmetric:
+        raise LevelSetError(f"the reduction needs a dynamically symmetric body (I1 = I2), got "
+                            f"I1 = {b.I1:g}, I2 = {b.I2:g}")  # fmt: skip
+
+
+def check_level_size(level: Any) -> None:
+    """``U`` at ``gamma3 = 0`` within :data:`_MAX_U`, else a one-line
+    :class:`~rollingtop.reduction.LevelSetError` naming the level (every model's level, once its
+    values are set)."""
+    with np.errstate(all="ignore"):
+        size = abs(float(level.U(math.pi / 2)))
+    if not size <= _MAX_U:
+        raise LevelSetError(
+            f"level {level.describe()} is too large for double precision: its effective "
+            f"potential reaches {size:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale units)"
+        )
 
 
 class LevelServices:

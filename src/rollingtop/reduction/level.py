@@ -29,10 +29,16 @@ from typing import Any, ClassVar, TypeAlias, overload
 import numpy as np
 from numpy.typing import NDArray
 
-from rollingtop._errors import RollingTopError
 from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
-from rollingtop.reduction._services import LevelServices, Real
+from rollingtop.reduction._services import (
+    LevelServices,
+    LevelSetError,
+    PoleLevelError,
+    Real,
+    check_level_size,
+    check_level_values,
+)
 
 __all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "PoleLevelError", "Real", "near_north"]
 
@@ -46,19 +52,8 @@ _AnalyticResult: TypeAlias = float | FloatArray | NDArray[np.complexfloating[Any
 #: ``|C1 -+ M3|`` below this times ``max(|M3|, |C1|)`` is a pole case: the simulator's tolerance
 #: (:data:`rollingtop.contact.meridian.POLE_CASE_TOLERANCE`), one decision for every command.
 POLE_TOLERANCE = POLE_CASE_TOLERANCE
-#: Largest effective potential a level may reach at ``gamma3 = 0``: beyond it ``U``, its
-#: derivatives and ``h - U`` would overflow (or lose every digit) in double precision.
-_MAX_U = 1e100
 #: Step of the complex-step derivative (exact to round-off for analytic functions).
 _COMPLEX_STEP = 1e-30
-
-
-class LevelSetError(RollingTopError):
-    """Inconsistent level set, or a level with no motion."""
-
-
-class PoleLevelError(LevelSetError):
-    """A pole level the model's reduction does not reduce (yet): the rough model's."""
 
 
 @dataclass(frozen=True)
@@ -114,18 +109,7 @@ class LevelSet(LevelServices):
     pole: str | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("M3", "C1", "C2"):
-            x = getattr(self, name)
-            if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
-                raise LevelSetError(f"level {name} = {x!r} must be a number")
-            if not math.isfinite(x):
-                raise LevelSetError(f"level {name} = {x!r} must be finite")
-            object.__setattr__(self, name, float(x))
-        if not self.body.symmetric:
-            raise LevelSetError(
-                f"the reduction needs a dynamically symmetric body (I1 = I2), got "
-                f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
-            )
+        check_level_values(self, ("M3", "C1", "C2"))
         pole = pole_case(self.M3, self.C1, scale=abs(float(self.scale)))
         if pole == "south":
             object.__setattr__(self, "C1", self.M3)
@@ -135,13 +119,7 @@ class LevelSet(LevelServices):
             object.__setattr__(self, "M3", 0.0)
             object.__setattr__(self, "C1", 0.0)
         object.__setattr__(self, "pole", pole)
-        with np.errstate(all="ignore"):
-            size = abs(float(self.U(math.pi / 2)))
-        if not size <= _MAX_U:
-            raise LevelSetError(
-                f"level {self.describe()} is too large for double precision: its effective "
-                f"potential reaches {size:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale units)"
-            )
+        check_level_size(self)
 
     def pole_offsets(self) -> tuple[float, float]:
         """How far the level is from its south and north pole levels: ``C1 - M3`` and

@@ -39,11 +39,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
+from rollingtop.reduction._services import check_level_size, check_level_values
 from rollingtop.reduction.level import (
-    _MAX_U,
     ComplexArray,
     LevelSet,
-    LevelSetError,
     PoleLevelError,
     Real,
     _Analytic,
@@ -74,29 +73,11 @@ class RoughLevel(LevelSet):
     routh: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("jellett", "routh"):
-            x = getattr(self, name)
-            if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
-                raise LevelSetError(f"level {name} = {x!r} must be a number")
-            if not math.isfinite(x):
-                raise LevelSetError(f"level {name} = {x!r} must be finite")
-            object.__setattr__(self, name, float(x))
+        check_level_values(self, ("jellett", "routh"))
         for name in ("M3", "C1", "C2"):
             object.__setattr__(self, name, 0.0)
-        if not self.body.symmetric:
-            raise LevelSetError(
-                f"the reduction needs a dynamically symmetric body (I1 = I2), got "
-                f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
-            )
         object.__setattr__(self, "pole", None)
-        with np.errstate(all="ignore"):
-            at_equator = abs(float(self.U(math.pi / 2)))
-        if not at_equator <= _MAX_U:
-            raise LevelSetError(
-                f"level {self.describe()} is too large for double precision: its effective "
-                f"potential reaches {at_equator:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale "
-                "units)"
-            )
+        check_level_size(self)
         size = max(abs(self.jellett), abs(self.routh) * self.body.R, 1e-300)
         for theta, name in ((0.0, "south (gamma3 = 1)"), (math.pi, "north (gamma3 = -1)")):
             if abs(self._numerator(theta)) <= POLE_LEVEL_TOLERANCE * size:

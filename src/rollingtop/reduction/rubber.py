@@ -51,12 +51,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
+from rollingtop.reduction._services import check_level_size, check_level_values
 from rollingtop.reduction.level import (
-    _MAX_U,
     POLE_TOLERANCE,
     ComplexArray,
     LevelSet,
-    LevelSetError,
     Real,
     _Analytic,
     _AnalyticResult,
@@ -85,19 +84,10 @@ class RubberLevel(LevelSet):
     rubber_spin: float = 0.0
 
     def __post_init__(self) -> None:
+        check_level_values(self, ("rubber_spin",))
         F = self.rubber_spin
-        if isinstance(F, bool) or not isinstance(F, int | float | np.floating | np.integer):
-            raise LevelSetError(f"level rubber_spin = {F!r} must be a number")
-        if not math.isfinite(F):
-            raise LevelSetError(f"level rubber_spin = {F!r} must be finite")
-        F = float(F)
         for name in ("M3", "C1", "C2"):
             object.__setattr__(self, name, 0.0)
-        if not self.body.symmetric:
-            raise LevelSetError(
-                f"the reduction needs a dynamically symmetric body (I1 = I2), got "
-                f"I1 = {self.body.I1:g}, I2 = {self.body.I2:g}"
-            )
         # the round-off of a value read from a state: |F| <~ |w| sqrt(I3 J) <~ |I w| * O(1)
         scale = abs(float(self.scale)) * math.sqrt(1.0 + self.body.m * self.body.R**2
                                                      / min(self.body.I1, self.body.I3))  # fmt: skip
@@ -105,14 +95,7 @@ class RubberLevel(LevelSet):
             F = 0.0
         object.__setattr__(self, "rubber_spin", F)
         object.__setattr__(self, "pole", "both" if F == 0.0 else None)
-        with np.errstate(all="ignore"):
-            at_equator = abs(float(self.U(math.pi / 2)))
-        if not at_equator <= _MAX_U:
-            raise LevelSetError(
-                f"level {self.describe()} is too large for double precision: its effective "
-                f"potential reaches {at_equator:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale "
-                "units)"
-            )
+        check_level_size(self)
 
     def pole_offsets(self) -> tuple[float, float]:
         """``rubber_spin`` at both poles: the one pole level ``F = 0`` lets both touch."""

@@ -40,8 +40,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import pair_weight
+from rollingtop.reduction._services import check_level_size, check_level_values
 from rollingtop.reduction.level import (
-    _MAX_U,
     ComplexArray,
     LevelSet,
     LevelSetError,
@@ -73,32 +73,14 @@ class ShellRotorLevel(LevelSet):
     jellett: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("M3", "jellett", "C2"):
-            x = getattr(self, name)
-            if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
-                raise LevelSetError(f"level {name} = {x!r} must be a number")
-            if not math.isfinite(x):
-                raise LevelSetError(f"level {name} = {x!r} must be finite")
-            object.__setattr__(self, name, float(x))
+        check_level_values(self, ("M3", "jellett", "C2"))
         object.__setattr__(self, "C1", 0.0)
         b = self.body
-        if not b.symmetric:
-            raise LevelSetError(
-                f"the reduction needs a dynamically symmetric body (I1 = I2), got "
-                f"I1 = {b.I1:g}, I2 = {b.I2:g}"
-            )
         if not b.has_shell:
             raise LevelSetError("the shell-rotor reduction needs a shell (shell_mass, "
                                 "shell_inertia > 0)")  # fmt: skip
         object.__setattr__(self, "pole", None)
-        with np.errstate(all="ignore"):
-            at_equator = abs(float(self.U(math.pi / 2)))
-        if not at_equator <= _MAX_U:
-            raise LevelSetError(
-                f"level {self.describe()} is too large for double precision: its effective "
-                f"potential reaches {at_equator:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale "
-                "units)"
-            )
+        check_level_size(self)
         size = max(abs(self.jellett) * (b.m + b.shell_mass), abs(self.M3) * b.R,
                    abs(self.C2), 1e-300)  # fmt: skip
         for value, name in zip(self.pole_offsets(), ("south (gamma3 = 1)", "north (gamma3 = -1)"),
