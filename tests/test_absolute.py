@@ -77,7 +77,7 @@ def test_resonant_orbit_drifts(paper_body):
 
     def dpsi(h):
         o = orbits(level, h)[0]
-        return period(level, h, o.theta_min, o.theta_max, weight=level.psi_dot)[0]
+        return period(level, h, o.theta_min, o.theta_max, weight="psi_dot")[0]
 
     h = brentq(dpsi, u_min + 1, u_min + 2, xtol=1e-15, rtol=8.9e-16)
     pm = period_map(level, h)

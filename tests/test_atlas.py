@@ -4,6 +4,7 @@ independent count of steady motions, resumable, atomic, and bad specs refused in
 import json
 import math
 
+import mpmath as mp
 import pytest
 import xarray as xr
 
@@ -16,6 +17,7 @@ from rollingtop.atlas import (
 )
 from rollingtop.reduction import LevelSet, steady_motions
 
+from .reduction.test_models import _mp_potential
 from .test_cli import run_cli
 
 BODY = {"R": 1.0, "m": 1.0, "g": 1.0, "a3": 0.1, "I1": 0.3, "I3": 0.5}
@@ -243,6 +245,12 @@ def test_a_model_axis_classifies_each_models_level_of_the_state(client, tmp_path
                     m.precession_rate / m.frequency, rel=1e-12)  # fmt: skip
             assert (int(cell["n_folds"]) >= 0) == (model == "meridian")
             assert int(ds.sel(model=model, a3=a3, I3=0.7)["status"]) == 1  # I3 > 2 I1
+            if model != "meridian":  # each centre: a minimum of U written again in mpmath
+                U, _ = _mp_potential(classes[model].level)
+                for k in range(int(cell["n_centres"])):
+                    theta = mp.acos(float(cell["centre_gamma3"][k]))
+                    assert abs(mp.diff(U, theta)) < 1e-9 * max(1.0, abs(U(theta)))
+                    assert mp.diff(U, theta, 2) > 0
 
 
 def test_a_model_other_than_the_meridian_one_is_an_atlas_of_its_own():

@@ -174,3 +174,32 @@ def test_bifurcation_of_the_other_reduced_models(capsys, tmp_path, name):
         theta = math.acos(gamma3)
         assert abs(float(level.dU(theta))) < 1e-8 * max(1.0, abs(U))
         assert float(level.U(theta)) == pytest.approx(U, rel=1e-12, abs=1e-12)
+
+
+def test_bifurcation_of_a_shell_rotor_level_without_its_axis(capsys, tmp_path):
+    """The shell-rotor pair's axis is C2, as the paper's: a [level] without it is scanned around
+    0 over twice the size of its other integrals (not refused), and the figure marks no level
+    value; each point is a critical point of that C2's U, computed again here."""
+    from rollingtop.reduction import ShellRotorLevel, reduction_of
+    from rollingtop.scenario import load_scenario
+
+    text = (EXAMPLES / "shell_rotor.toml").read_text()
+    head = text[: text.index("\n[initial]") + 1]
+    path = tmp_path / "pair.toml"
+    path.write_text(head + "[level]\nM3 = 1.5\njellett = 0.4\n")
+    code, out, err = run_cli(capsys, "bifurcation", str(path), "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["model"] == "shell-rotor" and data["axis"] == "C2"
+    assert data["fixed"] == {"M3": 1.5, "jellett": 0.4}
+    assert data["x"][0] == -3.0 and data["x"][-1] == 3.0  # 2 * max(|M3|, |jellett|)
+    body = load_scenario(str(path)).body
+    assert reduction_of("shell-rotor").names == ("M3", "jellett", "C2")
+    for x, gamma3, U, _ in data["points"][::60]:
+        level = ShellRotorLevel(body, M3=1.5, C2=x, jellett=0.4)
+        theta = math.acos(gamma3)
+        assert abs(float(level.dU(theta))) < 1e-8 * max(1.0, abs(U))
+        assert float(level.U(theta)) == pytest.approx(U, rel=1e-12, abs=1e-12)
+    # equilibria needs the whole level: refused in one line naming C2
+    code, out, err = run_cli(capsys, "equilibria", str(path))
+    assert code == 2 and "missing C2" in err and len(err.strip().splitlines()) == 1

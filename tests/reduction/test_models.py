@@ -589,6 +589,50 @@ def test_a_rubber_level_near_its_pole_level_keeps_its_period(body, F):
         assert o.period == pytest.approx(float(T), rel=QUAD_RTOL)
 
 
+@pytest.mark.parametrize("F", [1e-6, 1e-9, 1e-13])
+def test_a_rubber_level_near_its_pole_level_keeps_its_delta_psi(body, F):
+    """delta_psi next to the pole level: psi' ~ F / sin^2 swings by about pi across each wall
+    (of width ~F), the two walls of an orbit that almost rolls over cancel. The north wall is
+    integrated on the mirror image (pi - theta loses the wall's digits); against mpmath at
+    40 digits with psi' = -F cos / (sqrt(I3 J) sin^2) written again, to 1e-10 absolute, and the
+    reported error bounds the difference."""
+    from rollingtop.reduction.rotation import rotation_number
+
+    b = body
+    level = RubberLevel(b, rubber_spin=F)
+    U, rho = _mp_potential(level)
+
+    def psi_dot(t):
+        J = b.I1 * mp.cos(t) ** 2 + b.I3 * mp.sin(t) ** 2 + b.m * (b.R + b.a3 * mp.cos(t)) ** 2
+        return -F * mp.cos(t) / (mp.sqrt(b.I3 * J) * mp.sin(t) ** 2)
+
+    for h in (abs(b.m * b.g * b.a3) * 1.5, abs(b.m * b.g * b.a3) * 0.5):
+        (o,) = orbits(level, h)
+        N, err = rotation_number(level, h, o)
+        with mp.workdps(40):
+            ends = []
+            for t, pole in ((o.theta_min, 0), (o.theta_max, mp.pi)):
+                d = abs(pole - t)  # bracket the root within 30% of its distance to the pole
+                ends.append(mp.findroot(lambda x, h=h: U(x) - h,
+                                        (pole + (t - pole) * 0.7, pole + (t - pole) * 1.3)
+                                        if d < 0.5 else (t - 1e-6, t + 1e-6),
+                                        solver="anderson"))  # fmt: skip
+            lo, hi = ends
+            c, d = (lo + hi) / 2, (hi - lo) / 2
+            # theta = c + d sin(phi): smooth at the turning points; break points at the walls
+            walls = [lo + (hi - lo) * k for k in (1e-12, 1e-9, 1e-6, 1e-3, 0.5)]
+            walls += [hi - (hi - lo) * k for k in (1e-3, 1e-6, 1e-9, 1e-12)]
+            phis = [-mp.pi / 2, *(mp.asin((x - c) / d) for x in walls), mp.pi / 2]
+
+            def f(phi, h=h, c=c, d=d):
+                t = c + d * mp.sin(phi)
+                return psi_dot(t) * 2 * mp.sqrt(rho(t) / (2 * (h - U(t)))) * d * mp.cos(phi)
+
+            dpsi = float(mp.re(mp.quad(f, phis)))
+        assert 2 * math.pi * N == pytest.approx(dpsi, abs=1e-10)
+        assert abs(2 * math.pi * N - dpsi) <= 2 * math.pi * err + 1e-15
+
+
 def test_a_path_too_close_to_the_vertical_is_unresolved_not_a_hang(paper_body):
     """rubber_spin = 1e-12: the axis passes within ~1e-12 of the vertical, where its azimuth
     swings at ~h / rubber_spin. The orbit and its delta_psi (quadrature) are given; the path's
@@ -620,3 +664,51 @@ def test_a_level_table_starts_a_rolling_over_motion(paper_body):
     y = start_on_level(rubber, 0.5)
     assert 1e-13 < math.hypot(y[12], y[13]) < 1e-11  # off the pole by the wall's width
     assert reduction_of("rubber").reduced_energy(paper_body, y) == pytest.approx(0.5, rel=1e-9)
+
+
+def test_levels_of_the_other_models_take_their_integrals_by_keyword(paper_body):
+    """Only the body is positional: values in the meridian model's order (M3, C1, C2) are
+    refused, not put into fields the model ignores (a silent pole level)."""
+    shell_body = replace(paper_body, **SHELL)
+    for make in (
+        lambda: RubberLevel(paper_body, 0.7),
+        lambda: RoughLevel(paper_body, 0.1, 0.2),
+        lambda: ShellRotorLevel(shell_body, 1.0, 0.0, 0.5),
+        lambda: RubberLevel(paper_body),  # no silent default of the integral either
+    ):
+        with pytest.raises(TypeError):
+            make()
+    assert RubberLevel(paper_body, rubber_spin=0.7).rubber_spin == 0.7
+
+
+@pytest.mark.parametrize("change", [{"a3": 0.0}, {"g": 0.0}], ids=["balanced", "no_gravity"])
+def test_a_flat_potential_is_refused_for_steady_motions_and_rolls_over(paper_body, change):
+    """rubber_spin = 0 on a balanced body (or without gravity): U is constant, every gamma3 is
+    a steady motion. steady_motions says so in one line (it listed ~20000 'degenerate' points);
+    the orbit rolls over uniformly, theta' = sqrt(2 h / rho) with rho constant for a3 = 0 (closed
+    form, and the trapezoid rule of 1 / theta' over a turn for g = 0)."""
+    from rollingtop.reduction import LevelSetError
+
+    body = replace(paper_body, **change)
+    level = RubberLevel(body, rubber_spin=0.0)
+    with pytest.raises(LevelSetError, match="U is constant") as err:
+        steady_motions(level)
+    assert "\n" not in str(err.value)
+    h = 0.65
+    (o,) = orbits(level, h)
+    assert o.kind == "periodic" and o.rolls_over
+    theta = np.linspace(0.0, 2 * math.pi, 20001)
+    rho = body.I1 + body.m * (body.R**2 + body.a3**2 + 2 * body.a3 * body.R * np.cos(theta))
+    T = np.trapezoid(np.sqrt(rho / (2 * h)), theta)  # periodic integrand: spectral accuracy
+    assert o.period == pytest.approx(T, rel=1e-12)
+
+
+def test_a_wall_too_thin_for_doubles_is_refused_with_the_models_own_advice(paper_body):
+    """A rubber level within 1e-17 of its pole level: the wall next to the pole is thinner than
+    doubles resolve near pi; the refusal names the rubber model's pole level, not the meridian
+    model's C1 = +-M3."""
+    from rollingtop.reduction import LevelSetError
+
+    with pytest.raises(LevelSetError, match="rubber_spin = 0 exactly") as err:
+        orbits(RubberLevel(paper_body, rubber_spin=1e-17), 0.2)
+    assert "C1" not in str(err.value)

@@ -58,8 +58,9 @@ def _table(summary: dict[str, Any]) -> Any:
 @click.option("--c1-range", default=None, metavar="LO,HI",
               help="C1 window of the steady-motion count (default +-2 max |M3|,|C1|).")  # fmt: skip
 @click.option("--axis-range", default=None, metavar="LO,HI",
-              help="Another reduced model's axis window (smooth: C1, rough: jellett; default "
-                   "its value +- max(1, |value|)).")  # fmt: skip
+              help="Another reduced model's axis window (smooth: C1, rough: jellett, "
+                   "rubber: rubber_spin, shell-rotor: C2; default its value +- "
+                   "max(1, |value|)).")  # fmt: skip
 def bifurcation(
     scenario: str,
     as_json: bool,
@@ -75,9 +76,10 @@ def bifurcation(
     Prints the folds (where a centre and a saddle are born) and the regions of the (C2, h) plane
     with what a level in each holds, and the number of steady motions over (C1, C2).
 
-    The other reduced models (smooth, rough) get their critical values along one integral of
-    their level instead (the smooth plane's C1, Jellett's integral), with the number of steady
-    motions along it (--axis-range; rollingtop.reduction.classify.critical_values).
+    The other reduced models get their critical values along one integral of their level
+    instead (smooth: C1, rough: jellett, rubber: rubber_spin, shell-rotor: C2), with the number
+    of steady motions along it (--axis-range; rollingtop.reduction.classify.critical_values).
+    That integral may be left out of [level]: it is then scanned around 0.
     """
     from rollingtop.reduction.bifurcation import bifurcation_diagram, steady_count_map
     from rollingtop.scenario import load_scenario
@@ -131,17 +133,28 @@ def _other_model(sc: Any, as_json: bool, output: str | None,
                  window: tuple[float, float] | None) -> None:  # fmt: skip
     """``bifurcation`` for a reduced model other than the paper's: its critical values along
     its axis integral (:func:`rollingtop.reduction.classify.critical_values`)."""
+    from dataclasses import replace
+
     from rich.table import Table
 
-    from rollingtop.reduction.classify import critical_values
+    from rollingtop.reduction.classify import AXES, critical_values
 
-    level = sc.level_set()
+    axis = AXES[sc.model.name]
+    scanned_only = sc.level is not None and getattr(sc.level, axis, 0.0) is None
+    if scanned_only:
+        # the scanned integral left out of [level] (the shell-rotor pair's C2, as the paper's):
+        # scanned around 0, over twice the size of the level's other integrals
+        level = replace(sc.level, **{axis: 0.0}).level_set(sc.body, sc.model)
+        size = max([1.0, *(2.0 * abs(v) for k, v in level.values().items() if k != axis)])
+        window = window or (-size, size)
+    else:
+        level = sc.level_set()
     cv = critical_values(level, window=window, n=241)
     if output is not None:
         from rollingtop.plot import save_figure
         from rollingtop.plot.classification import critical_values_figure
 
-        save_figure(critical_values_figure(cv, level), output)
+        save_figure(critical_values_figure(cv, level, mark=not scanned_only), output)
     if as_json:
         click.echo(json.dumps(cv.to_dict()))
         return

@@ -122,14 +122,17 @@ def _draw_critical(ax: Any, cv: CriticalValues, colour: str) -> None:
                 ls="none", label=label)  # fmt: skip
 
 
-def critical_values_figure(cv: CriticalValues, level: LevelSet) -> Figure:
+def critical_values_figure(cv: CriticalValues, level: LevelSet, mark: bool = True) -> Figure:
     """The critical values of a reduced model's energy along its axis integral
-    (:func:`rollingtop.reduction.classify.critical_values`), the level's own value marked;
-    below, the number of steady motions along the axis."""
+    (:func:`rollingtop.reduction.classify.critical_values`), the level's own value marked
+    (unless ``mark`` is false: a level that left the axis out); below, the number of steady
+    motions along the axis."""
     fig = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax, axn = fig.subplots(2, 1, height_ratios=[3, 1], sharex=True)
     _draw_critical(ax, cv, get_model(cv.model).colour)
-    ax.axvline(level.values()[cv.axis], color="0.5", lw=0.8, ls="--", label="the level's value")
+    if mark:
+        ax.axvline(level.values()[cv.axis], color="0.5", lw=0.8, ls="--",
+                   label="the level's value")  # fmt: skip
     ax.set_ylabel("critical values of $h$")
     fixed = ", ".join(f"{k} = {v:.4g}" for k, v in cv.fixed.items())
     ax.set_title(f"{cv.model} model" + (f", at {fixed}" if fixed else ""), fontsize=10)

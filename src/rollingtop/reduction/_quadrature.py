@@ -13,13 +13,12 @@ and ``Delta psi`` is the same integral weighted by ``psi'(theta)``. The machiner
 - the energy gap ``h - U`` to full relative accuracy next to a turning point
   (:func:`energy_gap`) and the time density ``dt/dtheta`` built on it (:func:`time_density`);
 - Gauss-Legendre rules doubled until two values agree to :data:`PERIOD_RTOL`
-  (:func:`_doubled_gauss`), and a composite rule graded towards logarithmic peaks near a
+  (:func:`doubled_gauss`), and a composite rule graded towards logarithmic peaks near a
   separatrix (:func:`graded_gauss`).
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable, Sequence
 from typing import NamedTuple, TypeAlias
@@ -27,6 +26,7 @@ from typing import NamedTuple, TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop.reduction._gauss import PERIOD_RTOL, doubled_gauss, graded_gauss, leggauss
 from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet
 
@@ -42,29 +42,19 @@ __all__ = [
     "time_density",
 ]
 
-#: Target relative accuracy of the period quadrature (two successive rules agree to this).
-PERIOD_RTOL = 1e-12
-
 FloatArray: TypeAlias = NDArray[np.float64]
 #: A vectorised function of one variable: an integrand, a substitution, its Jacobian.
 ArrayFn: TypeAlias = Callable[[FloatArray], FloatArray]
-#: A weight ``w(theta)`` of the time integral (``psi'`` for ``Delta psi``), or ``None`` (time).
-Weight: TypeAlias = Callable[[FloatArray], FloatArray] | None
-
-
-@functools.lru_cache(maxsize=16)
-def _leggauss(n: int) -> tuple[FloatArray, FloatArray]:
-    """Gauss-Legendre nodes and weights on [-1, 1], each of shape ``(n,)``, kept (numpy computes
-    them by an ``n x n`` eigenvalue problem: 0.2 s for ``n = 4096``); read-only."""
-    x: FloatArray
-    w: FloatArray
-    x, w = np.polynomial.legendre.leggauss(n)
-    x.flags.writeable = w.flags.writeable = False
-    return x, w
+#: A weight ``w(theta)`` of the time integral, or ``None`` (the time itself): the *name* of a
+#: method of the level, a function of ``theta`` that takes the same value at ``pi - theta`` on
+#: the mirrored level (:meth:`LevelSet.mirrored`), as ``"psi_dot"`` does (``Delta psi``). A name,
+#: not a bound method, so that a half orbit next to the north pole can be integrated on the
+#: mirror image (:func:`_wall_period`).
+Weight: TypeAlias = str | None
 
 
 #: Gauss-Legendre rule for the energy gap near the turning points (see :func:`energy_gap`).
-_GAP_NODES, _GAP_WEIGHTS = _leggauss(20)
+_GAP_NODES, _GAP_WEIGHTS = leggauss(20)
 #: Within this fraction of the orbit's width from a turning point the gap is integrated.
 _GAP_NEAR = 0.1
 
@@ -118,7 +108,7 @@ def time_density(
     with np.errstate(divide="ignore", invalid="ignore"):
         val = 2.0 * np.sqrt(level.rho(theta) / (2.0 * np.maximum(gap, 0.0))) * jac
         if weight is not None:
-            val = val * weight(theta)
+            val = val * getattr(level, weight)(theta)
     density: FloatArray = np.where(np.isfinite(val), val, 0.0)
     return density
 
@@ -133,41 +123,6 @@ def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight: Weight =
         return time_density(level, theta, gap, d * np.cos(phi), weight)
 
     return f
-
-
-def _doubled_gauss(f: ArrayFn, a: float, b: float) -> tuple[float, float] | None:
-    """Gauss-Legendre rules of 32, 64, ..., 2048 nodes on ``[a, b]`` until two successive
-    values agree to :data:`PERIOD_RTOL` of the integral of ``|f|`` (the weighted integrals may
-    vanish); returns ``(value, their difference)``, or ``None`` without convergence."""
-    prev: float | None = None
-    for n in (32, 64, 128, 256, 512, 1024, 2048):
-        x, w = _leggauss(n)
-        values = f(a + (b - a) * (x + 1) / 2) * w * ((b - a) / 2)
-        cur, size = float(np.sum(values)), float(np.sum(np.abs(values)))
-        if prev is not None and abs(cur - prev) <= PERIOD_RTOL * size:
-            return cur, abs(cur - prev)
-        prev = cur
-    return None
-
-
-def graded_gauss(f: ArrayFn, a: float, b: float, points: Sequence[float], n: int) -> float:
-    """Composite Gauss-Legendre on ``[a, b]``, graded geometrically (ratio 0.2, 24 levels)
-    towards ``a``, ``b`` and each of ``points``: resolves peaks of width down to ~1e-17 there."""
-    x, w = _leggauss(n)
-    knots = np.unique(np.clip([a, *points, b], a, b))
-    edges: list[FloatArray] = []
-    ratios = 0.2 ** np.arange(24, -1, -1)
-    for u, v in zip(knots[:-1], knots[1:], strict=True):
-        m = (u + v) / 2
-        edges.append(np.concatenate([[u], u + (m - u) * ratios]))
-        edges.append(np.concatenate([[v], v - (v - m) * ratios])[::-1])
-    total = 0.0
-    for e in edges:
-        lo, hi = e[:-1], e[1:]
-        half = (hi - lo) / 2
-        nodes = (lo + hi)[:, None] / 2 + half[:, None] * x[None, :]
-        total += float(np.sum(f(nodes.ravel()).reshape(nodes.shape) * w * half[:, None]))
-    return total
 
 
 #: An orbit's end closer to its pole than this fraction of the orbit's width sits next to a thin
@@ -190,8 +145,9 @@ def period(
     """Period of the orbit between the simple turning points ``theta1 < theta2``.
 
     ``peaks`` are theta values of saddles near the orbit (break points for the graded
-    fallback). With ``weight`` (a function of theta) the integral over one period of
-    ``weight(theta(t)) dt`` instead. Returns ``(value, estimated absolute error)``.
+    fallback). With ``weight`` (the name of a method of the level, :data:`Weight`) the integral
+    over one period of ``weight(theta(t)) dt`` instead. Returns ``(value, estimated absolute
+    error)``.
 
     When an end of the orbit lies next to a thin wall of ``U`` at a pole (a level near a pole
     level, closer to the pole than :data:`WALL_RATIO` times the orbit's width), the orbit is
@@ -203,7 +159,7 @@ def period(
         return _wall_period(level, h, theta1, theta2, walls, peaks, weight)
     c, d = (theta1 + theta2) / 2, (theta2 - theta1) / 2
     f = _integrand(level, h, theta1, theta2, weight)
-    done = _doubled_gauss(f, -math.pi / 2, math.pi / 2)
+    done = doubled_gauss(f, -math.pi / 2, math.pi / 2)
     if done is not None:
         return done
     # Slow convergence: a logarithmic peak near a saddle, inside the orbit or at a turning point
@@ -321,13 +277,54 @@ def _wall_period(
     peaks: Sequence[float],
     weight: Weight,
 ) -> tuple[float, float]:
-    """:func:`period` split at the middle, each half by :func:`half_integral`."""
+    """:func:`period` split at the middle, each half by :func:`half_integral`.
+
+    A wall next to the north pole is integrated on the mirror image (:meth:`LevelSet.mirrored`,
+    ``theta -> pi - theta``), where its distance from the pole is ``theta`` itself, a float of
+    its own: ``pi - theta2`` keeps only the absolute precision of ``theta2`` (1e-7 relative for
+    a wall 3e-9 from the pole), and so would ``sin`` there. The turning point is found again on
+    the mirror, to its full relative precision.
+    """
     mid = (theta1 + theta2) / 2
     total, error = 0.0, 0.0
     for t_end, wall, left in ((theta1, walls[0], True), (theta2, walls[1], False)):
-        value, err = half_integral(level, h, t_end, mid, wall, left, peaks, weight)
+        mirror = _north_wall(level, h, t_end, mid) if wall and not left else None
+        if mirror is not None:
+            mirrored, x_end = mirror
+            value, err = half_integral(mirrored, h, x_end, math.pi - mid, True, True,
+                                       [math.pi - p for p in peaks], weight)  # fmt: skip
+        else:
+            value, err = half_integral(level, h, t_end, mid, wall, left, peaks, weight)
         total, error = total + value, error + err
     return total, error
+
+
+def _north_wall(
+    level: LevelSet, h: float, t_end: float, mid: float
+) -> tuple[LevelSet, float] | None:
+    """The mirrored level and the turning point ``pi - t_end`` found on it to full relative
+    precision (the root of ``U = h`` bracketed by halving and doubling the first guess); ``None``
+    when no bracket is found (the half is then integrated as it stands)."""
+    mirrored = level.mirrored()
+    guess, limit = math.pi - t_end, math.pi - mid
+
+    def gap(x: float) -> float:
+        with np.errstate(all="ignore"):
+            return float(h - mirrored.U(x))
+
+    lo, hi = guess, guess
+    for _ in range(64):
+        if gap(lo) < 0.0:
+            break
+        lo /= 2
+    for _ in range(64):
+        if gap(hi) > 0.0 or hi >= limit:
+            break
+        hi = min(2 * hi, limit)
+    if not (gap(lo) < 0.0 < gap(hi)):
+        return None
+    root = float(brentq(gap, lo, hi, xtol=1e-300, rtol=8.9e-16, maxiter=500))
+    return mirrored, root
 
 
 def half_integral(
@@ -351,7 +348,7 @@ def half_integral(
     half = half_map(t_end, mid, wall, left)
     f = _half_integrand(level, h, t_end, half, left, weight)
     u_max = half.u_max
-    done = _doubled_gauss(f, 0.0, u_max)
+    done = doubled_gauss(f, 0.0, u_max)
     if done is not None:
         return done
     breaks = [

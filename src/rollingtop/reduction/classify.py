@@ -235,18 +235,20 @@ def classify_models(
             if own is None or own[0] != name:
                 y = initial_state(body, name, gamma=gamma, omega=w)
             level = reduction.level_of_state(body, y)
-        except RollingTopError as err:  # e.g. a level the model does not reduce: others go on
+            h = reduction.reduced_energy(body, y)
+            # the shell-rotor pair's last slot is its shell's spin, not a carried direction:
+            # the geometric one then (reduced_components on 17 components)
+            theta = float(reduce_state(y[:17] if MODELS[name].own_inertia else y)["theta"])
+            found = [o for o in orbits(level, h)
+                     if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]  # fmt: skip
+            steady = steady_motions(level)
+        except RollingTopError as err:  # a level the model does not reduce, a flat U: others go on
             refused[name] = str(err)
             continue
-        h = reduction.reduced_energy(body, y)
-        # the shell-rotor pair's last slot is its shell's spin, not a carried direction: the
-        # geometric one then (reduced_components on 17 components)
-        theta = float(reduce_state(y[:17] if MODELS[name].own_inertia else y)["theta"])
-        found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]
         orbit = found[0] if found and found[0].kind == "periodic" else None
         note = "" if orbit is not None else "the state lies on a steady motion or a separatrix"
         note = "; ".join(x for x in (projected, note) if x)
-        out.append(ModelClassification(name, level, h, y, orbit, steady_motions(level),
+        out.append(ModelClassification(name, level, h, y, orbit, steady,
                                        critical_values(level, n=n), note))  # fmt: skip
     return out
 

@@ -99,6 +99,9 @@ class LevelSet(LevelServices):
     #: Whether :func:`rollingtop.reduction.near_pole.near_pole` knows this model's limits on
     #: its pole levels (the meridian model's only, so far).
     near_pole_limits: ClassVar[bool] = True
+    #: What to do about a wall of ``U`` too thin for doubles next to a pole (a level within
+    #: round-off of a pole level): :func:`rollingtop.reduction.orbits.orbits`' refusal says it.
+    pole_advice: ClassVar[str] = "for the pole case set C1 = +-M3 exactly; or rescale M3, C1"
 
     body: SphericalTop
     M3: float

@@ -51,7 +51,7 @@ def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
     raise LevelSetError(
         f"the motion reaches within 1e-15 of theta = {end:g} on {level.describe()}, h = {h:g}: "
         "the wall of U beside that pole is thinner than double precision resolves there "
-        "(for the pole case set C1 = +-M3 exactly; or rescale M3, C1)"
+        f"({level.pole_advice})"
     )
 
 

@@ -72,7 +72,7 @@ def rotation_number(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, flo
     inside = [float(c) for c in critical_points(exact_level) if lo < c < hi]
     peaks = [t for t in (exact_level.pole_theta,) if t is not None] + inside
     dpsi, err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max, peaks=peaks,
-                       weight=exact_level.psi_dot)  # fmt: skip
+                       weight="psi_dot")  # fmt: skip
     return dpsi / (2 * math.pi), err / (2 * math.pi)
 
 

@@ -32,7 +32,7 @@ level has walls at both poles and its motions stay inside ``0 < theta < pi``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -56,7 +56,7 @@ FloatArray = NDArray[np.float64]
 POLE_LEVEL_TOLERANCE = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class RoughLevel(LevelSet):
     """A level set ``(jellett, routh)`` of Routh's sphere (module docstring): the methods of
     :class:`~rollingtop.reduction.LevelSet` with the rough model's potential, spin and
@@ -65,12 +65,18 @@ class RoughLevel(LevelSet):
     integrals: ClassVar[tuple[str, ...]] = ("jellett", "routh")
     model: ClassVar[str] = "rough"
     near_pole_limits: ClassVar[bool] = False
+    #: :attr:`LevelSet.pole_advice`: its pole levels are refused.
+    pole_advice: ClassVar[str] = ("its pole levels are not reduced: integrate the full system "
+                                  "(rollingtop simulate)")  # fmt: skip
 
-    M3: float = 0.0
-    C1: float = 0.0
-    C2: float = 0.0
-    jellett: float = 0.0
-    routh: float = 0.0
+    #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
+    #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
+    M3: float = field(default=0.0, init=False)
+    C1: float = field(default=0.0, init=False)
+    C2: float = field(default=0.0, init=False)
+    scale: float = 0.0
+    jellett: float
+    routh: float
 
     def __post_init__(self) -> None:
         check_level_values(self, ("jellett", "routh"))

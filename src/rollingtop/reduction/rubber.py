@@ -44,7 +44,7 @@ whole circle as the pole case ``"both"`` of :class:`~rollingtop.reduction.LevelS
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -66,7 +66,7 @@ __all__ = ["RubberLevel", "rubber_integrals"]
 FloatArray = NDArray[np.float64]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class RubberLevel(LevelSet):
     """A level set ``rubber_spin = F`` of a body of revolution rolling without slipping or
     spinning (module docstring): the methods of :class:`~rollingtop.reduction.LevelSet` with the
@@ -77,11 +77,16 @@ class RubberLevel(LevelSet):
     integrals: ClassVar[tuple[str, ...]] = ("rubber_spin",)
     model: ClassVar[str] = "rubber"
     near_pole_limits: ClassVar[bool] = False
+    #: :attr:`LevelSet.pole_advice`: the pole level is reduced on the whole circle.
+    pole_advice: ClassVar[str] = "for the pole level set rubber_spin = 0 exactly"
 
-    M3: float = 0.0
-    C1: float = 0.0
-    C2: float = 0.0
-    rubber_spin: float = 0.0
+    #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
+    #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
+    M3: float = field(default=0.0, init=False)
+    C1: float = field(default=0.0, init=False)
+    C2: float = field(default=0.0, init=False)
+    scale: float = 0.0
+    rubber_spin: float
 
     def __post_init__(self) -> None:
         check_level_values(self, ("rubber_spin",))

@@ -32,7 +32,7 @@ vanishes there: such pole levels are refused (not reduced yet), as the rough mod
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -58,7 +58,7 @@ FloatArray = NDArray[np.float64]
 POLE_LEVEL_TOLERANCE = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ShellRotorLevel(LevelSet):
     """A level set ``(M3, jellett, C2)`` of the shell-rotor pair (module docstring); ``C1`` is
     not an integral of the pair (0)."""
@@ -66,11 +66,17 @@ class ShellRotorLevel(LevelSet):
     integrals: ClassVar[tuple[str, ...]] = ("M3", "jellett", "C2")
     model: ClassVar[str] = "shell-rotor"
     near_pole_limits: ClassVar[bool] = False
+    #: :attr:`LevelSet.pole_advice`: its pole levels are refused.
+    pole_advice: ClassVar[str] = ("its pole levels are not reduced: integrate the full system "
+                                  "(rollingtop simulate)")  # fmt: skip
 
-    M3: float = 0.0
-    C1: float = 0.0
-    C2: float = 0.0
-    jellett: float = 0.0
+    #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
+    #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
+    M3: float
+    C1: float = field(default=0.0, init=False)
+    C2: float
+    scale: float = 0.0
+    jellett: float
 
     def __post_init__(self) -> None:
         check_level_values(self, ("M3", "jellett", "C2"))
@@ -133,7 +139,7 @@ class ShellRotorLevel(LevelSet):
         ``k_p / sqrt(N)``)."""
         body = replace(self.body, a3=-self.body.a3)
         shift = float(pair_weight(body, 0.0)[1]) - float(pair_weight(self.body, 0.0)[1])
-        return ShellRotorLevel(body, -self.M3, 0.0, -self.C2 - self.body.R * self.M3 * shift,
+        return ShellRotorLevel(body=body, M3=-self.M3, C2=-self.C2 - self.body.R * self.M3 * shift,
                                jellett=self.jellett)  # fmt: skip
 
     def omega3(self, theta: Real) -> Real:

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
-from rollingtop.reduction.level import LevelSet, near_north
+from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
 
 __all__ = ["SteadyMotion", "steady_motions", "critical_points"]
 
@@ -104,11 +104,14 @@ def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.fl
     points at the walls next to the poles), each refined by Brent's method to machine
     precision; a zero of even multiplicity that does not change sign is found when the grid
     lands on it exactly only. Fewer points serve the classification of many levels
-    (:mod:`rollingtop.reduction.bifurcation`).
+    (:mod:`rollingtop.reduction.bifurcation`). A potential constant on the whole domain
+    (:func:`flat_potential`) has none that is isolated: empty.
     """
     grid = _grid(level, points)[1:-1]
     with np.errstate(all="ignore"):
         d = level.dU(grid)
+    if np.all(d == 0.0):  # U constant (flat_potential): no critical point is isolated
+        return np.empty(0)
     roots = []
     sign = np.sign(d)  # not d[:-1] * d[1:], which can overflow
     for i in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (sign[:-1] * sign[1:] <= 0)):
@@ -188,12 +191,33 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     )
 
 
+def flat_potential(level: LevelSet) -> bool:
+    """Whether ``U`` is constant on the level: ``dU/dtheta`` exactly 0 on the grid of
+    :func:`critical_points`, as on a no-spin level of a balanced body (``a3 = 0``) or without
+    gravity (``g = 0``), where ``U`` reduces to a constant term."""
+    with np.errstate(all="ignore"):
+        d = level.dU(_grid(level, 64)[1:-1])
+    return bool(np.all(d == 0.0))
+
+
 def steady_motions(level: LevelSet) -> list[SteadyMotion]:
     """Every steady motion on the level set, sorted by ``gamma3``.
 
     In a pole case the list may include motions on the negative-``s`` branch (after a pole
     passage); their ``theta`` lies outside ``(0, pi)``.
+
+    Raises
+    ------
+    LevelSetError
+        When ``U`` is constant (:func:`flat_potential`): every ``gamma3`` is then a steady
+        motion, a continuum with no isolated member to list.
     """
+    if flat_potential(level):
+        raise LevelSetError(
+            f"U is constant (U = {float(level.U(math.pi / 2)):.6g}) on {level.describe()}: "
+            "every gamma3 is a neutral steady motion, none is isolated (a balanced body or no "
+            "gravity, without spin)"
+        )
     if near_north(level):  # computed on the mirror image, where theta ~ 0 keeps its precision
         motions = [_mirror(m) for m in steady_motions(level.mirrored())]
     else:
