@@ -108,7 +108,7 @@ def _classify_state(
     from rollingtop._errors import RollingTopError
     from rollingtop.contact import get_model
     from rollingtop.dynamics.state import initial_state
-    from rollingtop.reduction.classify import _admissible_omega
+    from rollingtop.reduction.classify import admissible_omega
     from rollingtop.reduction.level import LevelSetError, PoleLevelError
     from rollingtop.reduction.models import reduction_of
     from rollingtop.reduction.rotation import centre_rotation_number
@@ -116,7 +116,7 @@ def _classify_state(
 
     name = ATLAS_MODELS[int(p["model"])]
     gamma = np.array([p[key] for key in STATE_KEYS[:3]])
-    omega, _ = _admissible_omega(name, gamma, [p[key] for key in STATE_KEYS[3:]])
+    omega, _ = admissible_omega(name, gamma, [p[key] for key in STATE_KEYS[3:]])
     try:
         y = initial_state(body, name, gamma=gamma, omega=omega)
         level = reduction_of(name).level_of_state(body, y)

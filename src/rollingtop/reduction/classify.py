@@ -35,6 +35,7 @@ __all__ = [
     "CriticalValues",
     "ModelClassification",
     "RotationGrid",
+    "admissible_omega",
     "classify_models",
     "critical_values",
     "rotation_grid",
@@ -230,7 +231,7 @@ def classify_models(
         if own is not None and own[0] == name:
             y = np.asarray(own[1], dtype=float)
         else:
-            w, projected = _admissible_omega(name, gamma, omega)
+            w, projected = admissible_omega(name, gamma, omega)
         try:
             if own is None or own[0] != name:
                 y = initial_state(body, name, gamma=gamma, omega=w)
@@ -253,7 +254,7 @@ def classify_models(
     return out
 
 
-def _admissible_omega(name: str, gamma: ArrayLike, omega: ArrayLike) -> tuple[FloatArray, str]:
+def admissible_omega(name: str, gamma: ArrayLike, omega: ArrayLike) -> tuple[FloatArray, str]:
     """``omega`` under the model ``name``'s constraints on the angular velocity alone
     (:attr:`~rollingtop.contact.ContactModel.spin_directions`; rubber rolling's
     ``(omega, gamma) = 0``): its parts along them dropped, and a note saying so (empty when
