@@ -25,6 +25,7 @@ from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._chaos import chaos, section
 from rollingtop.cli._classification import compare_classification
 from rollingtop.cli._ensemble import ensemble
+from rollingtop.cli._explore import explore
 from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
 from rollingtop.cli._rotation import rotation
@@ -37,7 +38,7 @@ __all__ = ["cli", "main"]
 
 for _command in (simulate, equilibria, orbits, portrait, bifurcation, compare_classification,
                  rotation, stability, atlas, path, plot, compare, animate, ensemble, section,
-                 chaos, verify, warmup):  # fmt: skip
+                 chaos, explore, verify, warmup):  # fmt: skip
     cli.add_command(_command)
 
 

@@ -9,6 +9,7 @@ At a critical point ``theta*`` of ``U`` the reduced motion rests: ``w_tau = 0``,
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -98,7 +99,8 @@ def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
 
 
 def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
-    """All zeros of ``dU/dtheta`` inside the theta domain, increasing.
+    """All zeros of ``dU/dtheta`` inside the theta domain, increasing (read-only: the last
+    levels' are kept, as every orbit of a level asks for them again; a level is a frozen value).
 
     Sign changes of ``dU/dtheta`` on a grid of ``points`` points (clustered at the ends, plus
     points at the walls next to the poles), each refined by Brent's method to machine
@@ -107,11 +109,18 @@ def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.fl
     (:mod:`rollingtop.reduction.bifurcation`). A potential constant on the whole domain
     (:func:`flat_potential`) has none that is isolated: empty.
     """
+    return _critical_points(level, int(points))
+
+
+@functools.lru_cache(maxsize=128)
+def _critical_points(level: LevelSet, points: int) -> NDArray[np.float64]:
     grid = _grid(level, points)[1:-1]
     with np.errstate(all="ignore"):
         d = level.dU(grid)
     if np.all(d == 0.0):  # U constant (flat_potential): no critical point is isolated
-        return np.empty(0)
+        d = np.empty(0)
+        d.flags.writeable = False
+        return d
     roots = []
     sign = np.sign(d)  # not d[:-1] * d[1:], which can overflow
     for i in np.flatnonzero(np.isfinite(d[:-1]) & np.isfinite(d[1:]) & (sign[:-1] * sign[1:] <= 0)):
@@ -121,7 +130,9 @@ def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.fl
             roots.append(
                 brentq(level.dU, grid[i], grid[i + 1], xtol=1e-15, rtol=8.9e-16, maxiter=200)
             )
-    return np.unique(np.array(roots, dtype=float))
+    found = np.unique(np.array(roots, dtype=float))
+    found.flags.writeable = False
+    return found
 
 
 def _scale(level: LevelSet, theta: float) -> float:

@@ -1,0 +1,329 @@
+"""The explore page: Panel widgets and Bokeh plots over :mod:`rollingtop.explore.view`.
+
+One :class:`ExplorePage` per browser session. A change of a widget (or a click on a plot) makes
+a new :class:`~rollingtop.explore.view.ExploreState`; the work it asks for runs in a thread pool,
+off the server's event loop, so the page never blocks; each kind of work (the level's plots, the
+diagram, a trajectory, the device's frame, a section) keeps only its newest request -- a newer
+one supersedes an older one that has not started, and an older result that arrives late is
+dropped. Results are applied to the page on the document's next tick (Bokeh's thread-safe way
+in). The URL's query carries the view (``?model=meridian&C2=-1.0&h=0.8``): it is read when the
+page loads and rewritten after every accepted change; a bad value is shown on the page and the
+previous valid view stays.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Callable
+from typing import Any
+from urllib.parse import urlencode
+
+import numpy as np
+import panel as pn
+from bokeh.events import Tap
+
+from rollingtop._errors import RollingTopError
+from rollingtop.contact import MODELS
+from rollingtop.devices import DEVICES
+from rollingtop.explore._plots import Plots
+from rollingtop.explore._work import Latest
+from rollingtop.explore.path import PATH_SAMPLES, PATH_T_END, path_view
+from rollingtop.explore.section import section_view
+from rollingtop.explore.view import BODY_KEYS, ExploreState, diagram_view, level_view, parse_query
+
+__all__ = ["ExplorePage", "LOOKS"]
+
+#: Device looks of the frame beside the path (``plain``: the body itself).
+LOOKS = ("plain", *DEVICES)
+
+
+class ExplorePage:
+    """The widgets, plots and callbacks of one session; :attr:`layout` is what Panel serves.
+
+    Parameters
+    ----------
+    base : ExploreState
+        The scenario's view; the URL's query is applied to it.
+    look : str
+        The device look of the frame beside the path (:data:`LOOKS`).
+    query : mapping, optional
+        The URL's query parameters (default: the session's, from ``pn.state.location``).
+    """
+
+    def __init__(self, base: ExploreState, look: str = "plain",
+                 query: dict[str, Any] | None = None) -> None:  # fmt: skip
+        self.doc = pn.state.curdoc
+        self.location = pn.state.location
+        self.muted = False
+        self.state = base
+        self.look = look
+        self.message = pn.pane.Alert("", alert_type="danger", visible=False,
+                                     css_classes=["rt-message"])  # fmt: skip
+        self.readout = pn.pane.HTML("", css_classes=["rt-readout"])
+        self.path_summary = pn.pane.HTML("click the phase portrait to start a trajectory",
+                                         css_classes=["rt-path"])  # fmt: skip
+        self.plots = Plots()
+        self.plots.portrait.on_event(Tap, self._on_portrait_tap)
+        self.plots.diagram.on_event(Tap, self._on_diagram_tap)
+        self._build_widgets()
+        self.level_work = Latest(self.on_document, self._compute_level, self._apply_level)
+        self.diagram_work = Latest(self.on_document, diagram_view, self._apply_diagram)
+        self.path_work = Latest(self.on_document, self._compute_path, self._apply_path)
+        self.frame_work = Latest(self.on_document, self._compute_frame, self._apply_frame)
+        if query is None and self.location is not None:
+            query = dict(self.location.query_params)
+        if query:
+            try:
+                self.state = parse_query(query, base)
+            except RollingTopError as err:
+                self._show_error(f"URL: {err}")
+        self._sync_widgets()
+        self.layout = self._layout()
+        self._refresh(diagram=True)
+
+    # ---- running on the document -------------------------------------------------------
+    def on_document(self, fn: Callable[[], None]) -> None:
+        """Run ``fn`` on the session's document (next tick), or now without one (tests)."""
+        if self.doc is None or getattr(self.doc, "session_context", None) is None:
+            fn()
+        else:
+            self.doc.add_next_tick_callback(fn)
+
+    def _show_error(self, text: str) -> None:
+        self.message.object = text
+        self.message.visible = True
+
+    def _clear_error(self) -> None:
+        self.message.visible = False
+
+    # ---- widgets -------------------------------------------------------------------------
+    def _slider(self, name: str, value: float, lo: float, hi: float) -> Any:
+        w = pn.widgets.EditableFloatSlider(name=name, value=value, start=lo, end=hi,
+                                           step=(hi - lo) / 400, width=260)  # fmt: skip
+        w.param.watch(self._on_widget, "value")
+        return w
+
+    def _build_widgets(self) -> None:
+        names = [m.name for m in MODELS.values()
+                 if m.own_inertia == self.state.body.has_shell]  # fmt: skip
+        self.model_select = pn.widgets.Select(name="contact model", options=names,
+                                              value=self.state.model, width=260)  # fmt: skip
+        self.model_select.param.watch(self._on_model, "value")
+        self.look_select = pn.widgets.Select(name="device look", options=list(LOOKS),
+                                             value=self.look, width=260)  # fmt: skip
+        self.look_select.param.watch(self._on_look, "value")
+        b = self.state.body
+        self.body_sliders = {}
+        for key in BODY_KEYS:
+            v = float(getattr(b, key))
+            lo, hi = (-b.R, b.R) if key == "a3" else (0.0, 3.0 * max(v, 0.1))
+            self.body_sliders[key] = self._slider(key, v, lo, hi)
+        self.level_box = pn.Column()
+        self.level_sliders: dict[str, Any] = {}
+        self._build_level_sliders()
+
+    def _build_level_sliders(self) -> None:
+        self.level_sliders = {}
+        items = {**self.state.level, **({"h": self.state.h} if self.state.level else {})}
+        for key, v in items.items():
+            span = max(1.0, 2.0 * abs(v))
+            self.level_sliders[key] = self._slider(key, v, v - span, v + span)
+        self.level_box.objects = list(self.level_sliders.values())
+
+    def _sync_widgets(self) -> None:
+        """The widgets set to :attr:`state`, without their callbacks."""
+        self.muted = True
+        try:
+            self.model_select.value = self.state.model
+            for key, w in self.body_sliders.items():
+                w.value = float(getattr(self.state.body, key))
+            items = {**self.state.level, **({"h": self.state.h} if self.state.level else {})}
+            if set(items) != set(self.level_sliders):
+                self._build_level_sliders()
+            for key, v in items.items():
+                w = self.level_sliders[key]
+                if not w.start <= v <= w.end:  # widen the slider to take the value
+                    span = max(1.0, 2.0 * abs(v))
+                    w.start, w.end = min(w.start, v - span), max(w.end, v + span)
+                w.value = float(v)
+        finally:
+            self.muted = False
+
+    def _layout(self) -> Any:
+        controls = pn.Column(
+            self.model_select, self.look_select, pn.pane.Markdown("**body**"),
+            *self.body_sliders.values(), pn.pane.Markdown("**level**"), self.level_box,
+            width=290,
+        )  # fmt: skip
+        plots = pn.Column(
+            pn.Row(self.plots.portrait_pane, self.plots.diagram_pane),
+            pn.Row(self.plots.potential_pane, self.plots.path_pane, self.plots.frame),
+            self.path_summary,
+        )  # fmt: skip
+        title = pn.pane.Markdown("## rollingtop explore: a rolling spherical top, reduced")
+        return pn.Column(title, self.message, self.readout, pn.Row(controls, plots))
+
+    # ---- callbacks -----------------------------------------------------------------------
+    def _query_of_widgets(self) -> dict[str, str]:
+        query = {"model": self.state.model}
+        query |= {k: repr(float(w.value)) for k, w in self.body_sliders.items()}
+        query |= {k: repr(float(w.value)) for k, w in self.level_sliders.items()}
+        return query
+
+    def _accept(self, query: dict[str, str], base: ExploreState | None = None) -> bool:
+        """Apply ``query`` to the current view: the new view, or a message and the old view."""
+        try:
+            state = parse_query(query, base or self.state)
+        except RollingTopError as err:
+            self._show_error(str(err))
+            self._sync_widgets()  # back to the previous valid view
+            return False
+        self._clear_error()
+        diagram = (state.model != self.state.model or state.body != self.state.body
+                   or {k: v for k, v in state.level.items() if k != self._axis()}
+                   != {k: v for k, v in self.state.level.items() if k != self._axis()})  # fmt: skip
+        self.state = state
+        self._refresh(diagram=diagram)
+        return True
+
+    def _axis(self) -> str:
+        from rollingtop.reduction.classify import AXES
+
+        return AXES.get(self.state.model, "")
+
+    def _on_widget(self, event: Any) -> None:
+        if self.muted:
+            return
+        self._accept(self._query_of_widgets())
+
+    def _on_model(self, event: Any) -> None:
+        if self.muted:
+            return
+        try:
+            state = self.state.with_model(event.new)
+        except RollingTopError as err:
+            self._show_error(f"model {event.new}: {err}")
+            self._sync_widgets()
+            return
+        self._clear_error()
+        self.state = state
+        self._sync_widgets()
+        self._refresh(diagram=True)
+
+    def _on_look(self, event: Any) -> None:
+        self.look = event.new
+        traj = getattr(self, "last_traj", None)
+        if traj is not None:
+            self.frame_work.request(traj)
+
+    def _on_portrait_tap(self, event: Any) -> None:
+        if not self.state.reduces:
+            self._on_section_tap(event)
+            return
+        self.plots.start.data = {"x": [event.x], "y": [event.y]}
+        self.path_summary.object = "integrating ..."
+        self.path_work.request((self.state, float(event.x), float(event.y)))
+
+    def _on_diagram_tap(self, event: Any) -> None:
+        if not self.state.reduces:
+            return
+        axis = self._axis()
+        query = self._query_of_widgets() | {axis: repr(float(event.x)), "h": repr(float(event.y))}
+        if self._accept(query):
+            self._sync_widgets()
+
+    def _on_section_tap(self, event: Any) -> None:
+        section = getattr(self, "last_section", None)
+        if section is None:
+            return
+        points, states = section
+        k = int(np.argmin(np.hypot(points[:, 0] - event.x, points[:, 1] - event.y)))
+        self.plots.start.data = {"x": [points[k, 0]], "y": [points[k, 1]]}
+        self.path_summary.object = "integrating ..."
+        self.path_work.request((self.state, states[k], None))
+
+    def _refresh(self, diagram: bool) -> None:
+        """Ask for the plots of :attr:`state`; the URL follows. A clicked orbit belonged to
+        the previous view: it goes."""
+        self.plots.clear_clicked()
+        self.level_work.request(self.state)
+        if diagram and self.state.reduces:
+            self.diagram_work.request(self.state)
+        elif self.state.reduces:  # the same curves: only the marker moves
+            self._move_mark()
+        if self.location is not None:
+            self.location.search = "?" + urlencode(self.state.to_query())
+
+    def _move_mark(self) -> None:
+        self.plots.move_mark(self.state.level[self._axis()], self.state.h)
+
+    # ---- work and its results ------------------------------------------------------------
+    def _compute_level(self, state: ExploreState) -> Any:
+        if state.reduces:
+            return level_view(state)
+        return section_view(state)
+
+    def _apply_level(self, state: ExploreState, view: Any) -> None:
+        if isinstance(view, Exception):
+            self._show_error(str(view))
+            return
+        self.readout.object = f"<b>{view.readout}</b>"
+        if not state.reduces:
+            self.last_section = (view.points, view.states)
+            self.plots.show_section(view)
+            return
+        if view.note:
+            self.readout.object += f" ({view.note})"
+        self.plots.show_level(state, view)
+        self._move_mark()
+
+    def _apply_diagram(self, state: ExploreState, view: Any) -> None:
+        if isinstance(view, Exception):
+            self._show_error(f"diagram: {view}")
+            return
+        self.plots.show_diagram(view)
+        self._move_mark()
+
+    def _compute_path(self, request: tuple[ExploreState, Any, Any]) -> Any:
+        state, x, w = request
+        if w is None:  # a crossing of the section: its state as it is
+            from rollingtop.simulate import simulate
+
+            traj = simulate(state.body, state.model, x, t_end=PATH_T_END, samples=PATH_SAMPLES)
+            return traj, None
+        view = path_view(state, x, w)
+        return view.trajectory, view
+
+    def _apply_path(self, request: Any, result: Any) -> None:
+        if isinstance(result, Exception):
+            self.path_summary.object = f"no trajectory: {result}"
+            return
+        traj, view = result
+        self.last_traj = traj
+        pos = traj.y[:, 15:17]
+        self.plots.show_path(pos[:, 0], pos[:, 1], view.orbit if view is not None else None)
+        text = view.summary if view is not None else "from the clicked crossing"
+        lost = traj.contact_lost_at
+        if lost is not None:
+            text += f"; the normal force turns negative at t = {lost:.6g} (the contact is lost)"
+        self.path_summary.object = f"trajectory: t = 0 .. {traj.t[-1]:g}, {text}"
+        self.frame_work.request(traj)
+
+    def _compute_frame(self, traj: Any) -> Any:
+        from rollingtop.plot.animation import frame_figure
+
+        look = self.look
+        if look != "plain":
+            from rollingtop.devices import check_device
+
+            check_device(look, traj.model)
+        fig = frame_figure(traj, float(traj.t[-1]), look=look, size=(4.0, 4.0), dpi=75)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png")
+        return buf.getvalue()
+
+    def _apply_frame(self, traj: Any, png: Any) -> None:
+        if isinstance(png, Exception):
+            self.path_summary.object += f" (device: {png})"
+            return
+        self.plots.frame.object = png

@@ -1,0 +1,126 @@
+"""Serving the explore page with Panel's own server (Bokeh's Tornado server).
+
+:func:`serve` compiles what the page needs first (the model's kernel, by a short trajectory;
+the plotting imports), then listens, prints the one line ``serving at http://HOST:PORT/`` and
+runs until it is interrupted; on the way out the server stops and the page's worker threads
+are shut down, so nothing keeps running.
+"""
+
+from __future__ import annotations
+
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import webbrowser
+from collections.abc import Callable
+from typing import Any
+
+from rollingtop._errors import ScenarioError
+from rollingtop.explore.path import path_view
+from rollingtop.explore.view import ExploreState, level_view
+
+__all__ = ["LOOPBACK", "serve", "spawn", "warm_up"]
+
+#: Addresses that only this machine reaches.
+LOOPBACK = ("127.0.0.1", "localhost", "::1")
+
+
+def warm_up(base: ExploreState) -> None:
+    """Compute once what the first page load needs, so that it is quick: the level's plots,
+    and a short trajectory (the model's compiled kernel, from the numba cache or compiled now,
+    with the command line's notice)."""
+    if not base.reduces:
+        return  # a section compiles on the page's first request (its kernel's notice then)
+    view = level_view(base)
+    x = view.steady[0][0] if view.steady else float(view.U_x[len(view.U_x) // 2])
+    try:
+        path_view(base, x, 0.0, t_end=0.1)
+    except ScenarioError:  # a steady motion on a pole level, say: the page refuses it too
+        pass
+
+
+def serve(
+    base: ExploreState,
+    *,
+    port: int,
+    host: str,
+    open_browser: bool,
+    look: str = "plain",
+    echo: Callable[[str], None] = print,
+) -> None:
+    """Serve the page for ``base`` at ``http://host:port/`` until interrupted.
+
+    Raises
+    ------
+    ScenarioError
+        The port cannot be bound (in use, or not permitted).
+    """
+    import panel as pn
+
+    from rollingtop.explore._work import WORKERS
+    from rollingtop.explore.app import ExplorePage
+
+    warm_up(base)
+
+    def page() -> Any:
+        return ExplorePage(base, look).layout
+
+    origins = [f"{host}:{port}"] + ([f"localhost:{port}", f"127.0.0.1:{port}"]
+                                    if host in LOOPBACK else [])  # fmt: skip
+    ours = signal.getsignal(signal.SIGINT)  # Panel installs its own; the command's stays
+    try:
+        server = pn.serve(page, port=port, address=host, show=False, start=False,
+                          title="rollingtop explore", websocket_origin=origins,
+                          verbose=False)  # fmt: skip
+    except OSError as err:
+        raise ScenarioError(f"cannot serve at {host}:{port}: {err.strerror or err} "
+                            "(choose another --port)") from None  # fmt: skip
+    finally:
+        signal.signal(signal.SIGINT, ours)
+    url = f"http://{host}:{port}/"
+    try:
+        server.start()
+        echo(f"serving at {url}")
+        sys.stdout.flush()
+        if open_browser:
+            webbrowser.open(url)
+        server.io_loop.start()
+    finally:
+        server.stop()
+        WORKERS.shutdown(wait=False, cancel_futures=True)
+
+
+def spawn(
+    scenario: str | None = None, *, port: int | None = None, timeout: float = 120.0,
+    args: tuple[str, ...] = (),
+) -> tuple[subprocess.Popen[str], str]:  # fmt: skip
+    """Start ``rollingtop explore`` in a child process (``--no-browser``; a free port unless
+    ``port``) and wait for its ``serving at`` line: ``(process, url)``. For scripts and tests
+    that drive the page in a browser; stop the process with SIGINT.
+
+    Raises
+    ------
+    RuntimeError
+        The process ended, or printed no ``serving at`` line within ``timeout`` seconds (its
+        stderr in the message).
+    """
+    if port is None:
+        with socket.socket() as sock:
+            sock.bind(("127.0.0.1", 0))
+            port = int(sock.getsockname()[1])
+    cmd = [sys.executable, "-m", "rollingtop", "explore", *([scenario] if scenario else []),
+           "--no-browser", "--port", str(port), *args]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.append(proc.stdout.readline()),  # type: ignore[union-attr]
+                              daemon=True)  # fmt: skip
+    reader.start()
+    reader.join(timeout)
+    line = lines[0].strip() if lines else ""
+    if not line.startswith("serving at "):
+        proc.kill()
+        _, err = proc.communicate(timeout=10)
+        raise RuntimeError(f"rollingtop explore did not start within {timeout:g} s: {err.strip()}")
+    return proc, line.removeprefix("serving at ")

@@ -1,0 +1,217 @@
+"""The explore page's numbers (rollingtop.explore.view, .path, .section) without a browser:
+each against the command line or an independent computation."""
+
+import json
+import math
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from rollingtop import ScenarioError
+from rollingtop.explore._work import Latest
+from rollingtop.explore.path import path_view
+from rollingtop.explore.section import section_view
+from rollingtop.explore.view import (
+    default_scenario,
+    diagram_view,
+    level_view,
+    parse_query,
+    state_from_scenario,
+)
+from rollingtop.reduction import LevelSet, reduction_of
+from rollingtop.scenario import load_scenario
+
+from ..conftest import EXAMPLES
+from ..test_cli import run_cli
+
+FIG5 = str(EXAMPLES / "fig5.toml")
+ENERGY_RTOL = 1e-9  # the reduced energy of a reconstructed state / a trajectory (rtol 1e-10)
+
+
+@pytest.fixture(scope="module")
+def fig5():
+    return state_from_scenario(load_scenario(FIG5))
+
+
+def test_the_first_view_is_the_scenarios_level(fig5):
+    assert fig5.model == "meridian"
+    assert fig5.level == {"M3": 1.0, "C1": 0.5, "C2": -2.0} and fig5.h == 4.0
+    assert state_from_scenario(default_scenario()) == fig5  # no scenario: the paper's Fig. 5
+
+
+@pytest.mark.parametrize("C2", [-2.0, -1.0, -1.6])
+def test_the_readout_counts_what_equilibria_prints(capsys, tmp_path, fig5, C2):
+    """steady motions: N on the page is `rollingtop equilibria --json`'s count for the same
+    level (a scenario file written here with that C2)."""
+    view = level_view(parse_query({"C2": repr(C2)}, fig5))
+    text = (EXAMPLES / "fig5.toml").read_text().replace("C2 = -2.0", f"C2 = {C2!r}")
+    path = tmp_path / "level.toml"
+    path.write_text(text)
+    code, out, err = run_cli(capsys, "equilibria", str(path), "--json")
+    assert code == 0, err
+    count = len(json.loads(out)["equilibria"])
+    assert view.count == count and view.readout.endswith(f"steady motions: {count}")
+    if C2 == -1.0:  # the issue's example: beyond the fold, one
+        assert view.count == 1
+
+
+def test_the_current_orbit_lies_on_the_energy_level(fig5):
+    """Every point of the highlighted orbit has rho w_tau^2 / 2 + U = h (the energy written
+    again here from U and rho), and U's curve is U."""
+    view = level_view(fig5)
+    level = fig5.level_set()
+    x, w = view.current
+    ok = np.isfinite(x)
+    theta = np.arccos(x[ok])
+    energy = level.U(theta) + 0.5 * level.rho(theta) * w[ok] ** 2
+    np.testing.assert_allclose(energy, fig5.h, rtol=1e-9)
+    np.testing.assert_allclose(level.U(np.arccos(view.U_x[:50])), view.U_y[:50], rtol=1e-10)
+    assert np.isfinite(view.background[0]).sum() > 1000
+
+
+def test_the_diagram_marks_the_level_and_its_curves_are_critical_values(fig5):
+    """Each centre point (C2, h) of the diagram is a steady motion's energy on the level
+    (M3, C1, C2): a critical point of that level's U with U = h."""
+    from rollingtop.reduction import steady_motions
+
+    view = diagram_view(fig5)
+    assert view.mark == (-2.0, 4.0) and view.axis == "C2"
+    assert view.x_range[0] <= -2.0 <= view.x_range[1]
+    C2, h = view.centres
+    ok = np.flatnonzero(np.isfinite(C2))
+    for k in ok[:: max(1, ok.size // 7)]:
+        motions = steady_motions(LevelSet(fig5.body, 1.0, 0.5, float(C2[k])))
+        assert min(abs(m.U - h[k]) for m in motions) < 1e-8 * max(1.0, abs(h[k]))
+    from rollingtop.reduction._critical_curves import folds
+
+    lo, hi = view.x_range
+    inside = [f for f in folds(fig5.body, 1.0, 0.5) if lo <= f.C2 <= hi]
+    assert sorted(view.folds[0]) == sorted(f.C2 for f in inside) and inside
+
+
+def test_a_click_starts_the_motion_of_that_point(fig5):
+    """The point (gamma3, w_tau) of the portrait: the trajectory's reduced energy is
+    rho w_tau^2 / 2 + U there (written again), to ENERGY_RTOL over the run, and its level is the
+    page's; the contact point's path is the trajectory's."""
+    level = fig5.level_set()
+    g3, w = -0.3, 0.4
+    view = path_view(fig5, g3, w, t_end=5.0)
+    theta = math.acos(g3)
+    h = float(level.U(theta) + 0.5 * level.rho(theta) * w * w)
+    assert view.h == pytest.approx(h, rel=1e-14)
+    traj = view.trajectory
+    reduction = reduction_of("meridian")
+    for y in traj.y[[0, -1]]:
+        assert reduction.reduced_energy(fig5.body, y) == pytest.approx(h, rel=ENERGY_RTOL)
+        values = reduction.level_of_state(fig5.body, y).values()
+        for k, v in fig5.level.items():
+            assert values[k] == pytest.approx(v, rel=1e-9, abs=1e-9)
+    np.testing.assert_array_equal(view.x, traj.y[:, 15])
+    assert "rotation number N = " in view.summary
+    ox, ow = view.orbit  # the clicked orbit: on the energy h
+    ok = np.isfinite(ox)
+    th = np.arccos(ox[ok])
+    np.testing.assert_allclose(level.U(th) + 0.5 * level.rho(th) * ow[ok] ** 2, h, rtol=1e-9)
+
+
+def test_a_click_outside_the_domain_is_refused(fig5):
+    with pytest.raises(ScenarioError, match="outside"):
+        path_view(fig5, 1.2, 0.0)
+
+
+@pytest.mark.parametrize(
+    ("query", "message"),
+    [
+        ({"C2": "abc"}, "C2 = 'abc' is not a number"),
+        ({"C2": "nan"}, "must be finite"),
+        ({"Q": "1"}, "unknown parameter 'Q'"),
+        ({"model": "ice"}, "not a contact model"),
+        ({"I3": "0.9"}, "body:"),  # I3 > I1 + I2
+        ({"jellett": "1"}, "unknown parameter 'jellett' for the meridian"),
+    ],
+)
+def test_a_bad_url_is_one_line_naming_the_parameter(fig5, query, message):
+    with pytest.raises(ScenarioError, match=message) as err:
+        parse_query(query, fig5)
+    assert "\n" not in str(err.value)
+
+
+def test_the_url_restores_the_view(fig5):
+    """to_query then parse_query from another view: the same view (floats by repr)."""
+    changed = parse_query({"C2": "-1.25", "h": "0.9", "a3": "0.05"}, fig5)
+    assert changed.level["C2"] == -1.25 and changed.h == 0.9 and changed.body.a3 == 0.05
+    assert parse_query(changed.to_query(), fig5) == changed
+    rough = parse_query({"model": "rough"}, fig5)
+    assert parse_query(rough.to_query(), fig5) == rough
+
+
+def test_another_model_takes_its_level_from_the_same_state(fig5):
+    """model=rough: the level of the page's reference state under the rough model, as
+    compare-classification builds it (initial_state of the same gamma, omega)."""
+    from rollingtop import initial_state
+
+    rough = parse_query({"model": "rough"}, fig5)
+    gamma, omega = fig5.start
+    y = initial_state(fig5.body, "rough", gamma=gamma, omega=omega)
+    reduction = reduction_of("rough")
+    assert rough.level == pytest.approx(reduction.level_of_state(fig5.body, y).values())
+    assert rough.h == pytest.approx(reduction.reduced_energy(fig5.body, y))
+    view = diagram_view(rough)
+    assert view.axis == "jellett" and view.mark == (rough.level["jellett"], rough.h)
+
+
+def test_a_model_without_a_reduction_shows_its_section():
+    """parallel: the section's crossings are states of the reference state's energy level
+    (energy written again from one state: (I w, w)/2 + m v^2/2 + m g (R + a3 gamma3))."""
+    from rollingtop.dynamics.integrals import energy
+
+    sc = load_scenario(str(EXAMPLES / "section_parallel.toml"))
+    state = state_from_scenario(sc)
+    assert not state.reduces and state.level == {}
+    view = section_view(state)
+    assert view.points.shape[0] > 100 and np.all(np.abs(view.points[:, 0]) <= 1.0)
+    e0 = float(energy(sc.body, sc.require_state()))
+    np.testing.assert_allclose(energy(sc.body, view.states[:20]), e0, rtol=1e-8)
+    b = sc.body
+    y = view.states[0]
+    w, v, g = y[3:6], y[0:3], y[12:15]
+    r = -b.R * g - np.array([0.0, 0.0, b.a3])  # from the CoM to the contact point
+    plain = 0.5 * (b.I1 * w[0] ** 2 + b.I2 * w[1] ** 2 + b.I3 * w[2] ** 2) + 0.5 * b.m * v @ v
+    plain += b.m * b.g * -(r @ g)
+    assert plain == pytest.approx(e0, rel=1e-8)
+
+
+def test_the_newest_request_supersedes_the_older_ones():
+    """Latest: requests made while one runs replace each other; only the newest result is
+    applied, and a result that arrives after a newer request is dropped."""
+    applied, started = [], []
+    gate = threading.Event()
+
+    def compute(x):
+        started.append(x)
+        gate.wait(5)
+        return x * 10
+
+    work = Latest(lambda fn: fn(), compute, lambda arg, res: applied.append((arg, res)))
+    work.request(1)
+    time.sleep(0.05)
+    for k in (2, 3, 4):
+        work.request(k)
+    gate.set()
+    deadline = time.time() + 5
+    while (not applied or work.running) and time.time() < deadline:
+        time.sleep(0.01)
+    assert started == [1, 4]  # 2 and 3 never ran
+    assert applied == [(4, 40)]  # 1's result arrived after newer requests: dropped
+
+
+def test_an_error_in_the_work_is_a_message_not_a_traceback():
+    applied = []
+    work = Latest(lambda fn: fn(), lambda x: 1 / x, lambda a, r: applied.append(r))
+    work.request(0)
+    deadline = time.time() + 5
+    while not applied and time.time() < deadline:
+        time.sleep(0.01)
+    assert isinstance(applied[0], RuntimeError) and "ZeroDivisionError" in str(applied[0])
