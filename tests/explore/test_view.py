@@ -215,3 +215,27 @@ def test_an_error_in_the_work_is_a_message_not_a_traceback():
     while not applied and time.time() < deadline:
         time.sleep(0.01)
     assert isinstance(applied[0], RuntimeError) and "ZeroDivisionError" in str(applied[0])
+
+
+@pytest.mark.parametrize(
+    "name", ["paper", "smooth", "rough", "rubber", "shell_rotor", "pole", "parallel"]
+)
+def test_every_example_opens_on_the_page(name):
+    """Each example's first view: a reduced model's readout counts its steady motions
+    (steady_motions of the scenario's own level) and a click starts a motion on its level (the
+    reduced energy of the trajectory's last state is the clicked point's); parallel shows its
+    section."""
+    sc = load_scenario(str(EXAMPLES / f"{name}.toml"))
+    state = state_from_scenario(sc)
+    if not state.reduces:
+        assert section_view(state).points.shape[1] == 2
+        return
+    from rollingtop.reduction import steady_motions
+
+    view = level_view(state)
+    assert view.count == len(steady_motions(sc.level_set()))
+    x = view.steady[0][0] + 0.05
+    path = path_view(state, x, 0.1, t_end=2.0)
+    y = path.trajectory.y[-1]
+    assert reduction_of(state.model).reduced_energy(state.body, y) == pytest.approx(
+        path.h, rel=ENERGY_RTOL, abs=ENERGY_RTOL)  # fmt: skip
