@@ -127,7 +127,8 @@ def test_stepper_stops_on_a_nan_or_underflowing_step(h):
     ctrl[dop.H_ABS] = h
     status = stepper.run(0, body.params, y, f, ctrl, counts, track, t_eval, w["out"],
                      np.zeros(2, dtype=np.int64), np.zeros(1), np.zeros((1, y.size)), 10**6,
-                     w["K"], w["ynew"], w["ytmp"], w["y_old"], w["Fd"], w["ws"])  # fmt: skip
+                     w["K"], w["ynew"], w["ytmp"], w["y_old"], w["Fd"], w["ws"],
+                     np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8)))  # fmt: skip
     assert status == dop.STEP_TOO_SMALL and counts[dop.STEPS] == 0
 
 
@@ -179,7 +180,7 @@ def test_ensemble_max_steps_status():
 
 def test_every_status_has_a_name():
     codes = [dop.FINISHED, dop.BUDGET_EXHAUSTED, dop.INTERRUPTED, dop.STEP_TOO_SMALL,
-             dop.NOT_FINITE, dop.TOO_MANY_REJECTED]  # fmt: skip
+             dop.NOT_FINITE, dop.TOO_MANY_REJECTED, dop.PROJECTION_FAILED]  # fmt: skip
     assert sorted(dop.STATUS_NAMES) == sorted(codes) and len(set(codes)) == len(codes)
 
 

@@ -48,6 +48,8 @@ STEP_TOO_SMALL = -1
 NOT_FINITE = -2
 #: ``MAX_REJECTED_IN_A_ROW`` steps in a row were rejected by the error control.
 TOO_MANY_REJECTED = -3
+#: The projection onto the integrals' level set gave a non-finite state.
+PROJECTION_FAILED = -4
 
 #: Short descriptions of the status codes (the ensemble reports them per trajectory).
 STATUS_NAMES = {
@@ -57,6 +59,7 @@ STATUS_NAMES = {
     STEP_TOO_SMALL: "step size underflow",
     NOT_FINITE: "non-finite state",
     TOO_MANY_REJECTED: "too many rejected steps in a row",
+    PROJECTION_FAILED: "projection onto the integrals failed",
 }
 
 #: Rejected attempts in a row after which a run gives up. After a rejection the next attempt is
@@ -67,8 +70,11 @@ MAX_REJECTED_IN_A_ROW = 100
 
 # Indices into the float control array ``ctrl``.
 T, H_ABS, T_END, RTOL, ATOL, G_OLD = 0, 1, 2, 3, 4, 5
-# Indices into the integer counter array ``counts``.
-NEXT_SAMPLE, STEPS, REJECTED, NFEV, N_EVENTS = 0, 1, 2, 3, 4
+# Indices into the integer counter array ``counts``: the projection's passes and the steps at
+# which it left a nonlinear integral (the energy at a turning point) for the next ones last.
+NEXT_SAMPLE, STEPS, REJECTED, NFEV, N_EVENTS, PROJ_PASSES, PROJ_DEFERRED = 0, 1, 2, 3, 4, 5, 6
+#: Length of ``counts``.
+N_COUNTS = 7
 # Indices into the integer event specification ``ev_spec``.
 EV_CODE, EV_DIRECTION = 0, 1
 # Indices into the reaction-tracking array ``track``.

@@ -97,7 +97,10 @@ def _print_report(summary: dict[str, Any]) -> None:
         f"{r['max_friction_ratio']:.6g}"
         + ("" if lost is None else f", CONTACT LOST at t = {lost:.6g}")
         + f"\nsteps {s['steps']} (+{s['rejected_steps']} rejected), {s['rhs_evals']} rhs "
-        f"evaluations, {s['wall_time_s']:.3f} s (+{s['compile_time_s']:.2f} s compile/load)",
+        f"evaluations, {s['wall_time_s']:.3f} s (+{s['compile_time_s']:.2f} s compile/load)"
+        + ("" if "projection_passes" not in s else
+           f"\nprojection onto the integrals: {s['projection_passes']} passes, the energy left "
+           f"for later at {s['projection_deferred']} steps (turning points)"),  # fmt: skip
         highlight=False,
     )
 
@@ -118,6 +121,9 @@ def _print_report(summary: dict[str, Any]) -> None:
 @click.option(
     "-o", "--output", type=click.Path(), default=None, help="Write samples to OUT.nc or OUT.csv."
 )
+@click.option("--project-integrals", is_flag=True, default=None,
+              help="Hold the model's integrals at their initial values by projection after "
+                   "every step ([integration] project_integrals).")  # fmt: skip
 @json_option
 def simulate(
     scenario: str,
@@ -127,6 +133,7 @@ def simulate(
     samples: int | None,
     model: ContactModel | None,
     output: str | None,
+    project_integrals: bool | None,
     as_json: bool,
 ) -> None:
     """Simulate SCENARIO.toml and print its integrals, constraints and reactions."""
@@ -137,7 +144,13 @@ def simulate(
 
     if output is not None:
         check_output_path(output, OUTPUT_SUFFIXES)
-    sc = load_scenario(scenario).with_overrides(t_end=t_end, rtol=rtol, atol=atol, samples=samples)
+    sc = load_scenario(scenario).with_overrides(
+        t_end=t_end,
+        rtol=rtol,
+        atol=atol,
+        samples=samples,
+        project_integrals=project_integrals or None,
+    )
     if model is not None and model is not sc.model:
         sc, change = switch_model(sc, model)
         dv, dw = math.hypot(*change[:3]), math.hypot(*change[3:])

@@ -67,6 +67,11 @@ class IntegrationResult:
         States at the events, projected onto the constraints.
     events_dropped : int
         Events found beyond ``max_events`` (not stored).
+    projection_passes, projection_deferred : int
+        With ``project_integrals``: the projection's passes over the run (Newton iterations:
+        one per accepted step for the linear integrals, one more per step that moved a
+        nonlinear one) and the steps at which it left the energy for the next ones (a turning
+        point, where no velocity direction changes it).
     """
 
     t: FloatArray
@@ -80,6 +85,8 @@ class IntegrationResult:
     event_t: FloatArray = field(default_factory=lambda: np.empty(0))
     event_y: FloatArray = field(default_factory=lambda: np.empty((0, N_STATE)))
     events_dropped: int = 0
+    projection_passes: int = 0
+    projection_deferred: int = 0
 
 
 class _Work(TypedDict):
@@ -138,7 +145,9 @@ def _compile_package(kernels: ModuleType) -> float:
     code = kernels._dispatch.CODES[0]
     with compiling(kernels, "integrator"):
         call(kernels.dynamics.project, code, p, y, call(new_workspace))
-        _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1))
+        # with a projection onto an integral: the same compiled loop (its arrays' types)
+        _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1),
+                      np.array([0], dtype=np.int64))  # fmt: skip
         call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
     _compiled[kernels.PACKAGE] = time.perf_counter() - start
     return _compiled[kernels.PACKAGE]
@@ -154,9 +163,11 @@ def _run_compiled(
     max_steps: int | None,
     progress: Callable[[float], None] | None,
     event: tuple[int, int, int],
+    held: IntArray | None = None,
 ) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
     n = t_eval.shape[0]
     w = _workspace(n)
+    icodes, targets, pw = _projection(code, p, y0, held)
     stepper = for_code(code).stepper
     ev_code, ev_direction, capacity = event
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
@@ -194,6 +205,9 @@ def _run_compiled(
             w["y_old"],
             w["Fd"],
             w["ws"],
+            icodes,
+            targets,
+            pw,
         )
         if progress is not None:
             progress(float(ctrl[dop.T]))
@@ -209,6 +223,24 @@ def _run_compiled(
     found = int(counts[dop.N_EVENTS])
     kept = min(found, capacity)
     return w["out"], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
+
+
+def _projection(
+    code: int, p: FloatArray, y0: FloatArray, held: IntArray | None
+) -> tuple[IntArray, FloatArray, FloatArray]:
+    """The arrays of the projection onto the integrals ``held`` (codes of
+    :mod:`rollingtop._compiled._integrals`; ``None``: no projection): their codes, their values
+    at ``y0`` (the compiled evaluation the projection compares with) and its work array."""
+    from rollingtop._compiled import _integrals
+    from rollingtop._compiled._template.invariants import WORK_ROWS
+
+    if held is None or len(held) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8))
+    icodes = np.ascontiguousarray(held, dtype=np.int64)
+    targets = np.array([call(_integrals.integral_value, int(c), p, y0) for c in icodes])
+    if not np.all(np.isfinite(targets)):
+        raise IntegrationError("the integrals to hold are not finite at the initial state")
+    return icodes, targets, np.zeros((WORK_ROWS, 8))
 
 
 def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
@@ -235,6 +267,11 @@ def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
             f"the state (or every trial step from it) became non-finite at t = {t:.9g} "
             "(for the meridian model: the symmetry axis reached the vertical?)"
         )
+    if status == dop.PROJECTION_FAILED:
+        raise IntegrationError(
+            f"the projection onto the integrals' level set gave a non-finite state at "
+            f"t = {t:.9g}: the integrals' gradients are degenerate there"
+        )
     if status == dop.TOO_MANY_REJECTED:
         raise IntegrationError(
             f"{dop.MAX_REJECTED_IN_A_ROW} rejected steps in a row at t = {t:.9g} (h = {h:.3g}): "
@@ -255,6 +292,7 @@ def integrate(
     events: str | None = None,
     event_direction: int = 0,
     max_events: int = 100_000,
+    project_integrals: tuple[str, ...] = (),
 ) -> IntegrationResult:
     """Integrate the constrained equations from ``y0`` at ``t_eval[0]`` to ``t_eval[-1]``.
 
@@ -295,6 +333,10 @@ def integrate(
         ``+1``: only rising zeros, ``-1``: only falling, ``0``: both.
     max_events : int
         Events stored at most (further ones are counted in ``events_dropped``).
+    project_integrals : tuple of str
+        Integrals (names of :data:`rollingtop.dynamics.integrals.INTEGRALS`) held at their
+        values at ``y0`` by a projection of the velocity after every accepted step
+        (:mod:`rollingtop._compiled._template.invariants`); empty: none.
     """
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     y0 = np.ascontiguousarray(y0, dtype=float)
@@ -312,6 +354,12 @@ def integrate(
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
     event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
+    from rollingtop._compiled._integrals import CODES
+
+    unknown = [n for n in project_integrals if n not in CODES]
+    if unknown:
+        raise ValueError(f"no compiled integral {unknown[0]!r} (known: {', '.join(CODES)})")
+    held = np.array([CODES[n] for n in project_integrals], dtype=np.int64)
     compile_s = compile_code(code)
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
@@ -323,6 +371,7 @@ def integrate(
         max_steps,
         progress,
         event,
+        held if held.size else None,
     )
     return IntegrationResult(
         t=t_eval,
@@ -344,4 +393,6 @@ def integrate(
         event_t=ev_t,
         event_y=ev_y,
         events_dropped=dropped,
+        projection_passes=int(counts[dop.PROJ_PASSES]),
+        projection_deferred=int(counts[dop.PROJ_DEFERRED]),
     )

@@ -26,6 +26,7 @@ DEFAULTS: dict[str, float | int | None] = {
     "atol": None,
     "samples": 1001,
     "max_steps": 10**8,
+    "project_integrals": False,
 }
 #: Largest ``max_steps`` (the integrator's own "no limit").
 MAX_STEPS_LIMIT = 2**62
@@ -51,6 +52,11 @@ class IntegrationOptions:
         :func:`rollingtop._checks.memory_limit` (:data:`BYTES_PER_SAMPLE` each).
     max_steps : int
         Bound on accepted steps, ``1 <= max_steps <= 2**62``.
+    project_integrals : bool
+        Hold every integral the model claims for the body
+        (:meth:`~rollingtop.contact.ContactModel.integrals_for`) at its initial value by a
+        projection of the velocity after every accepted step and at every sample
+        (:mod:`rollingtop._compiled._template.invariants`).
 
     Raises
     ------
@@ -63,6 +69,7 @@ class IntegrationOptions:
     atol: float | None = None
     samples: int = 1001
     max_steps: int = 10**8
+    project_integrals: bool = False
 
     def __post_init__(self) -> None:
         w = "integration"
@@ -84,6 +91,10 @@ class IntegrationOptions:
             raise ScenarioError(
                 f"integration.max_steps = {short_repr(max_steps)} must lie in [1, 2**62]"
             )
+        flag: object = self.project_integrals
+        if not isinstance(flag, bool):
+            given = short_repr(flag)
+            raise ScenarioError(f"integration.project_integrals = {given} must be true or false")
         step = t_end / (samples - 1)
         if step < sys.float_info.min or step <= 4 * math.ulp(t_end):
             raise ScenarioError(

@@ -80,6 +80,9 @@ def section_one(
     t_eval = np.array([0.0, t_max])
     out = np.zeros((2, n))
     ev_spec = np.array([W_TAU, 1], dtype=np.int64)
+    no_codes = np.zeros(0, dtype=np.int64)  # no projection onto the integrals here
+    no_targets = np.zeros(0)
+    no_work = np.zeros((1, 8))
     # the event code read from the array: the literal W_TAU would compile a second start
     ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew,
                                 ws)  # fmt: skip
@@ -90,7 +93,8 @@ def section_one(
             break
         budget = min(STOP_POLL_STEPS // 10, max_steps - counts[dop.STEPS])
         status = run(code, p, y, f, ctrl, counts, track, t_eval, out, ev_spec, ev_t, ev_y,
-                         budget, K, ynew, ytmp, y_old, Fd, ws)  # fmt: skip
+                         budget, K, ynew, ytmp, y_old, Fd, ws, no_codes, no_targets,
+                         no_work)  # fmt: skip
         if counts[dop.N_EVENTS] >= wanted:
             status = dop.FINISHED
             break

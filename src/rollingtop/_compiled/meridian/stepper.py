@@ -34,10 +34,14 @@ from rollingtop._compiled._dop853 import (
     MAX_FACTOR,
     MAX_REJECTED_IN_A_ROW,
     MIN_FACTOR,
+    N_COUNTS,
     N_EVENTS,
     NEXT_SAMPLE,
     NFEV,
     NOT_FINITE,
+    PROJ_DEFERRED,
+    PROJ_PASSES,
+    PROJECTION_FAILED,
     REJECTED,
     RTOL,
     SAFETY,
@@ -57,6 +61,7 @@ from rollingtop._compiled.meridian._dispatch import INLINE_RHS
 from rollingtop._compiled.meridian.dense import event_root, normal_root, prepare_dense
 from rollingtop._compiled.meridian.dynamics import project, rhs, rhs_inline
 from rollingtop._compiled.meridian.events import event_value
+from rollingtop._compiled.meridian.invariants import WORK_ROWS, project_integrals
 from rollingtop._jit import compiled, kernel
 from rollingtop._types import FloatArray, IntArray, Workspace
 
@@ -135,7 +140,7 @@ def start(
     t0, t_end = t_eval[0], t_eval[-1]
     h0 = initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ynew, ws)
     ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y)])
-    counts = np.zeros(5, dtype=np.int64)
+    counts = np.zeros(N_COUNTS, dtype=np.int64)
     counts[NFEV] = 2
     for i in range(y.shape[0]):
         out[0, i] = y[i]
@@ -164,6 +169,9 @@ def run(
     y_old: FloatArray,
     Fd: FloatArray,
     ws: Workspace,
+    icodes: IntArray,
+    targets: FloatArray,
+    pw: FloatArray,
 ) -> int:
     """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
 
@@ -177,9 +185,10 @@ def run(
         Current state (projected) and its derivative; updated in place.
     ctrl : ndarray, shape (6,)
         ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``); updated.
-    counts : ndarray of int64, shape (5,)
+    counts : ndarray of int64, shape (7,)
         Next sample index, accepted steps, rejected steps, right-hand-side evaluations, events
-        found (also those beyond the capacity of ``ev_t``).
+        found (also those beyond the capacity of ``ev_t``), the projection's passes and the
+        steps at which it left a nonlinear integral for the next ones.
     track : ndarray, shape (5,)
         Reaction tracking (see :func:`new_track`), updated at every accepted step.
     t_eval : ndarray, shape (n_samples,)
@@ -196,14 +205,18 @@ def run(
     K, ynew, ytmp, y_old, Fd, ws
         Work arrays: stages ``(16, 18)``, three states, dense-output coefficients ``(7, 18)`` and
         the kernel workspace.
+    icodes, targets, pw : ndarrays, shapes (k,), (k,), (WORK_ROWS, 8)
+        The integrals held by projection after every accepted step (codes of
+        :mod:`rollingtop._compiled._integrals`; ``k = 0``: none), their values, and the
+        projection's work array (:func:`.invariants.project_integrals`).
 
     Returns
     -------
     status : int
-        ``FINISHED``, ``BUDGET_EXHAUSTED``, ``STEP_TOO_SMALL``, ``NOT_FINITE`` or
-        ``TOO_MANY_REJECTED``. Every call ends: after at most ``budget`` accepted steps, each
-        preceded by fewer than :data:`MAX_REJECTED_IN_A_ROW` rejected attempts. Splitting a run
-        into calls does not change its steps.
+        ``FINISHED``, ``BUDGET_EXHAUSTED``, ``STEP_TOO_SMALL``, ``NOT_FINITE``,
+        ``TOO_MANY_REJECTED`` or ``PROJECTION_FAILED``. Every call ends: after at most
+        ``budget`` accepted steps, each preceded by fewer than :data:`MAX_REJECTED_IN_A_ROW`
+        rejected attempts. Splitting a run into calls does not change its steps.
     """
     n = y.shape[0]
     t = ctrl[T]
@@ -291,6 +304,10 @@ def run(
             while k < n_samples and t_eval[k] <= t_new:
                 dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
                 project(code, p, out[k], ws)
+                if icodes.shape[0] > 0 and pw.shape[0] == WORK_ROWS:  # samples on the level too
+                    if project_integrals(code, p, out[k], icodes, targets, pw, ws) < 0:
+                        ctrl[T] = t_new
+                        return PROJECTION_FAILED
                 k += 1
             counts[NEXT_SAMPLE] = k
         # Accept: project onto the constraints. The derivative at the new point is the last
@@ -301,6 +318,14 @@ def run(
             y[i] = ynew[i]
             f[i] = K[12, i]
         project(code, p, y, ws)
+        if icodes.shape[0] > 0 and pw.shape[0] == WORK_ROWS:
+            passes = project_integrals(code, p, y, icodes, targets, pw, ws)
+            if passes < 0:
+                ctrl[T] = t_new
+                return PROJECTION_FAILED
+            counts[PROJ_PASSES] += passes
+            if pw[WORK_ROWS - 1, 7] > 0.0:
+                counts[PROJ_DEFERRED] += 1
         for i in range(n):
             if not math.isfinite(y[i]) or not math.isfinite(f[i]):
                 ctrl[T] = t_new

@@ -14,6 +14,7 @@ from rollingtop._compiled.parallel import (
     dynamics,
     ensemble,
     events,
+    invariants,
     stepper,
     tangent,
 )
@@ -29,6 +30,7 @@ __all__ = [
     "dynamics",
     "ensemble",
     "events",
+    "invariants",
     "stepper",
     "tangent",
 ]

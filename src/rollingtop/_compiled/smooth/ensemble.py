@@ -54,6 +54,9 @@ def batch(
     f = np.zeros(n)
     ev_spec = np.zeros(2, dtype=np.int64)
     ev_t = np.zeros(1)
+    no_codes = np.zeros(0, dtype=np.int64)  # no projection onto the integrals here
+    no_targets = np.zeros(0)
+    no_work = np.zeros((1, 8))
     ev_y = np.zeros((1, n))
     for k in range(Y0.shape[0]):
         if read_flag(stop) != 0:
@@ -73,7 +76,8 @@ def batch(
                 break
             budget = min(STOP_POLL_STEPS, max_steps - counts[dop.STEPS])
             status = run(code, p, y, f, ctrl, counts, track, t_eval, out[k], ev_spec, ev_t, ev_y,
-                         budget, K, ynew, ytmp, y_old, Fd, ws)  # fmt: skip
+                         budget, K, ynew, ytmp, y_old, Fd, ws, no_codes, no_targets,
+                         no_work)  # fmt: skip
             if status != dop.BUDGET_EXHAUSTED or counts[dop.STEPS] >= max_steps:
                 break
         for i in range(n):

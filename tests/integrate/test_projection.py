@@ -1,0 +1,167 @@
+"""Projection onto the level set of the integrals (issue 26; rollingtop._compiled._integrals and
+rollingtop._compiled._template.invariants): the compiled integrals against their numpy
+definitions, their gradients against gradients written here, the drift of every claimed
+integral with projection, and the period against the reduction's quadrature."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from rollingtop import ScenarioError, initial_state, simulate
+from rollingtop._compiled import _integrals
+from rollingtop._jit import call
+from rollingtop.contact import get_model
+from rollingtop.dynamics.integrals import evaluate
+from rollingtop.integrate.options import IntegrationOptions
+from rollingtop.reduction import orbits, reduction_of
+from rollingtop.scenario import load_scenario
+
+from ..conftest import EXAMPLES, FREE, GAMMA0, OMEGA0
+
+#: Issue 26: every claimed integral within this, relative, with projection (here to t = 1e4).
+HELD_RTOL = 1e-12
+T_LONG = 1e4
+MODELS = ["meridian", "smooth", "rough", "rubber", "parallel"]
+
+
+def _state(body, model, rng=None):
+    gamma, omega = np.array(GAMMA0), np.array(OMEGA0)
+    if rng is not None:
+        gamma = gamma + 0.2 * rng.normal(size=3)
+        omega = omega + 0.5 * rng.normal(size=3)
+        gamma /= np.linalg.norm(gamma)
+    if model == "rubber":  # no spin about the normal
+        omega = omega - np.dot(omega, gamma) * gamma
+    return initial_state(body, model, gamma=gamma, omega=omega, free=FREE[model])
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_compiled_integrals_are_the_numpy_ones(paper_body, model, rng):
+    """integral_value against rollingtop.dynamics.integrals (numpy, vectorised) on states of
+    every model, to round-off."""
+    for _ in range(5):
+        y = _state(paper_body, model, rng)
+        p = paper_body.params
+        want = evaluate(paper_body, y, _integrals.CODES)
+        for name, code in _integrals.CODES.items():
+            got = call(_integrals.integral_value, code, p, y)
+            if name == "slip_nu" and model != "parallel":  # (v_P, nu) = 0: its sign is round-off
+                got, want[name] = abs(got), abs(want[name])
+            assert got == pytest.approx(float(want[name]), rel=1e-13, abs=1e-14), name
+
+
+def test_the_velocity_gradients_are_exact(paper_body, rng):
+    """velocity_gradient (central differences) against the gradients in u = (v, w) written here:
+    energy M u, Lagrange (0, 0, 0, 0, 0, I3), Jellett I r, area I gamma, momentum_x m alpha."""
+    b = paper_body
+    y = _state(b, "meridian", rng)
+    p = b.params
+    inertia = np.array([b.I1, b.I2, b.I3])
+    r = -b.R * y[12:15] - np.array([0.0, 0.0, b.a3])
+    expected = {
+        "energy": np.concatenate([b.m * y[0:3], inertia * y[3:6]]),
+        "lagrange": np.array([0, 0, 0, 0, 0, b.I3], dtype=float),
+        "jellett": np.concatenate([np.zeros(3), inertia * r]),
+        "area": np.concatenate([np.zeros(3), inertia * y[12:15]]),
+        "momentum_x": np.concatenate([b.m * y[6:9], np.zeros(3)]),
+    }
+    out = np.zeros(6)
+    for name, g in expected.items():
+        keep = y.copy()
+        call(_integrals.velocity_gradient, _integrals.CODES[name], p, y, out)
+        np.testing.assert_array_equal(y, keep)  # restored
+        np.testing.assert_allclose(out, g, rtol=1e-12, atol=1e-13, err_msg=name)
+
+
+@pytest.fixture(params=[0.1, -0.1], ids=["com_above", "com_below"])
+def body(request, paper_body):
+    return replace(paper_body, a3=request.param)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_projection_holds_every_claimed_integral(body, model):
+    """Issue 26: with project_integrals every integral the model claims for the body stays
+    within HELD_RTOL of its initial value to t = 1e4 (relative to its size, or to the
+    energy's scale for an integral that starts at 0), at every sample; the constraints stay at
+    round-off; without projection the drift is orders larger (so the test can fail)."""
+    y0 = _state(body, model)
+    names = get_model(model).integrals_for(body)
+    # parallel below the centre: a step-size underflow at a passage of the vertical near
+    # t = 4100, with or without projection (issue 26, item 4, still open): to t = 3000 there
+    t_end = 3000.0 if model == "parallel" and body.a3 < 0 else T_LONG
+    held = simulate(body, model, y0, t_end=t_end, samples=201, project_integrals=True)
+    free = simulate(body, model, y0, t_end=t_end, samples=201)
+    scale = float(np.max(np.abs(y0[:6])))
+    worst_free = 0.0
+    for name, values in evaluate(body, held.y, names).items():
+        size = max(abs(float(values[0])), 1e-3 * scale)
+        drift = float(np.max(np.abs(values - values[0]))) / size
+        assert drift < HELD_RTOL, (name, drift)
+        v_free = evaluate(body, free.y, [name])[name]
+        worst_free = max(worst_free, float(np.max(np.abs(v_free - v_free[0]))) / size)
+    assert worst_free > 100 * HELD_RTOL
+    assert np.max(np.abs(held.constraint_residuals)) < 1e-12
+    assert held.stats["projection_passes"] >= held.stats["steps"]
+    assert held.summary()["stats"]["projection_passes"] == held.stats["projection_passes"]
+
+
+def test_the_period_with_projection_is_no_worse(paper_body):
+    """Issue 26: gamma3's period averaged over ~3300 periods (the rising zeros of w_tau) against
+    the reduction's quadrature: with projection its error does not grow (measured: 2e-11
+    against 2e-9 without)."""
+    sc = load_scenario(EXAMPLES / "paper.toml")
+    y0 = sc.require_state()
+    reduction = reduction_of("meridian")
+    level, h = reduction.level_of_state(sc.body, y0), reduction.reduced_energy(sc.body, y0)
+    (orbit,) = [o for o in orbits(level, h) if o.gamma3_min <= y0[14] <= o.gamma3_max]
+    errors = {}
+    for proj in (False, True):
+        tr = simulate(sc, t_end=T_LONG, samples=2, events="w_tau", event_direction=1,
+                      project_integrals=proj)  # fmt: skip
+        te = tr.event_t
+        mean = (te[-1] - te[0]) / (len(te) - 1)
+        errors[proj] = abs(mean - orbit.period) / orbit.period
+    assert errors[True] <= errors[False]
+    assert errors[True] < 1e-10
+
+
+def test_the_option_is_validated_and_read_from_scenarios(tmp_path, capsys):
+    from ..test_cli import run_cli
+
+    with pytest.raises(ScenarioError, match="project_integrals = 'yes' must be true or false"):
+        IntegrationOptions(project_integrals="yes")
+    text = (EXAMPLES / "paper.toml").read_text().replace(
+        "[integration]", "[integration]\nproject_integrals = true")  # fmt: skip
+    path = tmp_path / "held.toml"
+    path.write_text(text)
+    assert load_scenario(path).integration.project_integrals is True
+    code, out, err = run_cli(capsys, "simulate", str(path), "--t-end", "50", "--json")
+    assert code == 0, err
+    import json
+
+    data = json.loads(out)
+    assert data["stats"]["projection_passes"] > 0
+    assert all(v["max_rel_drift"] < HELD_RTOL for v in data["integrals"].values())
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "paper.toml"), "--t-end", "50",
+                             "--project-integrals", "--json")  # fmt: skip
+    assert code == 0 and json.loads(out)["stats"]["projection_passes"] > 0
+
+
+def test_the_shell_rotor_pair_is_refused_in_one_line(capsys):
+    from ..test_cli import run_cli
+
+    code, out, err = run_cli(capsys, "simulate", str(EXAMPLES / "shell_rotor.toml"),
+                             "--t-end", "1", "--project-integrals")  # fmt: skip
+    assert code == 2 and "not for the shell-rotor model" in err
+    assert len([ln for ln in err.splitlines() if "error" in ln]) == 1
+
+
+def test_a_failed_projection_is_an_error_with_its_reason():
+    from rollingtop._compiled import _dop853 as dop
+    from rollingtop._errors import IntegrationError
+    from rollingtop.integrate.driver import _raise_for_status
+
+    ctrl = np.array([12.5, 0.1, 100.0, 1e-10, 1e-12, 0.0])
+    with pytest.raises(IntegrationError, match="projection onto the integrals.*t = 12.5"):
+        _raise_for_status(dop.PROJECTION_FAILED, ctrl, np.zeros(dop.N_COUNTS, dtype=np.int64))
