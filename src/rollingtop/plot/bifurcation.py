@@ -14,10 +14,11 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from rollingtop.plot._axes import axes_for
 from rollingtop.reduction.bifurcation import BifurcationDiagram, SteadyCountMap
 from rollingtop.reduction.level import LevelSet
 
-__all__ = ["bifurcation_figure"]
+__all__ = ["bifurcation_figure", "draw_bifurcation"]
 
 CENTRE_COLOUR = "#1f4e9c"
 SADDLE_COLOUR = "#c0392b"
@@ -102,24 +103,22 @@ def _on_pole_level(diagram: BifurcationDiagram) -> bool:
     return LevelSet(diagram.body, diagram.M3, diagram.C1, 0.0).pole is not None
 
 
-def bifurcation_figure(
-    diagram: BifurcationDiagram,
-    count_map: SteadyCountMap | None = None,
-    mark_C2: float | None = None,
-) -> Figure:
-    """The diagram (curves of critical values: centres solid, saddles dashed; folds as dots;
-    regions shaded and named) with a thumbnail of each region's level curve in
-    ``(gamma3, w_tau)`` beside it, and, if given, the steady-motion count over ``(C1, C2)``."""
+def _region_colours(diagram: BifurcationDiagram) -> ListedColormap:
+    """One pastel colour per region, in the order of :attr:`BifurcationDiagram.regions`."""
+    n = max(len(diagram.regions), 1)
+    return ListedColormap([colormaps["Pastel1"](i % 9) for i in range(n)])
+
+
+def draw_bifurcation(
+    ax: Axes | None, diagram: BifurcationDiagram, mark_C2: float | None = None
+) -> Axes:
+    """The diagram in ``(C2, h)`` on ``ax``: the regions shaded and named, ``min U``, the
+    curves of critical values (centres solid, saddles dashed), the folds as dots, on a pole
+    level the pole's energy, and a vertical line at ``mark_C2`` if given. Returns ``ax``
+    (``None``: a new figure's, :func:`~rollingtop.plot._axes.axes_for`)."""
+    ax = axes_for(ax, (6.4, 5.6))
     regions = diagram.regions
-    n_thumb = max(len(regions), 1)
-    cols = 1 if n_thumb <= 2 else 2
-    rows_t = math.ceil(n_thumb / cols)
-    extra = 1 if count_map is not None else 0
-    fig = Figure(figsize=(5.6 + 2.7 * cols + 4.4 * extra, max(5.6, 2.8 * rows_t)),
-                 layout="constrained")  # fmt: skip
-    outer = fig.add_gridspec(1, 2 + extra, width_ratios=[5.6, 2.7 * cols] + [4.4] * extra)
-    ax = fig.add_subplot(outer[0, 0])
-    cmap = ListedColormap([colormaps["Pastel1"](i % 9) for i in range(max(len(regions), 1))])
+    cmap = _region_colours(diagram)
     shade = np.ma.masked_less(diagram.region_index, 0)
     ax.pcolormesh(diagram.C2_grid, diagram.h_grid, shade, cmap=cmap, shading="nearest",
                   vmin=-0.5, vmax=len(regions) - 0.5, alpha=0.8, rasterized=True)  # fmt: skip
@@ -151,6 +150,26 @@ def bifurcation_figure(
                  f"a3 = {b.a3:g}, I1 = {b.I1:g}, I3 = {b.I3:g}, m = {b.m:g}, g = {b.g:g})",
                  fontsize=9)  # fmt: skip
     ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
+    return ax
+
+
+def bifurcation_figure(
+    diagram: BifurcationDiagram,
+    count_map: SteadyCountMap | None = None,
+    mark_C2: float | None = None,
+) -> Figure:
+    """The diagram (:func:`draw_bifurcation`) with a thumbnail of each region's level curve in
+    ``(gamma3, w_tau)`` beside it, and, if given, the steady-motion count over ``(C1, C2)``."""
+    regions = diagram.regions
+    n_thumb = max(len(regions), 1)
+    cols = 1 if n_thumb <= 2 else 2
+    rows_t = math.ceil(n_thumb / cols)
+    extra = 1 if count_map is not None else 0
+    fig = Figure(figsize=(5.6 + 2.7 * cols + 4.4 * extra, max(5.6, 2.8 * rows_t)),
+                 layout="constrained")  # fmt: skip
+    outer = fig.add_gridspec(1, 2 + extra, width_ratios=[5.6, 2.7 * cols] + [4.4] * extra)
+    draw_bifurcation(fig.add_subplot(outer[0, 0]), diagram, mark_C2)
+    cmap = _region_colours(diagram)
     thumbs = outer[0, 1].subgridspec(rows_t, cols)
     axis = "theta" if _on_pole_level(diagram) else "gamma3"
     for k in range(len(regions)):

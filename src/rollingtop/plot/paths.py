@@ -5,13 +5,25 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+
+from rollingtop.plot._axes import axes_for
 
 if TYPE_CHECKING:
     from rollingtop.absolute import PeriodMap
     from rollingtop.trajectory import Trajectory
 
-__all__ = ["path_figure", "timeseries_figure", "compare_figure"]
+__all__ = [
+    "PANELS",
+    "compare_figure",
+    "draw_drift",
+    "draw_gamma3",
+    "draw_path",
+    "draw_reactions",
+    "path_figure",
+    "timeseries_figure",
+]
 
 
 def _title(traj: Trajectory) -> str:
@@ -22,25 +34,10 @@ def _title(traj: Trajectory) -> str:
     )
 
 
-def path_figure(
-    traj: Trajectory,
-    period_map: PeriodMap | None = None,
-    *,
-    figsize: tuple[float, float] = (7.0, 7.0),
-) -> Figure:
-    """Contact-point and CoM paths on the plane.
-
-    Parameters
-    ----------
-    traj : Trajectory
-        If it carries events (rising zeros of ``w_tau``: the minima of ``gamma3``), the CoM's
-        once-per-period positions are marked.
-    period_map : PeriodMap, optional
-        Draws the predicted circle of the once-per-period positions (bounded motion) or the drift
-        direction, anchored at the first event.
-    """
-    fig = Figure(figsize=figsize, layout="constrained")
-    ax = fig.subplots()
+def draw_path(ax: Axes | None, traj: Trajectory, period_map: PeriodMap | None = None) -> Axes:
+    """Contact-point and CoM paths on the plane, on ``ax`` (:func:`path_figure`). Returns
+    ``ax`` (``None``: a new figure's, :func:`~rollingtop.plot._axes.axes_for`)."""
+    ax = axes_for(ax, (6.4, 6.4))
     cp, com = traj.contact_point, traj.position
     ax.plot(cp[:, 0], cp[:, 1], color="0.55", lw=0.6, label="contact point")
     ax.plot(com[:, 0], com[:, 1], color="#1f77b4", lw=0.9, label="centre of mass")
@@ -80,36 +77,93 @@ def path_figure(
     ax.set_ylabel("Y")
     ax.legend(loc="best", fontsize=8)
     ax.grid(alpha=0.3)
+    return ax
+
+
+def path_figure(
+    traj: Trajectory,
+    period_map: PeriodMap | None = None,
+    *,
+    figsize: tuple[float, float] = (7.0, 7.0),
+) -> Figure:
+    """Contact-point and CoM paths on the plane (:func:`draw_path`).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        If it carries events (rising zeros of ``w_tau``: the minima of ``gamma3``), the CoM's
+        once-per-period positions are marked.
+    period_map : PeriodMap, optional
+        Draws the predicted circle of the once-per-period positions (bounded motion) or the drift
+        direction, anchored at the first event.
+    """
+    fig = Figure(figsize=figsize, layout="constrained")
+    draw_path(fig.subplots(), traj, period_map)
     return fig
 
 
-def timeseries_figure(traj: Trajectory, *, figsize: tuple[float, float] = (8.0, 8.0)) -> Figure:
-    """``gamma3(t)``, the first integrals' relative drift, and the contact reactions."""
-    fig = Figure(figsize=figsize, layout="constrained")
-    ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
-    t = traj.t
-    ax1.plot(t, traj.gamma[:, 2], color="black", lw=0.9)
-    ax1.set_ylabel(r"$\gamma_3$")
-    ax1.set_title(_title(traj), fontsize=9)
+def draw_gamma3(ax: Axes | None, traj: Trajectory) -> Axes:
+    """``gamma3(t)`` on ``ax``, titled with the model and body (:func:`timeseries_figure`'s
+    first panel). Returns ``ax`` (``None``: a new figure's)."""
+    ax = axes_for(ax, (6.4, 3.2))
+    ax.plot(traj.t, traj.gamma[:, 2], color="black", lw=0.9)
+    ax.set_xlabel("t")
+    ax.set_ylabel(r"$\gamma_3$")
+    ax.set_title(_title(traj), fontsize=9)
+    return ax
+
+
+def draw_drift(ax: Axes | None, traj: Trajectory) -> Axes:
+    """Each first integral's relative drift ``|I - I0| / max |I|`` along the samples, on a log
+    scale (:func:`timeseries_figure`'s second panel). Returns ``ax`` (``None``: a new
+    figure's)."""
+    ax = axes_for(ax, (6.4, 3.2))
     for name, values in traj.integrals.items():
         scale = max(np.max(np.abs(values)), 1e-300)
         drift = np.abs(values - values[0]) / scale
-        ax2.semilogy(t, np.maximum(drift, 1e-17), lw=0.8, label=name)
-    ax2.set_ylabel("relative drift of\nthe first integrals")
-    ax2.legend(fontsize=7, ncols=3, loc="upper left")
-    ax2.set_ylim(1e-17, None)
-    ax3.plot(t, traj.normal_force, color="#1f77b4", lw=0.9, label="normal force N")
-    ax3.plot(t, traj.tangential_force, color="#d62728", lw=0.9, label="tangential force T")
-    ax3.axhline(0, color="0.6", lw=0.6)
+        ax.semilogy(traj.t, np.maximum(drift, 1e-17), lw=0.8, label=name)
+    ax.set_xlabel("t")
+    ax.set_ylabel("relative drift of\nthe first integrals")
+    ax.legend(fontsize=7, ncols=3, loc="upper left")
+    ax.set_ylim(1e-17, None)
+    return ax
+
+
+def draw_reactions(ax: Axes | None, traj: Trajectory) -> Axes:
+    """The normal and tangential forces along the samples, the loss of contact marked, and the
+    friction coefficient the motion needs (:func:`timeseries_figure`'s third panel). Returns
+    ``ax`` (``None``: a new figure's)."""
+    ax = axes_for(ax, (6.4, 3.2))
+    t = traj.t
+    ax.plot(t, traj.normal_force, color="#1f77b4", lw=0.9, label="normal force N")
+    ax.plot(t, traj.tangential_force, color="#d62728", lw=0.9, label="tangential force T")
+    ax.axhline(0, color="0.6", lw=0.6)
     lost = traj.contact_lost_at
     if lost is not None:
-        ax3.axvline(lost, color="black", ls="--", lw=0.8, label=f"contact lost, t = {lost:.4g}")
-    ax3.set_ylabel("reactions")
-    ax3.set_xlabel("t")
-    ax3.legend(fontsize=7, loc="upper left")
+        ax.axvline(lost, color="black", ls="--", lw=0.8, label=f"contact lost, t = {lost:.4g}")
+    ax.set_ylabel("reactions")
+    ax.set_xlabel("t")
+    ax.legend(fontsize=7, loc="upper left")
     ratio = np.nanmax(traj.friction_ratio) if np.any(traj.normal_force > 0) else np.nan
-    ax3.set_title(f"friction coefficient needed (max T/N at the samples): {ratio:.4g}",
-                  fontsize=8)  # fmt: skip
+    ax.set_title(f"friction coefficient needed (max T/N at the samples): {ratio:.4g}",
+                 fontsize=8)  # fmt: skip
+    return ax
+
+
+#: What :meth:`rollingtop.Trajectory.plot` draws for each ``kind``.
+PANELS = {"path": draw_path, "gamma3": draw_gamma3, "drift": draw_drift,
+          "reactions": draw_reactions}  # fmt: skip
+
+
+def timeseries_figure(traj: Trajectory, *, figsize: tuple[float, float] = (8.0, 8.0)) -> Figure:
+    """``gamma3(t)``, the first integrals' relative drift, and the contact reactions
+    (:func:`draw_gamma3`, :func:`draw_drift`, :func:`draw_reactions`)."""
+    fig = Figure(figsize=figsize, layout="constrained")
+    ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
+    for ax, draw in ((ax1, draw_gamma3), (ax2, draw_drift), (ax3, draw_reactions)):
+        draw(ax, traj)
+    for ax in (ax1, ax2):
+        ax.set_xlabel("")  # the panels share the lowest one's time axis
     return fig
 
 
