@@ -5,6 +5,7 @@ import json
 import math
 
 import mpmath as mp
+import numpy as np
 import pytest
 import xarray as xr
 
@@ -279,3 +280,86 @@ def test_bad_model_axes_are_refused_in_one_line(axes, model, initial, message):
         del data["initial"]
     with pytest.raises(AtlasError, match=message):
         atlas_spec_from_dict(data)
+
+
+# ---- in a notebook: ds.rollingtop ----------------------------------------------------------
+def test_the_accessor_shows_the_cells_and_their_counts():
+    """The summary's counts against np.unique of the cells, as ``rollingtop atlas`` prints
+    them; the axes and the fixed values (the axes' keys left out)."""
+    from .html_view import num, read
+
+    ds = classify_in_process(atlas_spec_from_dict(spec_dict(SMALL)))
+    classified = ds["status"].values == 0
+    view = read(ds.rollingtop._repr_html_())
+    assert view.subtitle == f"{ds['status'].size} cells (2 x 4 x 3), models: meridian"
+    shown = {(r["variable"], int(r["value"])): int(r["cells"])
+             for r in view.records("classified cells")}  # fmt: skip
+    for name in ("n_steady", "n_centres", "n_saddles", "n_folds"):
+        values, n = np.unique(ds[name].values[classified], return_counts=True)
+        expected = {(name, int(v)): int(c) for v, c in zip(values, n, strict=True)}
+        assert {k: v for k, v in shown.items() if k[0] == name} == expected
+        assert ds.rollingtop.counts()[name] == {k[1]: v for k, v in expected.items()}
+    cells = {r["status"]: int(r["cells"]) for r in view.records("cells")}
+    assert cells == {"classified": int(classified.sum()),
+                     "pole level (C1 = +-M3)": int((ds["status"].values == 2).sum())}  # fmt: skip
+    axes = {r["axis"]: r for r in view.records("axes")}
+    assert list(axes) == ["a3", "C2", "C1"] and int(axes["C2"]["values"]) == 4
+    assert num(axes["C2"]["from"]) == -3.0 and num(axes["C2"]["to"]) == 0.0
+    (fixed,) = view.records("fixed")
+    assert {k: num(v) for k, v in fixed.items()} == {**{k: v for k, v in BODY.items()
+                                                        if k != "a3"}, "M3": 1.0}  # fmt: skip
+
+
+def test_the_accessor_plots_a_count_over_two_axes_the_others_held():
+    import matplotlib.pyplot as plt
+    from matplotlib.axes import Axes
+
+    from rollingtop import RollingTopError
+
+    ds = classify_in_process(atlas_spec_from_dict(spec_dict(SMALL)))
+    try:
+        ax = ds.rollingtop.plot()  # the last two axes, a3 held at its middle value
+        assert isinstance(ax, Axes) and (ax.get_xlabel(), ax.get_ylabel()) == ("C2", "C1")
+        assert ax.get_title().endswith("at a3 = 0.2")
+        (mesh,) = ax.collections
+        cells = ds.sel(a3=0.2)
+        expected = np.where(cells["status"].values == 0, cells["n_steady"].values, -9).T
+        np.testing.assert_array_equal(np.ma.filled(mesh.get_array(), -9), expected)
+        _, given = plt.subplots()
+        assert ds.rollingtop.plot(given, "n_centres", x="C1", a3=0.05, C2=-1.0) is given
+        (curve,) = given.get_lines()
+        cells = ds.sel(a3=0.05, C2=-1.0)
+        expected = np.where(cells["status"].values == 0, cells["n_centres"].values, np.nan)
+        np.testing.assert_array_equal(curve.get_xdata(), ds["C1"].values)
+        np.testing.assert_array_equal(curve.get_ydata(), expected)
+        with pytest.raises(RollingTopError, match="'I3': not an axis of the atlas"):
+            ds.rollingtop.plot(I3=0.5)
+    finally:
+        plt.close("all")
+
+
+def test_the_accessor_names_the_models_on_a_model_axis():
+    import matplotlib.pyplot as plt
+
+    spec = atlas_spec_from_dict({
+        "body": dict(BODY), "contact": {"model": "meridian"},
+        "initial": {"gamma": [0.0, 0.6, 0.8], "omega": [0.7, -0.3, 0.4]},
+        "axes": {"model": ["meridian", "rough"], "a3": [-0.05, 0.1]},
+    })  # fmt: skip
+    ds = classify_in_process(spec)
+    try:
+        ax = ds.rollingtop.plot(x="model", y="a3")
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["meridian", "rough"]
+        (mesh,) = ax.collections
+        np.testing.assert_array_equal(mesh.get_array(), ds["n_steady"].values.T)
+        ax = ds.rollingtop.plot(x="a3", model="rough")
+        assert ax.get_title().endswith("at model = rough")
+        np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(),
+                                      ds["n_steady"].sel(model="rough").values)  # fmt: skip
+    finally:
+        plt.close("all")
+
+
+def test_a_dataset_that_is_no_atlas_is_refused_by_the_accessor():
+    with pytest.raises(AtlasError, match="not an atlas of rollingtop.atlas"):
+        xr.Dataset({"x": ("t", [1.0])}).rollingtop  # noqa: B018

@@ -102,3 +102,70 @@ def test_failed_write_leaves_nothing(traj, tmp_path, monkeypatch):
 def test_bad_output_path(traj, tmp_path, name, message):
     with pytest.raises(OutputError, match=message):
         traj.save(tmp_path / name)
+
+
+# ---- in a notebook -------------------------------------------------------------------------
+def test_repr_is_one_short_line(traj):
+    text = repr(traj)
+    assert text == f"<Trajectory: meridian model, t = 0 .. 5, {len(traj.t)} samples>"
+
+
+def test_html_view_shows_each_integrals_drift(traj):
+    """Every first integral's initial value and its largest drift, absolute and relative to the
+    initial value, as recomputed here from the samples; the body, the run, the contact."""
+    from .html_view import num, read
+
+    view = read(traj._repr_html_())
+    assert view.title == "rollingtop.Trajectory" and view.subtitle.startswith("meridian model")
+    (body,) = view.records("body")
+    assert {k: num(v) for k, v in body.items()} == pytest.approx(traj.body.to_dict(), rel=1e-5)
+    (motion,) = view.records("motion")
+    assert int(motion["samples"]) == len(traj.t) == 51 and num(motion["t_end"]) == traj.t[-1]
+    assert int(motion["steps"]) == traj.stats["steps"]
+    rows = {row["integral"]: row for row in view.records("first integrals along the samples")}
+    assert set(rows) == set(traj.integrals) == {"energy", "lagrange", "jellett", "area", "F6"}
+    for name, values in traj.integrals.items():
+        drift = float(np.max(np.abs(values - values[0])))
+        row = rows[name]
+        assert num(row["initial"]) == pytest.approx(values[0], rel=5e-6)
+        assert num(row["max |I - I0|"]) == pytest.approx(drift, rel=5e-3)
+        assert num(row["max |I - I0| / |I0|"]) == pytest.approx(drift / abs(values[0]), rel=5e-3)
+        assert drift / abs(values[0]) < 1e-8  # rtol 1e-10 over 5 time units
+    (contact,) = view.records("contact")
+    least = min(np.min(traj.normal_force), traj.step_reactions["min_normal_force"])
+    assert num(contact["min normal force"]) == pytest.approx(least, rel=5e-6)
+    assert contact["contact lost at"] == "–"
+
+
+def test_plot_draws_each_panel_of_the_command_lines_figures(traj):
+    """``path``: the contact point's and the centre of mass's paths (``rollingtop path``);
+    ``gamma3``, ``drift``, ``reactions``: the panels of ``rollingtop plot``."""
+    import matplotlib.pyplot as plt
+    from matplotlib.axes import Axes
+
+    from rollingtop import RollingTopError
+
+    def line(ax, label):
+        (found,) = [ln for ln in ax.get_lines() if ln.get_label() == label]
+        return np.column_stack(found.get_data()).astype(float)
+
+    try:
+        ax = traj.plot()
+        assert isinstance(ax, Axes)
+        np.testing.assert_array_equal(line(ax, "contact point"), traj.contact_point)
+        np.testing.assert_array_equal(line(ax, "centre of mass"), traj.position)
+        ax = traj.plot(kind="drift")
+        for name, values in traj.integrals.items():
+            drift = np.abs(values - values[0]) / np.max(np.abs(values))
+            np.testing.assert_allclose(line(ax, name)[:, 1], np.maximum(drift, 1e-17), rtol=1e-12)
+        assert ax.get_yscale() == "log" and ax.get_xlabel() == "t"
+        _, given = plt.subplots()
+        assert traj.plot(ax=given, kind="gamma3") is given
+        (g3,) = given.get_lines()
+        np.testing.assert_array_equal(g3.get_ydata(), traj.gamma[:, 2])
+        ax = traj.plot(kind="reactions")
+        np.testing.assert_allclose(line(ax, "normal force N")[:, 1], traj.normal_force)
+        with pytest.raises(RollingTopError, match="kind = 'energy': one of 'path'"):
+            traj.plot(kind="energy")
+    finally:
+        plt.close("all")

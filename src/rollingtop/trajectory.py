@@ -13,10 +13,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rollingtop._compiled import for_code
+from rollingtop._errors import RollingTopError
+from rollingtop._html import trajectory_html
 from rollingtop._jit import call
 from rollingtop._json import finite_or_none
 from rollingtop._layout import ALPHA, BETA, GAMMA, MAX_ROWS, N_STATE, POSITION, V, W
-from rollingtop._output import NetCDFOutput
+from rollingtop._output import TRAJECTORY_UNITS, NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, kernel_by_code
@@ -26,34 +28,11 @@ from rollingtop.io import check_output_path, write_bytes_atomic
 
 if TYPE_CHECKING:
     import xarray as xr
+    from matplotlib.axes import Axes
 
 __all__ = ["Trajectory", "OUTPUT_SUFFIXES"]
 
 OUTPUT_SUFFIXES = (".nc", ".csv")
-
-_UNITS = {
-    "t": "T",
-    "v": "L T-1",
-    "omega": "T-1",
-    "alpha": "1",
-    "beta": "1",
-    "gamma": "1",
-    "position": "L",
-    "contact_point": "L",
-    "normal_force": "M L T-2",
-    "tangential_force": "M L T-2",
-    "constraint_residual": "L T-1",
-    "orthonormality_error": "1",
-    "energy": "M L2 T-2",
-    "lagrange": "M L2 T-1",
-    "jellett": "M L3 T-1",
-    "area": "M L2 T-1",
-    "F6": "M L3 T-1",
-    "momentum_x": "M L T-1",
-    "momentum_y": "M L T-1",
-    "routh": "M L2 T-1",
-    "rubber_spin": "M L2 T-1",
-}
 
 
 @dataclass
@@ -277,6 +256,28 @@ class Trajectory(NetCDFOutput):
             },
         }
 
+    # ---- notebooks ---------------------------------------------------------------------------
+    def __repr__(self) -> str:
+        return (f"<Trajectory: {self.model.name} model, t = {self.t[0]:g} .. {self.t[-1]:g}, "
+                f"{len(self.t)} samples>")  # fmt: skip
+
+    def _repr_html_(self) -> str:
+        """The notebook's view of :meth:`summary`: body, motion, each first integral's drift."""
+        head = {"model": self.model.name, "description": self.model.description,
+                "samples": len(self.t), "rtol": self.rtol, "atol": self.atol}  # fmt: skip
+        return trajectory_html(self.summary(), self.body.to_dict(), head)
+
+    def plot(self, ax: Axes | None = None, *, kind: str = "path", **kw: Any) -> Axes:
+        """Draw the motion on ``ax`` (default: a new figure's) and return ``ax``: ``kind`` is
+        ``"path"`` (the paths on the plane of ``rollingtop path``; ``kw``: ``period_map``), or
+        ``"gamma3"``, ``"drift"`` (the first integrals' relative drift), ``"reactions"``: the
+        panels of ``rollingtop plot`` (:data:`rollingtop.plot.paths.PANELS`)."""
+        from rollingtop.plot.paths import PANELS
+
+        if kind not in PANELS:
+            raise RollingTopError(f"kind = {kind!r}: one of {', '.join(map(repr, PANELS))}")
+        return PANELS[kind](ax, self, **kw)
+
     # ---- export -----------------------------------------------------------------------------
     def _attrs(self) -> dict[str, str | float]:
         attrs: dict[str, str | float] = {f"body_{k}": v for k, v in self.body.to_dict().items()}
@@ -332,7 +333,7 @@ class Trajectory(NetCDFOutput):
             },
             attrs=self._attrs(),
         )
-        for name, units in _UNITS.items():
+        for name, units in TRAJECTORY_UNITS.items():
             if name in ds.variables:
                 ds[name].attrs["units"] = units
         ds["t"].attrs["long_name"] = "time"

@@ -20,10 +20,12 @@ an ``[axes]`` table whose keys are body or level keys, each a list of values or
 
 The package's modules, each imported only by those after it: :mod:`._cells` (the classification
 of a chunk of cells, one Dask task), :mod:`._spec` (the spec and its validation), :mod:`._store`
-(the partial folder and the output), :mod:`._run` (the run on Dask).
+(the partial folder and the output), :mod:`._run` (the run on Dask); :mod:`._display` registers
+``ds.rollingtop`` on xarray's Datasets (an atlas's summary in a notebook and its ``plot()``).
 """
 
 from rollingtop.atlas._cells import BODY_KEYS, FIELDS, LEVEL_KEYS, MAX_CENTRES, classify_cells
+from rollingtop.atlas._display import AtlasAccessor
 from rollingtop.atlas._run import atlas, classify_in_process
 from rollingtop.atlas._spec import (
     ATLAS_VERSION,
@@ -52,6 +54,7 @@ __all__ = [
     "MAX_SPEC_BYTES",
     "MAX_WORKERS_PER_CORE",
     "STATUS",
+    "AtlasAccessor",
     "AtlasError",
     "AtlasSpec",
     "atlas",

@@ -5,21 +5,25 @@ models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, the ro
 - :mod:`.variables`: full state <-> reduced variables and integrals.
 - :mod:`.system`: the reduced system (eq. 3.3).
 - :mod:`.level`: level sets ``(M3, C1, C2)`` and the effective potential ``U``.
-- :mod:`.steady`: steady motions (critical points of ``U``).
+- :mod:`.steady`: steady motions (critical points of ``U``), as a list that knows its level
+  (:class:`~.steady.SteadyMotions`).
 - :mod:`.orbits`: orbits on ``(M3, C1, C2, h)``, turning points, periods; the quadrature of
   the time along an orbit is the private :mod:`._quadrature`, and :class:`~.orbits.Orbit` with
-  its turning points (shared with :mod:`.no_spin`) the private :mod:`._orbit`.
+  its turning points and :class:`~.orbits.Orbits` (the list of one energy; shared with
+  :mod:`.no_spin`) the private :mod:`._orbit`.
+- In a notebook the levels, their steady motions and orbits and the bifurcation diagrams show
+  themselves as HTML tables and draw themselves (``.plot()``): the private :mod:`._display`.
 - :mod:`.no_spin`, :mod:`.near_pole`: the no-spin level and levels near a pole level.
 """
 
 from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
 from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
-from rollingtop.reduction.orbits import Orbit, orbits
+from rollingtop.reduction.orbits import Orbit, Orbits, orbits
 from rollingtop.reduction.rough import RoughLevel
 from rollingtop.reduction.rubber import RubberLevel
 from rollingtop.reduction.shell_rotor import ShellRotorLevel
 from rollingtop.reduction.smooth import SmoothLevel
-from rollingtop.reduction.steady import SteadyMotion, steady_motions
+from rollingtop.reduction.steady import SteadyMotion, SteadyMotions, steady_motions
 from rollingtop.reduction.system import integrate_reduced, reduced_integrals_of, reduced_rhs
 from rollingtop.reduction.variables import (
     euler_angles,
@@ -34,6 +38,7 @@ __all__ = [
     "LevelSet",
     "LevelSetError",
     "Orbit",
+    "Orbits",
     "REDUCTIONS",
     "Reduction",
     "RoughLevel",
@@ -41,6 +46,7 @@ __all__ = [
     "ShellRotorLevel",
     "SmoothLevel",
     "SteadyMotion",
+    "SteadyMotions",
     "euler_angles",
     "integrate_reduced",
     "orbits",

@@ -1,19 +1,23 @@
-"""One orbit of a level set (:class:`Orbit`), its turning points and the tolerances that decide
-its kind: shared by :mod:`.orbits` (every level) and :mod:`.no_spin` (the no-spin level, to
-which :func:`~rollingtop.reduction.orbits.orbits` hands it), and re-exported by
-:mod:`.orbits`."""
+"""One orbit of a level set (:class:`Orbit`), the orbits of one energy (:class:`Orbits`), its
+turning points and the tolerances that decide its kind: shared by :mod:`.orbits` (every level)
+and :mod:`.no_spin` (the no-spin level, to which :func:`~rollingtop.reduction.orbits.orbits`
+hands it), and re-exported by :mod:`.orbits`."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet
 
-__all__ = ["SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE", "Orbit", "turning_point"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE", "Orbit", "Orbits", "turning_point"]
 
 #: ``|h - U(saddle)|`` below this (relative to the scale of ``U``) is on the separatrix.
 SEPARATRIX_TOLERANCE = 1e-10
@@ -76,6 +80,40 @@ class Orbit:
         """``theta`` runs round the whole circle (no spin, above the upright pole's energy):
         the orbit has no turning points and ``theta_min``, ``theta_max`` are a full turn apart."""
         return self.theta_max - self.theta_min >= 2 * math.pi * (1 - 1e-12)
+
+
+class Orbits(list[Orbit]):
+    """The orbits of a level set at one reduced energy (:func:`~rollingtop.reduction.orbits`): a
+    list, which also knows its :attr:`level` and :attr:`h`, shows itself as a table in a
+    notebook and draws itself (:meth:`plot`).
+
+    Attributes
+    ----------
+    level : LevelSet
+    h : float
+        The reduced energy.
+    """
+
+    def __init__(self, found: Iterable[Orbit], level: LevelSet, h: float) -> None:
+        super().__init__(found)
+        self.level = level
+        self.h = h
+
+    def _repr_html_(self) -> str:
+        """The notebook's view: the level, ``h`` and the full energy, a row per orbit (turning
+        points, period, kind; ``rollingtop orbits``' table)."""
+        from rollingtop.reduction._display import orbits_html
+
+        return orbits_html(self)
+
+    def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
+        """Draw the orbits in ``(gamma3, w_tau)`` with the level's steady motions on ``ax``
+        (default: a new figure's) and return ``ax``: ``rollingtop portrait --h-levels h``'s
+        upper panel (:func:`rollingtop.plot.portrait.draw_portrait`, which takes ``kw``:
+        ``show_contact``, ``legend``)."""
+        from rollingtop.reduction._display import plot_orbits
+
+        return plot_orbits(self, ax, **kw)
 
 
 def turning_point(level: LevelSet, h: float, a: float, b: float) -> float:

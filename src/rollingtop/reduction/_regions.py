@@ -1,17 +1,67 @@
-"""The regions of a bifurcation diagram (:mod:`rollingtop.reduction.bifurcation`): which
-periodic orbits a level ``h`` holds, grouped by the centres they enclose, and which pass through
-the pole."""
+"""The regions of a bifurcation diagram (:mod:`rollingtop.reduction.bifurcation`): a
+:class:`Region`, which periodic orbits a level ``h`` holds, grouped by the centres they enclose,
+and which pass through the pole."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rollingtop.reduction._critical_curves import FloatArray, _base_level, _critical
 from rollingtop.reduction.level import LevelSet
+
+
+@dataclass(frozen=True)
+class Region:
+    """A connected region of the ``(C2, h)`` plane in which every level holds the same orbits.
+
+    Attributes
+    ----------
+    name : str
+        ``"A"``, ``"B"``, ... in order of the representative point's ``C2``, then ``h``.
+    signature : tuple of int
+        Centres inside each periodic orbit, in order of increasing ``gamma3``
+        (:func:`region_signature`).
+    label : str
+        The signature in words.
+    C2, h : float
+        A representative level: the middle of the region's interval of ``h`` in its middle
+        column.
+    centre_gamma3 : tuple of tuple of float
+        At the representative level: ``gamma3`` of the centres inside each orbit.
+    through_pole : tuple of bool
+        Whether each orbit passes through the pole (pole levels ``C1 = +-M3`` only).
+    C2_range, h_range : tuple of float
+        The extent of the region on the grid.
+    cells : int
+        The number of columns (values of ``C2`` on the grid) it spans.
+    """
+
+    name: str
+    signature: tuple[int, ...]
+    label: str
+    C2: float
+    h: float
+    centre_gamma3: tuple[tuple[float, ...], ...]
+    through_pole: tuple[bool, ...]
+    C2_range: tuple[float, float]
+    h_range: tuple[float, float]
+    cells: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name, "label": self.label, "orbits": len(self.signature),
+            "centres_per_orbit": list(self.signature), "C2": self.C2, "h": self.h,
+            "centre_gamma3": [list(g) for g in self.centre_gamma3],
+            "through_pole": list(self.through_pole),
+            "C2_range": list(self.C2_range), "h_range": list(self.h_range), "cells": self.cells,
+        }  # fmt: skip
+
 
 #: Marks an orbit (a tuple of centre indices) that passes through the pole.
 THROUGH_POLE = -1

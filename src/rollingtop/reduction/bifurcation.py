@@ -40,11 +40,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop._html import count
 from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction._critical_curves import (
@@ -63,6 +64,7 @@ from rollingtop.reduction._critical_curves import (
 from rollingtop.reduction._regions import (
     POLE_CUT,
     THROUGH_POLE,
+    Region,
     _centres,
     _orbits_at,
     _pole,
@@ -72,6 +74,9 @@ from rollingtop.reduction._regions import (
 )
 from rollingtop.reduction._steady_map import SteadyCountMap, steady_count_map
 from rollingtop.reduction.level import LevelSet, LevelSetError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = [
     "BifurcationDiagram",
@@ -93,53 +98,6 @@ FloatArray = NDArray[np.float64]
 
 #: Critical values closer than this (relative) are one value: no region between them.
 EQUAL_VALUES = 1e-9
-
-
-@dataclass(frozen=True)
-class Region:
-    """A connected region of the ``(C2, h)`` plane in which every level holds the same orbits.
-
-    Attributes
-    ----------
-    name : str
-        ``"A"``, ``"B"``, ... in order of the representative point's ``C2``, then ``h``.
-    signature : tuple of int
-        Centres inside each periodic orbit, in order of increasing ``gamma3``
-        (:func:`region_signature`).
-    label : str
-        The signature in words.
-    C2, h : float
-        A representative level: the middle of the region's interval of ``h`` in its middle
-        column.
-    centre_gamma3 : tuple of tuple of float
-        At the representative level: ``gamma3`` of the centres inside each orbit.
-    through_pole : tuple of bool
-        Whether each orbit passes through the pole (pole levels ``C1 = +-M3`` only).
-    C2_range, h_range : tuple of float
-        The extent of the region on the grid.
-    cells : int
-        The number of columns (values of ``C2`` on the grid) it spans.
-    """
-
-    name: str
-    signature: tuple[int, ...]
-    label: str
-    C2: float
-    h: float
-    centre_gamma3: tuple[tuple[float, ...], ...]
-    through_pole: tuple[bool, ...]
-    C2_range: tuple[float, float]
-    h_range: tuple[float, float]
-    cells: int
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "name": self.name, "label": self.label, "orbits": len(self.signature),
-            "centres_per_orbit": list(self.signature), "C2": self.C2, "h": self.h,
-            "centre_gamma3": [list(g) for g in self.centre_gamma3],
-            "through_pole": list(self.through_pole),
-            "C2_range": list(self.C2_range), "h_range": list(self.h_range), "cells": self.cells,
-        }  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -187,6 +145,26 @@ class BifurcationDiagram:
             "h_range": [float(self.h_grid[0]), float(self.h_grid[-1])],
             "grid": [len(self.C2_grid), len(self.h_grid)],
         })  # fmt: skip
+
+    def __repr__(self) -> str:
+        return (f"<BifurcationDiagram: M3 = {self.M3:g}, C1 = {self.C1:g}; "
+                f"{count(len(self.folds), 'fold')}, {count(len(self.regions), 'region')} in C2 = "
+                f"{self.C2_grid[0]:g} .. {self.C2_grid[-1]:g}, h = {self.h_grid[0]:g} .. "
+                f"{self.h_grid[-1]:g}>")  # fmt: skip
+
+    def _repr_html_(self) -> str:
+        """The notebook's view: body, window, the folds and the regions (their orbits)."""
+        from rollingtop.reduction._display import diagram_html
+
+        return diagram_html(self)
+
+    def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
+        """Draw the diagram of ``rollingtop bifurcation`` (its main panel, without the
+        thumbnails) on ``ax`` (default: a new figure's) and return ``ax``; ``kw`` go to
+        :func:`rollingtop.plot.bifurcation.draw_bifurcation` (``mark_C2``)."""
+        from rollingtop.reduction._display import plot_diagram
+
+        return plot_diagram(self, ax, **kw)
 
 
 def _default_c2_range(level: LevelSet, fs: Sequence[Fold]) -> tuple[float, float]:

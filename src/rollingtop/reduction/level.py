@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, TypeAlias, overload
+from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,6 +39,9 @@ from rollingtop.reduction._services import (
     check_level_size,
     check_level_values,
 )
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["LevelSet", "LevelSetError", "POLE_TOLERANCE", "PoleLevelError", "Real", "near_north"]
 
@@ -367,6 +370,20 @@ class LevelSet(LevelServices):
     def describe(self) -> str:
         """One line naming the level set."""
         return f"M3 = {self.M3:g}, C1 = {self.C1:g}, C2 = {self.C2:g}{self.pole_label()}"
+
+    def _repr_html_(self) -> str:
+        """The notebook's view: model, integrals, body, the steady motions' count."""
+        from rollingtop.reduction._display import level_html
+
+        return level_html(self)
+
+    def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
+        """Draw the phase portrait of ``rollingtop portrait`` (upper panel) on ``ax`` (default:
+        a new figure's) and return ``ax``; ``kw`` go to
+        :func:`rollingtop.plot.portrait.draw_portrait` (``h_levels``, ``show_contact``)."""
+        from rollingtop.reduction._display import plot_level
+
+        return plot_level(self, ax, **kw)
 
 
 def near_north(level: LevelSet) -> bool:

@@ -28,6 +28,7 @@ from rollingtop.reduction._orbit import (
     SEPARATRIX_TOLERANCE,
     STEADY_TOLERANCE,
     Orbit,
+    Orbits,
     turning_point,
 )
 from rollingtop.reduction._quadrature import PERIOD_RTOL, WALL_RATIO, half_integral, period
@@ -35,7 +36,7 @@ from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
 from rollingtop.reduction.no_spin import no_spin_orbits
 from rollingtop.reduction.steady import SteadyMotion, critical_points, steady_motion
 
-__all__ = ["Orbit", "orbits", "period", "half_integral", "canonical_orbit", "near_north"]
+__all__ = ["Orbit", "Orbits", "orbits", "period", "half_integral", "canonical_orbit", "near_north"]
 __all__ += ["PERIOD_RTOL", "WALL_RATIO", "SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE"]
 
 
@@ -55,8 +56,9 @@ def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
     )
 
 
-def orbits(level: LevelSet, h: float) -> list[Orbit]:
-    """All connected components of the level set ``(M3, C1, C2, h)``, sorted by ``gamma3_min``.
+def orbits(level: LevelSet, h: float) -> Orbits:
+    """All connected components of the level set ``(M3, C1, C2, h)``, sorted by ``gamma3_min``
+    (a list that knows ``level`` and ``h``: :class:`Orbits`).
 
     A level nearer the north pole level than the south one is computed on its mirror image
     (:meth:`LevelSet.mirrored`), where the distance of the wall from the pole is ``theta``
@@ -71,11 +73,11 @@ def orbits(level: LevelSet, h: float) -> list[Orbit]:
         raise LevelSetError(f"level h = {h!r} must be a finite number")
     h = float(h)
     if level.pole == "both":
-        return no_spin_orbits(level, h)
+        return Orbits(no_spin_orbits(level, h), level, h)
     if near_north(level):
         mirrored = [_mirror(o) for o in _orbits(level.mirrored(), h)]
-        return sorted(mirrored, key=lambda o: (o.gamma3_min, o.theta_min))
-    return _orbits(level, h)
+        return Orbits(sorted(mirrored, key=lambda o: (o.gamma3_min, o.theta_min)), level, h)
+    return Orbits(_orbits(level, h), level, h)
 
 
 def _mirror(o: Orbit) -> Orbit:

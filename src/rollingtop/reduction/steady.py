@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,7 +22,10 @@ from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
 
-__all__ = ["SteadyMotion", "steady_motions", "critical_points"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["SteadyMotion", "SteadyMotions", "steady_motions", "critical_points"]
 
 #: Points of the theta grid on which sign changes of dU/dtheta are looked for.
 GRID_POINTS = 20_001
@@ -83,6 +87,36 @@ class SteadyMotion:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite values become ``None``)."""
         return json_ready(asdict(self))
+
+
+class SteadyMotions(list[SteadyMotion]):
+    """The steady motions of a level set (:func:`steady_motions`): a list, which also knows its
+    :attr:`level`, shows itself as a table in a notebook and draws itself (:meth:`plot`).
+
+    Attributes
+    ----------
+    level : LevelSet
+    """
+
+    def __init__(self, motions: Iterable[SteadyMotion], level: LevelSet) -> None:
+        super().__init__(motions)
+        self.level = level
+
+    def _repr_html_(self) -> str:
+        """The notebook's view: the count by type and a row per motion (``rollingtop
+        equilibria``'s table)."""
+        from rollingtop.reduction._display import steady_html
+
+        return steady_html(self)
+
+    def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
+        """Draw ``U`` with each steady motion at its energy on ``ax`` (default: a new figure's)
+        and return ``ax``: the lower panel of ``rollingtop portrait``
+        (:func:`rollingtop.plot.portrait.draw_potential`, which takes ``kw``: ``h_levels``,
+        ``window``)."""
+        from rollingtop.reduction._display import plot_steady
+
+        return plot_steady(self, ax, **kw)
 
 
 def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
@@ -211,8 +245,9 @@ def flat_potential(level: LevelSet) -> bool:
     return bool(np.all(d == 0.0))
 
 
-def steady_motions(level: LevelSet) -> list[SteadyMotion]:
-    """Every steady motion on the level set, sorted by ``gamma3``.
+def steady_motions(level: LevelSet) -> SteadyMotions:
+    """Every steady motion on the level set, sorted by ``gamma3`` (a list that knows
+    ``level``: :class:`SteadyMotions`).
 
     In a pole case the list may include motions on the negative-``s`` branch (after a pole
     passage); their ``theta`` lies outside ``(0, pi)``.
@@ -233,7 +268,7 @@ def steady_motions(level: LevelSet) -> list[SteadyMotion]:
         motions = [_mirror(m) for m in steady_motions(level.mirrored())]
     else:
         motions = [steady_motion(level, float(t)) for t in critical_points(level)]
-    return sorted(motions, key=lambda m: (m.gamma3, m.theta))
+    return SteadyMotions(sorted(motions, key=lambda m: (m.gamma3, m.theta)), level)
 
 
 def _mirror(m: SteadyMotion) -> SteadyMotion:
