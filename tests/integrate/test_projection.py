@@ -165,3 +165,75 @@ def test_a_failed_projection_is_an_error_with_its_reason():
     ctrl = np.array([12.5, 0.1, 100.0, 1e-10, 1e-12, 0.0])
     with pytest.raises(IntegrationError, match="projection onto the integrals.*t = 12.5"):
         _raise_for_status(dop.PROJECTION_FAILED, ctrl, np.zeros(dop.N_COUNTS, dtype=np.int64))
+
+
+# ---- the normal force between steps (issue 26, item 3) ---------------------------------------
+
+#: The meridian state whose normal force dips to about -0.002 near t = 0.894 (omega x 2.95).
+DIP_OMEGA = 2.95 * np.array([0.7, -0.3, 2.0])
+
+
+def _dip_state(body):
+    return initial_state(body, "meridian", gamma=GAMMA0, omega=DIP_OMEGA, free=FREE["meridian"])
+
+
+def test_the_normal_force_between_steps_is_the_reference_solutions(paper_body):
+    """The monitored minimum of the normal force and the first loss of contact, against the
+    plain equations (tests/dynamics/reference.py) integrated by solve_ivp at rtol 1e-12 and
+    sampled densely (the minimum refined by Brent's method, the loss by brentq on the dense
+    solution), to 1e-8; the package's run at its default tolerance, 1e-10."""
+    import warnings
+
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq, minimize_scalar
+
+    from ..dynamics import reference
+
+    y0 = _dip_state(paper_body)
+    p = paper_body.params
+    sol = solve_ivp(lambda t, y: reference.rhs("meridian", p, y)[0], (0.0, 1.5), y0,
+                    method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)  # fmt: skip
+
+    def normal(t):
+        return reference.reactions("meridian", p, sol.sol(t))[0]
+
+    ts = np.linspace(0.0, 1.5, 3001)
+    ns = np.array([normal(t) for t in ts])
+    k = int(np.argmin(ns))
+    best = minimize_scalar(normal, bracket=(ts[k - 1], ts[k], ts[k + 1]), tol=1e-12)
+    first = int(np.flatnonzero(ns < 0)[0])
+    t_lost = brentq(normal, ts[first - 1], ts[first], xtol=1e-14)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the ContactLostWarning: the point of the test
+        tr = simulate(paper_body, "meridian", y0, t_end=1.5, samples=3)
+    sr = tr.step_reactions
+    assert sr["min_normal_force"] == pytest.approx(best.fun, abs=1e-8)
+    assert sr["t_min_normal_force"] == pytest.approx(best.x, abs=1e-5)  # a flat minimum
+    assert sr["contact_lost_at"] == pytest.approx(t_lost, abs=1e-8)
+
+
+def test_a_dip_below_zero_inside_a_step_is_found_on_the_dense_output(paper_body):
+    """At rtol 1e-3 (steps of ~0.15 time units) the dip of the normal force below zero lasts
+    less than a step: its loss of contact is found inside the step, at a root of the normal
+    force on the dense interpolant to 1e-10 (the interpolant sampled just before and after:
+    the same steps, since the samples do not change them)."""
+    from rollingtop._compiled import for_code
+    from rollingtop.integrate import integrate
+
+    y0 = _dip_state(paper_body)
+    p = paper_body.params
+    run = integrate(0, p, y0, np.array([0.0, 1.5]), rtol=1e-3, atol=1e-5)
+    t_lost = run.reactions["contact_lost_at"]
+    assert t_lost is not None and run.steps < 20
+    probe = integrate(0, p, y0, np.array([0.0, t_lost - 1e-10, t_lost + 1e-10, 1.5]),
+                      rtol=1e-3, atol=1e-5)  # fmt: skip
+    assert probe.steps == run.steps
+    diag = np.zeros((4, 8))
+    call(for_code(0).dynamics.diagnostics, 0, p, np.ascontiguousarray(probe.y), diag)
+    assert diag[1, 0] >= 0.0 > diag[2, 0]
+    # the dip is shorter than the steps around it: sampled at 2001 points of the interpolant
+    dense = integrate(0, p, y0, np.linspace(0.0, 1.5, 2001), rtol=1e-3, atol=1e-5)
+    diag = np.zeros((2001, 8))
+    call(for_code(0).dynamics.diagnostics, 0, p, np.ascontiguousarray(dense.y), diag)
+    below = np.linspace(0.0, 1.5, 2001)[diag[:, 0] < 0]
+    assert below.size and below[-1] - below[0] < 1.5 / run.steps

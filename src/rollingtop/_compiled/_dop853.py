@@ -77,15 +77,33 @@ NEXT_SAMPLE, STEPS, REJECTED, NFEV, N_EVENTS, PROJ_PASSES, PROJ_DEFERRED = 0, 1,
 N_COUNTS = 7
 # Indices into the integer event specification ``ev_spec``.
 EV_CODE, EV_DIRECTION = 0, 1
-# Indices into the reaction-tracking array ``track``.
+# Indices into the reaction-tracking array ``track``: the normal force at the last accepted step
+# and, for the dips between steps, the one before it (``PREV_NORMAL`` at ``PREV_T``).
 MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 0, 1, 2, 3, 4, 5
+PREV_T, PREV_NORMAL = 6, 7
 
 
 @compiled()
 def new_track() -> FloatArray:
     """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
-    the normal force at the last accepted step."""
-    return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan])
+    the normal force at the last accepted step, the time and normal force of the one before."""
+    return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan, np.nan, np.nan])
+
+
+@kernel
+def dip_predicted(t0: float, n0: float, t1: float, n1: float, t2: float, n2: float) -> bool:
+    """Whether the parabola through the normal force at the last three step ends ``t0 < t1 <
+    t2`` has its minimum inside the last step ``(t1, t2)``: the force may dip there below both
+    ends, which the dense output then resolves (:func:`.dense.dip_minimum`)."""
+    if not (math.isfinite(t0) and math.isfinite(n0)):
+        return False
+    d1 = (n1 - n0) / (t1 - t0)
+    d2 = (n2 - n1) / (t2 - t1)
+    a = (d2 - d1) / (t2 - t0)  # half the second derivative
+    if not a > 0.0:
+        return False
+    vertex = 0.5 * (t1 + t2) - 0.5 * d2 / a  # where the parabola's slope vanishes
+    return t1 < vertex < t2
 
 
 @kernel

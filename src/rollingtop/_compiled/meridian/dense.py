@@ -12,6 +12,8 @@ first loss of contact and the zeros of an event function. Called by the stepper
 
 from __future__ import annotations
 
+import math
+
 from rollingtop._compiled._dop853_dense import dense_eval
 from rollingtop._compiled._dop853_stages import stage
 from rollingtop._compiled._dop853_tableau import D
@@ -78,6 +80,87 @@ def normal_root(
         else:
             hi = mid
     return t + 0.5 * (lo + hi) * h
+
+
+#: Interior points of a step where the normal force is sampled when a dip is predicted, and the
+#: golden-section iterations that then refine its minimum.
+DIP_SAMPLES = 8
+DIP_REFINE = 40
+_GOLDEN = 0.3819660112501051
+
+
+@kernel
+def normal_at(
+    code: int, p: FloatArray, Fd: FloatArray, y: FloatArray, x: float, ytmp: FloatArray,
+    dy: FloatArray, ws: Workspace,
+) -> tuple[float, float]:  # fmt: skip
+    """The contact force ``(N, |F_t|)`` at the fraction ``x`` of the step, on the dense output
+    (projected onto the constraints, as the samples are)."""
+    dense_eval(Fd, y, x, ytmp)
+    project(code, p, ytmp, ws)
+    nc = rhs(code, p, ytmp, dy, ws)
+    return reaction(nc, ytmp, ws)
+
+
+@kernel
+def dip_minimum(
+    code: int, p: FloatArray, Fd: FloatArray, y: FloatArray, t: float, h: float,
+    ytmp: FloatArray, dy: FloatArray, ws: Workspace, found: FloatArray,
+) -> int:  # fmt: skip
+    """The normal force's minimum inside the step ``[t, t + h]`` on the dense output: sampled at
+    :data:`DIP_SAMPLES` - 1 interior points, the best one refined by golden sections. Writes
+    ``found = (t_min, N_min, t_lost)`` (``t_lost``: where the force first turns negative, by
+    bisection between the last positive sample and the first negative one; NaN if it does not)
+    and returns the right-hand sides evaluated. Each evaluation is also handed to the
+    friction-ratio tracking by the caller through ``found[3:5]`` (the largest ``|F_t| / N``
+    and its time)."""
+    best_x, best_n = 0.0, math.inf
+    found[2] = math.nan
+    found[3], found[4] = 0.0, math.nan
+    x_pos = 0.0
+    evals = 0
+    for j in range(1, DIP_SAMPLES):
+        x = j / DIP_SAMPLES
+        n_x, tf = normal_at(code, p, Fd, y, x, ytmp, dy, ws)
+        evals += 1
+        if n_x > 0.0 and tf / n_x > found[3]:
+            found[3], found[4] = tf / n_x, t + x * h
+        if n_x < best_n:
+            best_x, best_n = x, n_x
+        if n_x < 0.0 and math.isnan(found[2]):
+            lo, hi = x_pos, x
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                n_mid, _ = normal_at(code, p, Fd, y, mid, ytmp, dy, ws)
+                if n_mid >= 0.0:
+                    lo = mid
+                else:
+                    hi = mid
+            evals += 60
+            found[2] = t + 0.5 * (lo + hi) * h
+        if n_x >= 0.0 and math.isnan(found[2]):
+            x_pos = x
+    a = max(0.0, best_x - 1.0 / DIP_SAMPLES)
+    b = min(1.0, best_x + 1.0 / DIP_SAMPLES)
+    c = a + _GOLDEN * (b - a)
+    d = b - _GOLDEN * (b - a)
+    fc, _ = normal_at(code, p, Fd, y, c, ytmp, dy, ws)
+    fd, _ = normal_at(code, p, Fd, y, d, ytmp, dy, ws)
+    for _ in range(DIP_REFINE):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = a + _GOLDEN * (b - a)
+            fc, _ = normal_at(code, p, Fd, y, c, ytmp, dy, ws)
+        else:
+            a, c, fc = c, d, fd
+            d = b - _GOLDEN * (b - a)
+            fd, _ = normal_at(code, p, Fd, y, d, ytmp, dy, ws)
+    evals += DIP_REFINE + 2
+    x_min, n_min = (c, fc) if fc < fd else (d, fd)
+    if n_min > best_n:
+        x_min, n_min = best_x, best_n
+    found[0], found[1] = t + x_min * h, n_min
+    return evals
 
 
 @kernel

@@ -32,6 +32,7 @@ from rollingtop._compiled._dop853 import (
     H_ABS,
     LAST_NORMAL,
     MAX_FACTOR,
+    MAX_RATIO,
     MAX_REJECTED_IN_A_ROW,
     MIN_FACTOR,
     N_COUNTS,
@@ -39,6 +40,8 @@ from rollingtop._compiled._dop853 import (
     NEXT_SAMPLE,
     NFEV,
     NOT_FINITE,
+    PREV_NORMAL,
+    PREV_T,
     PROJ_DEFERRED,
     PROJ_PASSES,
     PROJECTION_FAILED,
@@ -49,8 +52,10 @@ from rollingtop._compiled._dop853 import (
     STEPS,
     T_CONTACT_LOST,
     T_END,
+    T_MAX_RATIO,
     TOO_MANY_REJECTED,
     T,
+    dip_predicted,
     new_track,
     update_track,
 )
@@ -58,7 +63,12 @@ from rollingtop._compiled._dop853_dense import dense_eval
 from rollingtop._compiled._dop853_stages import scaled_errors, stage
 from rollingtop._compiled._kernel import reaction
 from rollingtop._compiled.meridian_variants._dispatch import INLINE_RHS
-from rollingtop._compiled.meridian_variants.dense import event_root, normal_root, prepare_dense
+from rollingtop._compiled.meridian_variants.dense import (
+    dip_minimum,
+    event_root,
+    normal_root,
+    prepare_dense,
+)
 from rollingtop._compiled.meridian_variants.dynamics import project, rhs, rhs_inline
 from rollingtop._compiled.meridian_variants.events import event_value
 from rollingtop._compiled.meridian_variants.invariants import WORK_ROWS, project_integrals
@@ -330,7 +340,8 @@ def run(
             if not math.isfinite(y[i]) or not math.isfinite(f[i]):
                 ctrl[T] = t_new
                 return NOT_FINITE
-        if N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and track[LAST_NORMAL] >= 0.0:
+        N_old = track[LAST_NORMAL]
+        if N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and N_old >= 0.0:
             # first loss of contact: locate N = 0 inside the step on the dense output
             if not dense_ready:
                 prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
@@ -338,6 +349,21 @@ def run(
                 dense_ready = True
             track[T_CONTACT_LOST] = normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
             counts[NFEV] += 60
+        elif dip_predicted(track[PREV_T], track[PREV_NORMAL], t, N_old, t_new, N):
+            # a minimum of the normal force inside the step: found on the dense output, with
+            # its loss of contact if it dips below zero between two positive ends
+            if not dense_ready:
+                prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
+                counts[NFEV] += 3
+                dense_ready = True
+            found = K[14]  # stages 14-16 are free once the dense output is built
+            counts[NFEV] += dip_minimum(code, p, Fd, y_old, t, h, ytmp, K[13], ws, found)
+            if not math.isnan(found[2]) and math.isnan(track[T_CONTACT_LOST]):
+                track[T_CONTACT_LOST] = found[2]
+            update_track(track, found[0], found[1], 0.0)
+            if found[3] > track[MAX_RATIO]:
+                track[MAX_RATIO], track[T_MAX_RATIO] = found[3], found[4]
+        track[PREV_T], track[PREV_NORMAL] = t, N_old
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
         if ev_spec[EV_CODE] != 0:
