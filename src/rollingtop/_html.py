@@ -20,7 +20,8 @@ STYLE = (
     ".rollingtop-repr .rt-title{font-weight:600}"
     ".rollingtop-repr .rt-sub{color:var(--jp-content-font-color2,#555)}"
     ".rollingtop-repr .rt-section{font-weight:600;margin:6px 0 1px 0}"
-    ".rollingtop-repr table{border-collapse:collapse;margin:0 0 2px 0;font-size:12px}"
+    ".rollingtop-repr table{border-collapse:collapse;margin:0 0 2px 0;font-size:12px;"
+    "display:table}"
     ".rollingtop-repr th,.rollingtop-repr td{padding:1px 10px 1px 0;border:none;"
     "text-align:right;white-space:nowrap}"
     ".rollingtop-repr th{font-weight:600}"
@@ -69,7 +70,8 @@ def table(header: Sequence[str] | None, rows: Iterable[Sequence[Any]]) -> str:
         for k, h in enumerate(header or ())
     )
     body = "".join("<tr>" + "".join(_cell(x) for x in row) + "</tr>" for row in listed)
-    return f"<table>{f'<tr>{head}</tr>' if head else ''}{body}</table>"
+    # a class of its own: themes that style every bare table (mkdocs-material) leave it alone
+    return f'<table class="rt-table">{f"<tr>{head}</tr>" if head else ""}{body}</table>'
 
 
 def row_table(values: Mapping[str, Any]) -> str:
