@@ -15,7 +15,9 @@ from rollingtop.reduction import orbits, steady_motions
 from .conftest import EXAMPLES, ROOT
 from .html_view import num, read
 
-nbclient = pytest.importorskip("nbclient")
+# the test extra's nbclient runs the tour on ipykernel's kernel
+nbclient = pytest.importorskip("nbclient", reason="needs the test extra: nbclient, ipykernel")
+pytest.importorskip("ipykernel", reason="needs the test extra: nbclient, ipykernel")
 
 TOUR = ROOT / "docs" / "tour.ipynb"
 #: Seconds any one cell may take (the whole tour: about 10).

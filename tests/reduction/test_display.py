@@ -125,6 +125,16 @@ def test_a_level_shows_its_integrals_body_and_steady_motions(levels, name):
     assert f"{len(maxima)} saddle" in line
 
 
+def test_a_level_without_isolated_steady_motions_says_why(body):
+    """A balanced body without spin: U is constant, steady_motions refuses the level, and the
+    view shows the refusal instead of a count."""
+    from dataclasses import replace
+
+    level = LevelSet(replace(body, a3=0.0), 0.0, 0.0, 0.5)
+    (line,) = read(level._repr_html_()).texts
+    assert line.startswith("U is constant (U = ") and "none is isolated" in line
+
+
 def test_steady_motions_show_each_motion(fig5):
     motions = steady_motions(fig5)
     view = read(motions._repr_html_())
