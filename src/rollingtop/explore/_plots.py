@@ -55,7 +55,8 @@ class Plots:
         )
         p.scatter("x", "y", source=self.start, marker="x", color="black", size=12)
         p.legend.location = "top_left"
-        u = self.potential = _figure("effective potential U", "gamma3", "U")
+        u = self.potential = _figure("effective potential U", "gamma3", "U",
+                                     y_range=Range1d(start=0.0, end=1.0))  # fmt: skip
         u.line("x", "y", source=self.U, color="black", line_width=1.5)
         u.scatter("x", "U", source=self.steady, color="colour", size=8)
         self.h_line = Span(location=0.0, dimension="width", line_color=_CURRENT, line_dash="dashed")
@@ -87,6 +88,26 @@ class Plots:
         self.clicked.data = {"x": [], "y": []}
         self.start.data = {"x": [], "y": []}
 
+    def shows_mark(self, x: float, h: float) -> bool:
+        """Whether the diagram's window holds the point ``(x, h)``."""
+        xr, yr = self.diagram.x_range, self.diagram.y_range
+        return bool(xr.start <= x <= xr.end and yr.start <= h <= yr.end)
+
+    def no_diagram(self, reason: str) -> None:
+        """No diagram for this level: its curves cleared, the reason in its title."""
+        for src in (self.centres, self.saddles, self.folds, self.floor):
+            src.data = {"x": [], "y": []}
+        self.diagram.title.text = f"no bifurcation diagram: {reason[:70]}"
+
+    def clear(self) -> None:
+        """Every source emptied (the page's session has gone)."""
+        for src in (self.back, self.current, self.section, self.start, self.clicked, self.U,
+                    self.centres, self.saddles, self.folds, self.floor, self.mark,
+                    self.path_source):  # fmt: skip
+            src.data = {"x": [], "y": []}
+        self.steady.data = {"x": [], "y": [], "U": [], "colour": []}
+        self.frame.object = None
+
     def move_mark(self, x: float, h: float) -> None:
         """The current level's point on the diagram."""
         self.mark.data = {"x": [x], "y": [h]}
@@ -115,8 +136,11 @@ class Plots:
         finite = np.isfinite(view.U_y)
         low = float(np.min(view.U_y[finite])) if finite.any() else state.h
         top = max(state.h, low) + max(1.0, abs(state.h - low))
-        keep = finite & (view.U_y <= top)
-        self.U.data = {"x": view.U_x[keep], "y": view.U_y[keep]}
+        shown = np.where(finite & (view.U_y <= top), view.U_y, np.nan)  # a gap where U is high
+        self.U.data = {"x": view.U_x, "y": shown}
+        lo, hi = min(low, state.h), top
+        pad = 0.05 * (hi - lo) or 1.0
+        self.potential.y_range.start, self.potential.y_range.end = lo - pad, hi + pad
         self.h_line.location = state.h
         for fig in (self.portrait, self.potential):
             fig.xaxis.axis_label = view.x_label
@@ -125,6 +149,7 @@ class Plots:
         """The critical values (centres solid, saddles dashed), folds, ``min U`` and the
         current level's point, in the diagram's window."""
         self.diagram.xaxis.axis_label = view.axis
+        self.diagram.title.text = "bifurcation diagram (click: move the level)"
         self.centres.data = {"x": view.centres[0], "y": view.centres[1]}
         self.saddles.data = {"x": view.saddles[0], "y": view.saddles[1]}
         self.folds.data = {"x": view.folds[0], "y": view.folds[1]}

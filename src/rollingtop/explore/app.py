@@ -37,6 +37,10 @@ __all__ = ["ExplorePage", "LOOKS"]
 LOOKS = ("plain", *DEVICES)
 
 
+def _ignore(*args: Any) -> None:
+    """A result nobody will see."""
+
+
 class ExplorePage:
     """The widgets, plots and callbacks of one session; :attr:`layout` is what Panel serves.
 
@@ -62,6 +66,9 @@ class ExplorePage:
         self.readout = pn.pane.HTML("", css_classes=["rt-readout"])
         self.path_summary = pn.pane.HTML("click the phase portrait to start a trajectory",
                                          css_classes=["rt-path"])  # fmt: skip
+        self.drawn: ExploreState | None = None  # the last view whose plots were drawn
+        self.last_traj: Any = None  # the last clicked trajectory (for the device's frame)
+        self.last_section: tuple[Any, Any] | None = None  # a section's points and states
         self.plots = Plots()
         self.plots.portrait.on_event(Tap, self._on_portrait_tap)
         self.plots.diagram.on_event(Tap, self._on_diagram_tap)
@@ -83,11 +90,21 @@ class ExplorePage:
 
     # ---- running on the document -------------------------------------------------------
     def on_document(self, fn: Callable[[], None]) -> None:
-        """Run ``fn`` on the session's document (next tick), or now without one (tests)."""
-        if self.doc is None or getattr(self.doc, "session_context", None) is None:
+        """Run ``fn`` on the session's document (next tick), or now without a document (tests);
+        a result for a session that has gone is dropped."""
+        if self.doc is None:
             fn()
-        else:
+        elif getattr(self.doc, "session_context", None) is not None:
             self.doc.add_next_tick_callback(fn)
+
+    def close(self) -> None:
+        """Drop what the page holds (its session has gone): its plots' data, the last
+        trajectory and section, the widgets' callbacks."""
+        for work in (self.level_work, self.diagram_work, self.path_work, self.frame_work):
+            work.apply = _ignore
+        self.last_traj = None
+        self.last_section = None
+        self.plots.clear()
 
     def _show_error(self, text: str) -> None:
         self.message.object = text
@@ -165,9 +182,11 @@ class ExplorePage:
 
     # ---- callbacks -----------------------------------------------------------------------
     def _query_of_widgets(self) -> dict[str, str]:
+        """The widgets' values as a URL query (an emptied text field: ``""``, which
+        :func:`parse_query` refuses by name)."""
         query = {"model": self.state.model}
-        query |= {k: repr(float(w.value)) for k, w in self.body_sliders.items()}
-        query |= {k: repr(float(w.value)) for k, w in self.level_sliders.items()}
+        for k, w in (*self.body_sliders.items(), *self.level_sliders.items()):
+            query[k] = "" if w.value is None else repr(float(w.value))
         return query
 
     def _accept(self, query: dict[str, str], base: ExploreState | None = None) -> bool:
@@ -179,9 +198,11 @@ class ExplorePage:
             self._sync_widgets()  # back to the previous valid view
             return False
         self._clear_error()
+        axis = self._axis()
         diagram = (state.model != self.state.model or state.body != self.state.body
-                   or {k: v for k, v in state.level.items() if k != self._axis()}
-                   != {k: v for k, v in self.state.level.items() if k != self._axis()})  # fmt: skip
+                   or {k: v for k, v in state.level.items() if k != axis}
+                   != {k: v for k, v in self.state.level.items() if k != axis}
+                   or not self.plots.shows_mark(state.level.get(axis, 0.0), state.h))  # fmt: skip
         self.state = state
         self._refresh(diagram=diagram)
         return True
@@ -212,7 +233,7 @@ class ExplorePage:
 
     def _on_look(self, event: Any) -> None:
         self.look = event.new
-        traj = getattr(self, "last_traj", None)
+        traj = self.last_traj
         if traj is not None:
             self.frame_work.request(traj)
 
@@ -233,8 +254,8 @@ class ExplorePage:
             self._sync_widgets()
 
     def _on_section_tap(self, event: Any) -> None:
-        section = getattr(self, "last_section", None)
-        if section is None:
+        section = self.last_section
+        if section is None or self.drawn != self.state:  # the section of another view
             return
         points, states = section
         k = int(np.argmin(np.hypot(points[:, 0] - event.x, points[:, 1] - event.y)))
@@ -251,6 +272,10 @@ class ExplorePage:
             self.diagram_work.request(self.state)
         elif self.state.reduces:  # the same curves: only the marker moves
             self._move_mark()
+        self._write_url()
+
+    def _write_url(self) -> None:
+        """The URL's query: the current view."""
         if self.location is not None:
             self.location.search = "?" + urlencode(self.state.to_query())
 
@@ -264,9 +289,14 @@ class ExplorePage:
         return section_view(state)
 
     def _apply_level(self, state: ExploreState, view: Any) -> None:
-        if isinstance(view, Exception):
+        if isinstance(view, Exception):  # the analysis refuses the view: the last drawn stays
             self._show_error(str(view))
+            if self.drawn is not None and self.drawn != state:
+                self.state = self.drawn
+                self._sync_widgets()
+                self._write_url()
             return
+        self.drawn = state
         self.readout.object = f"<b>{view.readout}</b>"
         if not state.reduces:
             self.last_section = (view.points, view.states)
@@ -278,8 +308,8 @@ class ExplorePage:
         self._move_mark()
 
     def _apply_diagram(self, state: ExploreState, view: Any) -> None:
-        if isinstance(view, Exception):
-            self._show_error(f"diagram: {view}")
+        if isinstance(view, Exception):  # no diagram for this level: said in its title
+            self.plots.no_diagram(str(view))
             return
         self.plots.show_diagram(view)
         self._move_mark()
@@ -287,9 +317,15 @@ class ExplorePage:
     def _compute_path(self, request: tuple[ExploreState, Any, Any]) -> Any:
         state, x, w = request
         if w is None:  # a crossing of the section: its state as it is
+            import warnings
+
+            from rollingtop._errors import ContactLostWarning
             from rollingtop.simulate import simulate
 
-            traj = simulate(state.body, state.model, x, t_end=PATH_T_END, samples=PATH_SAMPLES)
+            with warnings.catch_warnings():  # in the page's summary instead
+                warnings.simplefilter("ignore", ContactLostWarning)
+                traj = simulate(state.body, state.model, x, t_end=PATH_T_END,
+                                samples=PATH_SAMPLES)  # fmt: skip
             return traj, None
         view = path_view(state, x, w)
         return view.trajectory, view

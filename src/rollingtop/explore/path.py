@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from rollingtop._errors import ScenarioError
+from rollingtop._errors import ContactLostWarning, ScenarioError
 from rollingtop._types import FloatArray
 from rollingtop.explore.view import ExploreState, joined, orbit_curves
 
@@ -63,7 +64,9 @@ def path_view(
     h = float(level.energy(theta, w_tau))
     branch = 1 if w_tau >= 0 else -1
     y0 = state_from_level(level, h, gamma3, branch=branch, theta=theta)
-    traj = simulate(state.body, state.model, y0, t_end=t_end, samples=PATH_SAMPLES)
+    with warnings.catch_warnings():  # the loss of contact is in the page's summary instead
+        warnings.simplefilter("ignore", ContactLostWarning)
+        traj = simulate(state.body, state.model, y0, t_end=t_end, samples=PATH_SAMPLES)
     pos = traj.y[:, 15:17]
     summary = f"h = {h:.6g}"
     found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]
@@ -73,7 +76,8 @@ def path_view(
         kind = cls["class"] if cls["q"] is None else f"{cls['class']} p/q = {cls['p']}/{cls['q']}"
         summary += f", rotation number N = {N:.6f} ({kind})"
     elif found:
-        summary += f" ({found[0].kind} orbit)"
+        what = "a steady motion" if found[0].kind == "steady" else "its period is infinite"
+        summary += f" ({found[0].kind} orbit: {what})"
     curve = joined(orbit_curves(level, h))
     return PathView(pos[:, 0].copy(), pos[:, 1].copy(), h, gamma3, float(w_tau), summary, traj,
                     curve)  # fmt: skip

@@ -8,6 +8,7 @@ are shut down, so nothing keeps running.
 
 from __future__ import annotations
 
+import errno
 import signal
 import socket
 import subprocess
@@ -17,7 +18,7 @@ import webbrowser
 from collections.abc import Callable
 from typing import Any
 
-from rollingtop._errors import ScenarioError
+from rollingtop._errors import Interrupted, ScenarioError
 from rollingtop.explore.path import path_view
 from rollingtop.explore.view import ExploreState, level_view
 
@@ -65,7 +66,9 @@ def serve(
     warm_up(base)
 
     def page() -> Any:
-        return ExplorePage(base, look).layout
+        view = ExplorePage(base, look)
+        pn.state.on_session_destroyed(lambda _: view.close())  # its data go with the session
+        return view.layout
 
     origins = [f"{host}:{port}"] + ([f"localhost:{port}", f"127.0.0.1:{port}"]
                                     if host in LOOPBACK else [])  # fmt: skip
@@ -75,11 +78,21 @@ def serve(
                           title="rollingtop explore", websocket_origin=origins,
                           verbose=False)  # fmt: skip
     except OSError as err:
+        hint = "choose another --port" if err.errno == errno.EADDRINUSE else "check --host"
         raise ScenarioError(f"cannot serve at {host}:{port}: {err.strerror or err} "
-                            "(choose another --port)") from None  # fmt: skip
+                            f"({hint})") from None  # fmt: skip
     finally:
         signal.signal(signal.SIGINT, ours)
     url = f"http://{host}:{port}/"
+    # SIGINT and SIGTERM stop the event loop (a handler that raised would be caught and logged
+    # by asyncio when it lands inside a callback); the signal is raised once the loop is out
+    caught: list[int] = []
+
+    def stop(signum: int, frame: Any) -> None:
+        caught.append(signum)
+        server.io_loop.asyncio_loop.call_soon_threadsafe(server.io_loop.stop)
+
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         server.start()
         echo(f"serving at {url}")
@@ -88,8 +101,12 @@ def serve(
             webbrowser.open(url)
         server.io_loop.start()
     finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
         server.stop()
         WORKERS.shutdown(wait=False, cancel_futures=True)
+    if caught:
+        raise Interrupted(caught[0])
 
 
 def spawn(
