@@ -1,7 +1,7 @@
 """Regenerate docs/explore.png: the page of `rollingtop explore examples/fig5.toml --look roller`
-in Debian's chromium (headless), at C2 = -1.6, h = 3.6 (before the fold: two centres and a saddle), after a
-click on the phase portrait has started a trajectory (its path, rotation class and the roller
-device's last frame beside it).
+in Debian's chromium (headless), at C2 = -1.6, h = 3.6 (before the fold: two centres and a
+saddle), after a click on the phase portrait has started a trajectory (its path, rotation class
+and the roller device's last frame beside it).
 Run: python docs/explore.py   (needs the explore extra and `apt-get install chromium`)"""
 
 import os
@@ -13,8 +13,15 @@ from playwright.sync_api import sync_playwright
 
 from rollingtop.explore.server import spawn
 
-FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+FLAGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 
 if __name__ == "__main__":
     examples = Path(__file__).parents[1] / "examples"

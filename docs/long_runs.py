@@ -154,8 +154,12 @@ if __name__ == "__main__":
     results = []
     for model, example, t_end in RUNS:
         res = run(model, example, t_end / 100 if quick else t_end)
-        print(model, {k: res[k].get("final_drift") for k in ("free", "projected")},
-              {k: res[k].get("period_error") for k in ("free", "projected")}, flush=True)
+        print(
+            model,
+            {k: res[k].get("final_drift") for k in ("free", "projected")},
+            {k: res[k].get("period_error") for k in ("free", "projected")},
+            flush=True,
+        )
         results.append(res)
     if quick:
         save_figure(figure(results), "/tmp/long_runs_quick.png")

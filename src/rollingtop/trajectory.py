@@ -251,8 +251,11 @@ class Trajectory(NetCDFOutput):
                 "rhs_evals": int(self.stats["rhs_evals"]),
                 "wall_time_s": float(self.stats["wall_time_s"]),
                 "compile_time_s": float(self.stats.get("compile_time_s", 0.0)),
-                **{k: int(self.stats[k]) for k in ("projection_passes", "projection_deferred")
-                   if k in self.stats},
+                **{
+                    k: int(self.stats[k])
+                    for k in ("projection_passes", "projection_deferred")
+                    if k in self.stats
+                },
             },
         }
 

@@ -98,9 +98,12 @@ def _print_report(summary: dict[str, Any]) -> None:
         + ("" if lost is None else f", CONTACT LOST at t = {lost:.6g}")
         + f"\nsteps {s['steps']} (+{s['rejected_steps']} rejected), {s['rhs_evals']} rhs "
         f"evaluations, {s['wall_time_s']:.3f} s (+{s['compile_time_s']:.2f} s compile/load)"
-        + ("" if "projection_passes" not in s else
-           f"\nprojection onto the integrals: {s['projection_passes']} passes, the energy left "
-           f"for later at {s['projection_deferred']} steps (turning points)"),  # fmt: skip
+        + (
+            ""
+            if "projection_passes" not in s
+            else f"\nprojection onto the integrals: {s['projection_passes']} passes, the energy "
+            f"left for later at {s['projection_deferred']} steps (turning points)"
+        ),
         highlight=False,
     )
 
