@@ -42,6 +42,20 @@ def warm_up(base: ExploreState) -> None:
         pass
 
 
+def _check_address(host: str, port: int) -> None:
+    """A :class:`ScenarioError` when ``host:port`` cannot be bound (tried and released)."""
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+        family, _, _, _, address = infos[0]
+        with socket.socket(family, socket.SOCK_STREAM) as sock:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            sock.bind(address)
+    except OSError as err:
+        hint = "choose another --port" if err.errno == errno.EADDRINUSE else "check --host"
+        raise ScenarioError(f"cannot serve at {host}:{port}: {err.strerror or err} "
+                            f"({hint})") from None  # fmt: skip
+
+
 def serve(
     base: ExploreState,
     *,
@@ -63,6 +77,7 @@ def serve(
     from rollingtop.explore._work import WORKERS
     from rollingtop.explore.app import ExplorePage
 
+    _check_address(host, port)  # before compiling: a busy port is said at once
     warm_up(base)
 
     def page() -> Any:
