@@ -71,10 +71,13 @@ MAX_REJECTED_IN_A_ROW = 100
 # Indices into the float control array ``ctrl``.
 T, H_ABS, T_END, RTOL, ATOL, G_OLD = 0, 1, 2, 3, 4, 5
 # Indices into the integer counter array ``counts``: the projection's passes and the steps at
-# which it left a nonlinear integral (the energy at a turning point) for the next ones last.
+# which it left a nonlinear integral (the energy at a turning point) for the next ones, then the
+# right-hand sides spent on monitoring the normal force inside steps (not in ``NFEV``, which
+# counts the integration's own).
 NEXT_SAMPLE, STEPS, REJECTED, NFEV, N_EVENTS, PROJ_PASSES, PROJ_DEFERRED = 0, 1, 2, 3, 4, 5, 6
+MONITOR_EVALS = 7
 #: Length of ``counts``.
-N_COUNTS = 7
+N_COUNTS = 8
 # Indices into the integer event specification ``ev_spec``.
 EV_CODE, EV_DIRECTION = 0, 1
 # Indices into the reaction-tracking array ``track``: the normal force at the last accepted step

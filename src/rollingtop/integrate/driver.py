@@ -72,6 +72,9 @@ class IntegrationResult:
         one per accepted step for the linear integrals, one more per step that moved a
         nonlinear one) and the steps at which it left the energy for the next ones (a turning
         point, where no velocity direction changes it).
+    monitor_evals : int
+        Right-hand sides evaluated to find the normal force's minima inside steps (not in
+        ``rhs_evals``, the integration's own).
     """
 
     t: FloatArray
@@ -87,6 +90,7 @@ class IntegrationResult:
     events_dropped: int = 0
     projection_passes: int = 0
     projection_deferred: int = 0
+    monitor_evals: int = 0
 
 
 class _Work(TypedDict):
@@ -395,4 +399,5 @@ def integrate(
         events_dropped=dropped,
         projection_passes=int(counts[dop.PROJ_PASSES]),
         projection_deferred=int(counts[dop.PROJ_DEFERRED]),
+        monitor_evals=int(counts[dop.MONITOR_EVALS]),
     )

@@ -35,6 +35,7 @@ from rollingtop._compiled._dop853 import (
     MAX_RATIO,
     MAX_REJECTED_IN_A_ROW,
     MIN_FACTOR,
+    MONITOR_EVALS,
     N_COUNTS,
     N_EVENTS,
     NEXT_SAMPLE,
@@ -195,10 +196,11 @@ def run(
         Current state (projected) and its derivative; updated in place.
     ctrl : ndarray, shape (6,)
         ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``); updated.
-    counts : ndarray of int64, shape (7,)
+    counts : ndarray of int64, shape (8,)
         Next sample index, accepted steps, rejected steps, right-hand-side evaluations, events
-        found (also those beyond the capacity of ``ev_t``), the projection's passes and the
-        steps at which it left a nonlinear integral for the next ones.
+        found (also those beyond the capacity of ``ev_t``), the projection's passes, the steps
+        at which it left a nonlinear integral for the next ones, and the right-hand sides spent
+        on the normal force inside steps.
     track : ndarray, shape (5,)
         Reaction tracking (see :func:`new_track`), updated at every accepted step.
     t_eval : ndarray, shape (n_samples,)
@@ -354,10 +356,11 @@ def run(
             # its loss of contact if it dips below zero between two positive ends
             if not dense_ready:
                 prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
-                counts[NFEV] += 3
+                counts[MONITOR_EVALS] += 3
                 dense_ready = True
             found = K[14]  # stages 14-16 are free once the dense output is built
-            counts[NFEV] += dip_minimum(code, p, Fd, y_old, t, h, ytmp, K[13], ws, found)
+            counts[MONITOR_EVALS] += dip_minimum(code, p, Fd, y_old, t, h, ytmp, K[13], ws,
+                                                 found)  # fmt: skip
             if not math.isnan(found[2]) and math.isnan(track[T_CONTACT_LOST]):
                 track[T_CONTACT_LOST] = found[2]
             update_track(track, found[0], found[1], 0.0)
