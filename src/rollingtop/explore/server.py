@@ -9,6 +9,7 @@ are shut down, so nothing keeps running.
 from __future__ import annotations
 
 import errno
+import logging
 import signal
 import socket
 import subprocess
@@ -78,9 +79,11 @@ def serve(
     from rollingtop.explore.app import ExplorePage
 
     _check_address(host, port)  # before compiling: a busy port is said at once
+    # a tab closed while a result was on its way is not the user's concern
+    logging.getLogger("bokeh.server.views.ws").setLevel(logging.ERROR)
     warm_up(base)
 
-    def page() -> Any:
+    def page() -> Any:  # a closed tab's session goes 5 s after it closes (Bokeh's default: 15)
         view = ExplorePage(base, look)
         pn.state.on_session_destroyed(lambda _: view.close())  # its data go with the session
         return view.layout
@@ -91,7 +94,8 @@ def serve(
     try:
         server = pn.serve(page, port=port, address=host, show=False, start=False,
                           title="rollingtop explore", websocket_origin=origins,
-                          verbose=False)  # fmt: skip
+                          verbose=False, check_unused_sessions_milliseconds=2000,
+                          unused_session_lifetime_milliseconds=5000)  # fmt: skip
     except OSError as err:
         hint = "choose another --port" if err.errno == errno.EADDRINUSE else "check --host"
         raise ScenarioError(f"cannot serve at {host}:{port}: {err.strerror or err} "
