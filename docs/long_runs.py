@@ -6,6 +6,8 @@ t = 1e7; the example scenarios of the smooth, rough, rubber and parallel models 
 default tolerances (rtol = 1e-10, atol = 1e-12). Writes docs/long_runs.png, docs/long_runs.json
 and the block between the markers of docs/guide/accuracy.md and of README.md.
 Run: python docs/long_runs.py [--quick]   (--quick: t / 100, for a look; writes nothing)
+Apart, in parallel: --models=meridian --save=A.json, --models=smooth,rough --save=B.json, then
+python docs/long_runs.py --part=A.json --part=B.json writes the figure and the blocks.
 """
 
 from __future__ import annotations
@@ -149,25 +151,42 @@ def replace_block(path: Path, text: str) -> None:
     write_bytes_atomic(path, (head + text + tail).encode())
 
 
-if __name__ == "__main__":
-    quick = "--quick" in sys.argv
-    results = []
-    for model, example, t_end in RUNS:
-        res = run(model, example, t_end / 100 if quick else t_end)
-        print(
-            model,
-            {k: res[k].get("final_drift") for k in ("free", "projected")},
-            {k: res[k].get("period_error") for k in ("free", "projected")},
-            flush=True,
-        )
-        results.append(res)
+def main(argv: list[str]) -> None:
+    quick = "--quick" in argv
+    models = None
+    for arg in argv:
+        if arg.startswith("--models="):
+            models = arg.split("=", 1)[1].split(",")
+    parts = [a.split("=", 1)[1] for a in argv if a.startswith("--part=")]
+    if parts:  # combine the results of runs made apart (--models=... --save=FILE)
+        results = [r for f in parts for r in json.loads(Path(f).read_text())]
+        order = [m for m, _, _ in RUNS]
+        results.sort(key=lambda r: order.index(r["model"]))
+    else:
+        results = []
+        for model, example, t_end in RUNS:
+            if models is not None and model not in models:
+                continue
+            res = run(model, example, t_end / 100 if quick else t_end)
+            print(model, {k: res[k].get("final_drift") for k in ("free", "projected")},
+                  {k: res[k].get("period_error") for k in ("free", "projected")},
+                  flush=True)  # fmt: skip
+            results.append(res)
+    save = [a.split("=", 1)[1] for a in argv if a.startswith("--save=")]
+    if save:
+        Path(save[0]).write_text(json.dumps(results))
+        return
     if quick:
         save_figure(figure(results), "/tmp/long_runs_quick.png")
         print(block(results))
-        raise SystemExit(0)
+        return
     save_figure(figure(results), ROOT / "docs" / "long_runs.png", dpi=110)
     write_bytes_atomic(ROOT / "docs" / "long_runs.json", json.dumps(results).encode())
     text = block(results)
     for path in (ROOT / "docs" / "guide" / "accuracy.md", ROOT / "README.md"):
         replace_block(path, text)
     print(text)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
