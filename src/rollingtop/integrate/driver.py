@@ -20,6 +20,7 @@ from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
+from rollingtop.integrate._held import held_arrays
 
 __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "compile_kernels"]
 
@@ -171,7 +172,7 @@ def _run_compiled(
 ) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
     n = t_eval.shape[0]
     w = _workspace(n)
-    icodes, targets, pw = _projection(code, p, y0, held)
+    icodes, targets, pw = held_arrays(code, p, y0, held)
     stepper = for_code(code).stepper
     ev_code, ev_direction, capacity = event
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
@@ -227,24 +228,6 @@ def _run_compiled(
     found = int(counts[dop.N_EVENTS])
     kept = min(found, capacity)
     return w["out"], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
-
-
-def _projection(
-    code: int, p: FloatArray, y0: FloatArray, held: IntArray | None
-) -> tuple[IntArray, FloatArray, FloatArray]:
-    """The arrays of the projection onto the integrals ``held`` (codes of
-    :mod:`rollingtop._compiled._integrals`; ``None``: no projection): their codes, their values
-    at ``y0`` (the compiled evaluation the projection compares with) and its work array."""
-    from rollingtop._compiled import _integrals
-    from rollingtop._compiled._template.invariants import WORK_ROWS
-
-    if held is None or len(held) == 0:
-        return np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8))
-    icodes = np.ascontiguousarray(held, dtype=np.int64)
-    targets = np.array([call(_integrals.integral_value, int(c), p, y0) for c in icodes])
-    if not np.all(np.isfinite(targets)):
-        raise IntegrationError("the integrals to hold are not finite at the initial state")
-    return icodes, targets, np.zeros((WORK_ROWS, 8))
 
 
 def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
