@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._checks import check_memory
 from rollingtop._compiled import compiling, for_code
 from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
 from rollingtop._compiled._tangent import REACHED_VERTICAL
@@ -87,6 +88,8 @@ def check_options(t_end: object, samples: object, rtol: float, atol: float | Non
         raise ScenarioError(f"t_end = {t_end!r} must be a positive number")
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 1:
         raise ScenarioError(f"samples = {samples!r} must be an integer >= 1")
+    # the indicators (3) and the states (18) at every sample, and the dataset made of them
+    check_memory(f"samples = {samples}", 2.0 * 8 * (3 + N_STATE) * float(samples))
     if not (isinstance(rtol, int | float) and 1e-15 <= rtol <= 0.1):
         raise ScenarioError(f"rtol = {rtol!r} must lie in [1e-15, 0.1]")
     atol = rtol / 100 if atol is None else atol

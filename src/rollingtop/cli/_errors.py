@@ -100,3 +100,11 @@ def reported() -> Iterator[None]:
         raise Stopped.of(exc.signum)(exc.signum) from None
     except OSError as exc:
         raise RunFailed(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": ")) from None
+    except OverflowError:  # Python's float arithmetic raises where numpy's gives inf
+        raise BadInput(
+            "a derived quantity overflows double precision (a product or power "
+            "of the inputs beyond 1e308): rescale the scenario's units"
+        ) from None
+    except MemoryError:
+        raise RunFailed("not enough memory for what was asked (fewer samples, a smaller "
+                        "grid)") from None  # fmt: skip

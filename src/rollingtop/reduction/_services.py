@@ -68,8 +68,11 @@ def check_level_size(level: Any) -> None:
     """``U`` at ``gamma3 = 0`` within :data:`_MAX_U`, else a one-line
     :class:`~rollingtop.reduction.LevelSetError` naming the level (every model's level, once its
     values are set)."""
-    with np.errstate(all="ignore"):
-        size = abs(float(level.U(math.pi / 2)))
+    try:
+        with np.errstate(all="ignore"):
+            size = abs(float(level.U(math.pi / 2)))
+    except (OverflowError, ZeroDivisionError):  # Python floats raise where numpy's give inf
+        size = math.inf
     if not size <= _MAX_U:
         raise LevelSetError(
             f"level {level.describe()} is too large for double precision: its effective "

@@ -1,0 +1,59 @@
+"""Issue 27's table, the cases fixed so far: each ends with one error line and exit 2, in a real
+process (no traceback), and leaves no file behind."""
+
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import EXAMPLES
+
+
+def _scenario(tmp_path, name, **replace):
+    text = (EXAMPLES / f"{name}.toml").read_text()
+    for old, new in replace.items():
+        text = text.replace(old, new)
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return str(path)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            lambda d: [
+                "chaos",
+                str(EXAMPLES / "parallel_chaotic.toml"),
+                "--samples",
+                "99999999999",
+            ],
+            "needs about 30.6 TiB of memory",
+        ),  # fmt: skip
+        (
+            lambda d: ["chaos", str(EXAMPLES / "parallel_chaotic.toml"), "--samples", "1000000000"],
+            "needs about 312.9 GiB of memory",
+        ),  # fmt: skip
+        (
+            lambda d: [
+                "bifurcation",
+                _scenario(d, "fig5", **{"I1 = 0.3": "I1 = 1e300", "I3 = 0.5": "I3 = 1.5e300"}),
+            ],
+            "too large for double precision",
+        ),  # fmt: skip
+        (
+            lambda d: ["stability", _scenario(d, "paper", **{"R = 1.0": "R = 1e300"})],
+            "overflows double precision",
+        ),
+    ],
+    ids=["chaos_745_GiB", "chaos_24_GB", "bifurcation_I_1e300", "stability_R_1e300"],
+)
+def test_a_size_or_an_overflow_is_one_line(tmp_path, args, message):
+    argv = args(tmp_path)  # writes its scenario first
+    before = set(tmp_path.iterdir())
+    proc = subprocess.run([sys.executable, "-m", "rollingtop", *argv], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
+    assert set(tmp_path.iterdir()) == before
