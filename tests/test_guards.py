@@ -57,3 +57,25 @@ def test_a_size_or_an_overflow_is_one_line(tmp_path, args, message):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
     assert set(tmp_path.iterdir()) == before
+
+
+def test_a_wide_window_and_a_runaway_time_scale_are_one_line(tmp_path):
+    """bifurcation --h-range -1e308,1e308 (a grid whose spacing overflows: pcolormesh's
+    traceback) and simulate with g = 1e50 (1.5e26 periods of its pendulum rate in t_end = 50:
+    it ran for hours) end at once with one line; no figure is written."""
+    cases = [
+        (["bifurcation", str(EXAMPLES / "fig5.toml"), "--h-range", "-1e308,1e308", "-o",
+          "b.png"], "h range (-1e+308, 1e+308) must be finite and increasing, and its width"),
+        (["bifurcation", str(EXAMPLES / "fig5.toml"), "--c2-range", "-1e308,1e308"],
+         "C2 range"),
+        (["simulate", _scenario(tmp_path, "paper", **{"g = 1.0": "g = 1e50"}), "-o", "r.nc"],
+         "more than max_steps = 100000000 steps"),
+    ]  # fmt: skip
+    for argv, message in cases:
+        before = set(tmp_path.iterdir())
+        proc = subprocess.run([sys.executable, "-m", "rollingtop", *argv], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=120)  # fmt: skip
+        assert proc.returncode == 2, proc.stderr
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and message in lines[0], proc.stderr
+        assert set(tmp_path.iterdir()) == before

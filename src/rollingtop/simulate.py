@@ -7,6 +7,7 @@ options replace single integration options in either form.
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable, Iterable
@@ -246,6 +247,7 @@ def _run(
     events: str | None,
     event_direction: int,
 ) -> Trajectory:
+    _check_work(body, y0, opts)
     code = model.kernel_code(body, y0)  # the model's variant for this start (pole cases)
     held: tuple[str, ...] = ()
     if opts.project_integrals:
@@ -299,6 +301,28 @@ def _run(
             stacklevel=3,  # the caller of simulate
         )
     return traj
+
+
+def _check_work(body: SphericalTop, y0: NDArray[np.float64], opts: IntegrationOptions) -> None:
+    """Refuse a run whose fastest time scale makes ``t_end`` need a hundred times ``max_steps``
+    steps even at one step per oscillation (issue 27: ``g = 1e50`` ran for hours): the rate is the
+    largest of the spin ``|w|``, ``|v| / R``, ``sqrt(g / R)`` and ``sqrt(m g (R + |a3|) /
+    I_min)`` (the pendulum of the body about its contact point)."""
+    with np.errstate(all="ignore"):
+        rate = max(float(np.linalg.norm(y0[3:6])), float(np.linalg.norm(y0[0:3])) / body.R,
+                   math.sqrt(body.g / body.R),
+                   math.sqrt(body.m * body.g * (body.R + abs(body.a3))
+                             / float(np.min(body.inertia))))  # fmt: skip
+    periods = opts.t_end * rate / (2 * math.pi)
+    # a hundredfold: a run near its budget reaches max_steps and says so itself; an overflowing
+    # state (periods not finite) is the stepper's to report
+    if math.isfinite(periods) and periods > 100 * opts.max_steps:
+        raise ScenarioError(
+            f"t_end = {opts.t_end:g} spans about {periods:.2g} periods of the motion's fastest "
+            f"rate ({rate:.3g} per time unit, from the spin, g / R and the inertia): far more than "
+            f"max_steps = {opts.max_steps} steps even at one a period; shorten t_end, rescale "
+            "the units or raise max_steps"
+        )
 
 
 def simulate_models(

@@ -236,8 +236,9 @@ def bifurcation_diagram(
     if t0 is not None:  # a3 = 0: the pitchfork where the family changes type belongs in view
         marks.append(Fold(_pitchfork_c2(level, t0), math.cos(t0), math.nan, "pitchfork", t0))
     c2_lo, c2_hi = C2_range if C2_range is not None else _default_c2_range(level, marks)
-    if not (math.isfinite(c2_lo) and math.isfinite(c2_hi) and c2_lo < c2_hi):
-        raise LevelSetError(f"C2 range ({c2_lo:g}, {c2_hi:g}) must be finite and increasing")
+    if not (math.isfinite(c2_hi - c2_lo) and c2_lo < c2_hi):  # its width too: a grid's spacing
+        raise LevelSetError(f"C2 range ({c2_lo:g}, {c2_hi:g}) must be finite and increasing, "
+                            "and its width finite")  # fmt: skip
     C2_grid = np.linspace(c2_lo, c2_hi, nc)
     if t0 is not None:
         branches.append(_family_branch(level, t0, (c2_lo, c2_hi)))
@@ -275,8 +276,9 @@ def bifurcation_diagram(
     if h_range is None:
         h_range = _default_h_range(branches, (c2_lo, c2_hi), float(np.nanmin(min_U)))
     h_lo, h_hi = h_range
-    if not (math.isfinite(h_lo) and math.isfinite(h_hi) and h_lo < h_hi):
-        raise LevelSetError(f"h range ({h_lo:g}, {h_hi:g}) must be finite and increasing")
+    if not (math.isfinite(h_hi - h_lo) and h_lo < h_hi):
+        raise LevelSetError(f"h range ({h_lo:g}, {h_hi:g}) must be finite and increasing, and "
+                            "its width finite")  # fmt: skip
     h_grid = np.linspace(h_lo, h_hi, nh)
     # regions: nodes of neighbouring columns with the same orbits and overlapping h intervals
     parent = list(range(len(nodes)))
