@@ -79,3 +79,48 @@ def test_a_wide_window_and_a_runaway_time_scale_are_one_line(tmp_path):
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and message in lines[0], proc.stderr
         assert set(tmp_path.iterdir()) == before
+
+
+def test_section_writes_its_figure_and_its_data_both_or_neither(tmp_path):
+    """section -o sec.png --netcdf out/sec.nc where the NetCDF cannot be written (its folder
+    read-only): one line naming the NetCDF, exit 1, and no PNG left behind (it was)."""
+    import os
+
+    if os.geteuid() == 0:  # root writes into a read-only folder: a missing folder instead
+        target = tmp_path / "missing" / "sec.nc"
+    else:
+        (tmp_path / "out").mkdir()
+        (tmp_path / "out").chmod(0o500)
+        target = tmp_path / "out" / "sec.nc"
+    before = set(tmp_path.iterdir())
+    proc = subprocess.run([sys.executable, "-m", "rollingtop", "section",
+                           str(EXAMPLES / "section_parallel.toml"), "-o", "sec.png",
+                           "--netcdf", str(target), "--trajectories", "2", "--crossings", "3"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert proc.returncode in (1, 2), proc.stderr
+    lines = [ln for ln in proc.stderr.strip().splitlines() if "error" in ln]
+    assert len(lines) == 1 and "sec.nc" in lines[0], proc.stderr
+    assert set(tmp_path.iterdir()) == before and not (tmp_path / "sec.png").exists()
+
+
+def test_write_together_publishes_all_or_nothing(tmp_path):
+    """rollingtop.io.write_together: a second writer that fails (ENOSPC) leaves neither file nor
+    any temporary behind, and an existing file unchanged; both succeed: both published."""
+    import errno
+
+    from rollingtop.io import WriteFailed, write_together
+
+    first, second = tmp_path / "a.png", tmp_path / "b.nc"
+    second.write_bytes(b"old")
+
+    def full(tmp):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with pytest.raises(WriteFailed, match="b.nc"):
+        write_together([(first, lambda tmp: tmp.write_bytes(b"png")), (second, full)])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.nc"]
+    assert second.read_bytes() == b"old"
+    write_together([(first, lambda tmp: tmp.write_bytes(b"png")),
+                    (second, lambda tmp: tmp.write_bytes(b"new"))])  # fmt: skip
+    assert first.read_bytes() == b"png" and second.read_bytes() == b"new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "b.nc"]

@@ -18,7 +18,7 @@ import stat
 import subprocess
 import tempfile
 import threading
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeAlias
 
@@ -36,6 +36,7 @@ __all__ = [
     "netcdf_bytes",
     "read_input_text",
     "write_bytes_atomic",
+    "write_together",
 ]
 
 #: A file name: a string or a path-like object.
@@ -217,6 +218,44 @@ def atomic_write(
                 raise
             raise WriteFailed(path, *_reason(cause)) from None
     return path
+
+
+def write_together(files: Sequence[tuple[PathArg, Callable[[Path], None]]]) -> list[Path]:
+    """Write several files all or none (a command's figure and its data, say): each
+    ``write(tmp)`` fills a temporary file beside its path, flushed to disk; only when every one
+    has succeeded are they renamed onto their paths. A failure removes every temporary file and
+    leaves every path as it was (raised as :class:`WriteFailed` naming the file, as
+    :func:`atomic_write` does)."""
+    paths = [Path(p) for p, _ in files]
+    with contextlib.ExitStack() as stack:
+        temps = []
+        for path, (_, write) in zip(paths, files, strict=True):
+            fd, tmp = stack.enter_context(_temporary_beside(path, ".tmp"))
+            os.close(fd)
+            try:
+                write(tmp)
+                fd = os.open(tmp, os.O_RDONLY)
+                try:
+                    umask = os.umask(0)
+                    os.umask(umask)
+                    os.fchmod(fd, 0o666 & ~umask)  # mkstemp creates 0600
+                    os.fsync(fd)
+                finally:
+                    os.close(fd)
+            except WriteFailed:
+                raise
+            except Exception as exc:
+                cause = _write_error(exc)
+                if cause is None:
+                    raise
+                raise WriteFailed(path, *_reason(cause)) from None
+            temps.append(tmp)
+        for tmp, path in zip(temps, paths, strict=True):
+            try:
+                os.replace(tmp, path)
+            except OSError as exc:
+                raise WriteFailed(path, *_reason(exc)) from None
+    return paths
 
 
 def netcdf_bytes(ds: Dataset) -> memoryview:

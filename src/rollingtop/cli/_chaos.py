@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import click
@@ -98,8 +100,8 @@ def section(
     trajectories sampled on the level set of the scenario's initial state (same energy and
     other integrals of its model)."""
     from rollingtop.chaos import poincare_section, section_summary
-    from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
-    from rollingtop.plot import FIGURE_SUFFIXES, save_figure
+    from rollingtop.io import check_output_path, netcdf_bytes, write_together
+    from rollingtop.plot import FIGURE_SUFFIXES
     from rollingtop.scenario import load_scenario
 
     check_output_path(output, FIGURE_SUFFIXES)
@@ -115,9 +117,19 @@ def section(
                               progress=progress)  # fmt: skip
     from rollingtop.plot.section import section_figure
 
-    save_figure(section_figure(ds), output)
+    fig = section_figure(ds)
+    fmt = output.rsplit(".", 1)[-1].lower()
+    writes: list[tuple[str, Callable[[Path], None]]] = [
+        (output, lambda tmp: fig.savefig(tmp, format=fmt, dpi=200))
+    ]
     if netcdf is not None:
-        write_bytes_atomic(netcdf, netcdf_bytes(ds))
+        data = netcdf_bytes(ds)
+
+        def write_data(tmp: Path) -> None:
+            tmp.write_bytes(data)
+
+        writes.append((netcdf, write_data))
+    write_together(writes)  # the figure and the crossings, both or neither
     summary = section_summary(ds)
     if summary["contact_lost"]:
         click.echo(f"rollingtop: warning: {summary['contact_lost']} of {summary['trajectories']} "
