@@ -363,3 +363,21 @@ def test_the_accessor_names_the_models_on_a_model_axis():
 def test_a_dataset_that_is_no_atlas_is_refused_by_the_accessor():
     with pytest.raises(AtlasError, match="not an atlas of rollingtop.atlas"):
         xr.Dataset({"x": ("t", [1.0])}).rollingtop  # noqa: B018
+
+
+def test_a_cell_the_analysis_cannot_classify_is_marked_whatever_the_axis_order():
+    """Issue 27: I1 = 1e300 or C2 = 1e20 (levels beyond doubles) are status 3 in their cells,
+    not a failed atlas; a3 = [1.5, 0.5] runs as [0.5, 1.5] does (the inadmissible body is its
+    cell, status 1); the classified cells equal a LevelSet's steady motions."""
+    ds = classify_in_process(atlas_spec_from_dict(spec_dict({"I1": [0.3, 1e300],
+                                                             "C2": [-2.0, 1e20]})))  # fmt: skip
+    status = ds["status"].values
+    assert status[0, 0] == 0 and (status[0, 1], status[1, 0], status[1, 1]) == (3, 3, 3)
+    assert ds["n_steady"].values[0, 0] == len(steady_motions(LevelSet(SphericalTop(**BODY),
+                                                                      1.0, 0.5, -2.0)))  # fmt: skip
+    assert np.all(ds["n_steady"].values[status == 3] == -1)
+    for order in ([1.5, 0.5], [0.5, 1.5]):
+        ds = classify_in_process(atlas_spec_from_dict(spec_dict({"a3": order})))
+        by_a3 = dict(zip(ds["a3"].values.tolist(), ds["status"].values.ravel().tolist(),
+                         strict=True))  # fmt: skip
+        assert by_a3 == {1.5: 1, 0.5: 0}

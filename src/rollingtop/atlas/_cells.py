@@ -8,7 +8,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from rollingtop._errors import BodyError
+from rollingtop._errors import BodyError, RollingTopError
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 
@@ -79,19 +79,32 @@ def classify_cells(
         if level.pole is not None:
             out["status"][n] = 2
             continue
-        th, _, u2 = _critical(level)
-        g3 = np.cos(th)
-        out["status"][n] = 0
-        out["n_steady"][n] = len(g3)
-        out["n_centres"][n] = int(np.sum(u2 > 0))
-        out["n_saddles"][n] = int(np.sum(u2 < 0))
-        out["n_folds"][n] = _fold_count(*(p[key] for key in (*BODY_KEYS, "M3", "C1")))
-        centres = [t for t, c in zip(th, u2 > 0, strict=True) if c][:MAX_CENTRES]
-        for c, t in enumerate(centres):
-            m = steady_motion(level, float(t))
-            out["centre_gamma3"][n, c] = m.gamma3
-            out["rotation_centre"][n, c] = centre_rotation_number(m)
+        try:  # a level the analysis cannot classify (degenerate, beyond doubles): its cell only
+            with np.errstate(all="ignore"):
+                th, _, u2 = _critical(level)
+                g3 = np.cos(th)
+                out["status"][n] = 0
+                out["n_steady"][n] = len(g3)
+                out["n_centres"][n] = int(np.sum(u2 > 0))
+                out["n_saddles"][n] = int(np.sum(u2 < 0))
+                out["n_folds"][n] = _fold_count(*(p[key] for key in (*BODY_KEYS, "M3", "C1")))
+                centres = [t for t, c in zip(th, u2 > 0, strict=True) if c][:MAX_CENTRES]
+                for c, t in enumerate(centres):
+                    m = steady_motion(level, float(t))
+                    out["centre_gamma3"][n, c] = m.gamma3
+                    out["rotation_centre"][n, c] = centre_rotation_number(m)
+        except (RollingTopError, ArithmeticError, ValueError):
+            _unclassified(out, n, 3)
     return out
+
+
+def _unclassified(out: dict[str, np.ndarray], n: int, status: int) -> None:
+    """Cell ``n`` not classified, with its ``status``: its other fields back to -1 and NaN."""
+    for name in FIELDS:
+        out[name][n] = -1
+    out["status"][n] = status
+    out["rotation_centre"][n] = np.nan
+    out["centre_gamma3"][n] = np.nan
 
 
 # ---- running it on Dask, resumably --------------------------------------------------------------
@@ -105,7 +118,6 @@ def _classify_state(
     builds it: the centre of mass's velocity from the model's constraints, ``omega``'s part
     along a constraint on the angular velocity dropped), classified by the model's own
     reduction. ``n_folds`` is the meridian model's alone (-1 for the others)."""
-    from rollingtop._errors import RollingTopError
     from rollingtop.contact import get_model
     from rollingtop.dynamics.state import initial_state
     from rollingtop.reduction.classify import admissible_omega
@@ -132,15 +144,19 @@ def _classify_state(
     if level.pole is not None:
         out["status"][n] = 2
         return
-    motions = steady_motions(level)
-    out["status"][n] = 0
-    out["n_steady"][n] = len(motions)
-    out["n_centres"][n] = sum(m.type == "center" for m in motions)
-    out["n_saddles"][n] = sum(m.type == "saddle" for m in motions)
-    if get_model(name).has_reduction:  # the whole of the paper's reduction: its fold curves
-        out["n_folds"][n] = _fold_count(*(float(getattr(body, key)) for key in BODY_KEYS),
-                                        level.M3, level.C1)  # fmt: skip
-    centres = [m for m in motions if m.type == "center"][:MAX_CENTRES]
-    for c, m in enumerate(centres):
-        out["centre_gamma3"][n, c] = m.gamma3
-        out["rotation_centre"][n, c] = centre_rotation_number(m)
+    try:  # a level the analysis cannot classify (a flat U, beyond doubles): its cell only
+        with np.errstate(all="ignore"):
+            motions = steady_motions(level)
+            out["status"][n] = 0
+            out["n_steady"][n] = len(motions)
+            out["n_centres"][n] = sum(m.type == "center" for m in motions)
+            out["n_saddles"][n] = sum(m.type == "saddle" for m in motions)
+            if get_model(name).has_reduction:  # the paper's whole reduction: its fold curves
+                out["n_folds"][n] = _fold_count(*(float(getattr(body, key)) for key in BODY_KEYS),
+                                                level.M3, level.C1)  # fmt: skip
+            centres = [m for m in motions if m.type == "center"][:MAX_CENTRES]
+            for c, m in enumerate(centres):
+                out["centre_gamma3"][n, c] = m.gamma3
+                out["rotation_centre"][n, c] = centre_rotation_number(m)
+    except (RollingTopError, ArithmeticError, ValueError):
+        _unclassified(out, n, 3)

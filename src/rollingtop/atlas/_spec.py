@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from rollingtop._checks import short_repr
-from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._errors import BodyError, RollingTopError, ScenarioError
 from rollingtop._types import FloatArray
 from rollingtop.atlas._cells import ATLAS_MODELS, BODY_KEYS, LEVEL_KEYS, STATE_KEYS
 from rollingtop.contact import MODELS, get_model
@@ -35,7 +35,7 @@ STATUS = {
     0: "classified",
     1: "inadmissible body",
     2: "pole level (C1 = +-M3)",
-    3: "level too large",
+    3: "level too large, or one the analysis cannot classify (beyond doubles, degenerate)",
     4: "state refused by the model",
 }
 #: Most worker processes per core of the embedded local cluster.
@@ -157,13 +157,21 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
     if missing:
         raise AtlasError(f"[level] or [axes] must give {', '.join(missing)}")
     level_t = {k: v for k, v in level_t.items() if k in LEVEL_KEYS}
-    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    given = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    body_t = dict(given)
     for key in BODY_KEYS:
         if key in axes:
             body_t[key] = float(axes[key][0])
     data["body"], data["level"] = body_t, level_t
     data.pop("initial", None)
-    sc = Scenario.from_dict(data)
+    try:
+        sc = Scenario.from_dict(data)
+    except BodyError:
+        # an axis whose first value is no admissible body: the [body] table's own body is the
+        # one checked, each cell is checked alone (status 1) whatever the order of its axis
+        if not any(key in axes for key in BODY_KEYS):
+            raise
+        sc = Scenario.from_dict({**data, "body": given})
     if not sc.model.has_reduction:
         raise AtlasError(f"the atlas classifies the reduction of the meridian model, not model "
                          f"{sc.model.name!r}")  # fmt: skip
@@ -171,6 +179,7 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
         raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
                          f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
     fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
+    fixed.update({k: float(body_t[k]) for k in BODY_KEYS if k in axes})
     fixed.update({k: float(level_t[k]) for k in LEVEL_KEYS})
     return AtlasSpec(fixed, axes)
 
@@ -232,6 +241,7 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
                          "inertia are not among its axes")  # fmt: skip
     y0 = sc.require_state()
     fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
+    fixed.update({k: float(body_t[k]) for k in BODY_KEYS if k in axes})
     fixed.update(zip(STATE_KEYS, (float(x) for x in (*y0[12:15], *y0[3:6])), strict=True))
     fixed["model"] = float(ATLAS_MODELS.index(model)) if model in ATLAS_MODELS else 0.0
     return AtlasSpec(fixed, axes)

@@ -67,7 +67,8 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
               for key in parts[min(parts)]}  # fmt: skip
     data_vars = {}
     docs = {
-        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large, "
+        "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large or not "
+        "classifiable, "
         "4 state refused by the model",
         "n_steady": "steady motions (critical points of U in (-1, 1)); -1: not classified",
         "n_centres": "steady motions that are centres (U'' > 0)",
