@@ -146,9 +146,9 @@ def _temporary_beside(path: Path, suffix: str) -> Iterator[tuple[int, Path]]:
         raise
 
 
-def _publish(fd: int, tmp: Path, path: Path, data: memoryview | None = None) -> None:
-    """Write ``data`` (if any) to ``fd`` with checked writes, flush it to disk, give it the
-    permissions ``open()`` would, close it (always) and rename ``tmp`` onto ``path``."""
+def _flush(fd: int, data: memoryview | None = None) -> None:
+    """Write ``data`` (if any) to ``fd`` with checked writes, give the file the permissions
+    ``open()`` would, flush it to disk and close it (always)."""
     try:
         view = data if data is not None else memoryview(b"")
         while view:
@@ -162,13 +162,39 @@ def _publish(fd: int, tmp: Path, path: Path, data: memoryview | None = None) -> 
         os.fsync(fd)
     finally:
         os.close(fd)
+
+
+def _rename(tmp: Path, path: Path) -> None:
+    """Rename ``tmp`` onto ``path``, and make the rename durable where possible."""
     os.replace(tmp, path)
-    with contextlib.suppress(OSError):  # make the rename itself durable where possible
+    with contextlib.suppress(OSError):
         dir_fd = os.open(path.parent, os.O_RDONLY)
         try:
             os.fsync(dir_fd)
         finally:
             os.close(dir_fd)
+
+
+def _publish(fd: int, tmp: Path, path: Path, data: memoryview | None = None) -> None:
+    """:func:`_flush` ``data`` into ``tmp`` (open as ``fd``), then :func:`_rename` it onto
+    ``path``."""
+    _flush(fd, data)
+    _rename(tmp, path)
+
+
+@contextlib.contextmanager
+def _failures_named(path: Path) -> Iterator[None]:
+    """An ``OSError`` of a writer (or a failed encoder process) inside the block leaves as
+    :class:`WriteFailed` naming ``path``; anything else passes unchanged."""
+    try:
+        yield
+    except WriteFailed:
+        raise
+    except Exception as exc:
+        cause = _write_error(exc)
+        if cause is None:
+            raise
+        raise WriteFailed(path, *_reason(cause)) from None
 
 
 def write_bytes_atomic(path: PathArg, data: ReadableBuffer) -> Path:
@@ -207,16 +233,9 @@ def atomic_write(
     suffix = f".tmp{path.suffix}" if keep_suffix else ".tmp"
     with _temporary_beside(path, suffix) as (fd, tmp):
         os.close(fd)
-        try:
+        with _failures_named(path):
             write(tmp)
             _publish(os.open(tmp, os.O_RDONLY), tmp, path)
-        except WriteFailed:
-            raise
-        except Exception as exc:
-            cause = _write_error(exc)
-            if cause is None:
-                raise
-            raise WriteFailed(path, *_reason(cause)) from None
     return path
 
 
@@ -232,29 +251,13 @@ def write_together(files: Sequence[tuple[PathArg, Callable[[Path], None]]]) -> l
         for path, (_, write) in zip(paths, files, strict=True):
             fd, tmp = stack.enter_context(_temporary_beside(path, ".tmp"))
             os.close(fd)
-            try:
+            with _failures_named(path):
                 write(tmp)
-                fd = os.open(tmp, os.O_RDONLY)
-                try:
-                    umask = os.umask(0)
-                    os.umask(umask)
-                    os.fchmod(fd, 0o666 & ~umask)  # mkstemp creates 0600
-                    os.fsync(fd)
-                finally:
-                    os.close(fd)
-            except WriteFailed:
-                raise
-            except Exception as exc:
-                cause = _write_error(exc)
-                if cause is None:
-                    raise
-                raise WriteFailed(path, *_reason(cause)) from None
+                _flush(os.open(tmp, os.O_RDONLY))
             temps.append(tmp)
         for tmp, path in zip(temps, paths, strict=True):
-            try:
-                os.replace(tmp, path)
-            except OSError as exc:
-                raise WriteFailed(path, *_reason(exc)) from None
+            with _failures_named(path):
+                _rename(tmp, path)
     return paths
 
 
