@@ -11,17 +11,7 @@ from pathlib import Path
 
 from playwright.sync_api import sync_playwright
 
-from rollingtop.explore.server import spawn
-
-FLAGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
+from rollingtop.explore.server import CHROMIUM_FLAGS, spawn
 
 if __name__ == "__main__":
     examples = Path(__file__).parents[1] / "examples"
@@ -31,7 +21,7 @@ if __name__ == "__main__":
     proc, url = spawn(str(examples / "fig5.toml"), args=("--look", "roller"))
     try:
         with sync_playwright() as p:
-            b = p.chromium.launch(executable_path=browser, args=FLAGS)
+            b = p.chromium.launch(executable_path=browser, args=list(CHROMIUM_FLAGS))
             page = b.new_page(viewport={"width": 1340, "height": 760})
             page.goto(url + "?C2=-1.6&h=3.6")
             page.get_by_text("steady motions:").first.wait_for(timeout=60_000)

@@ -7,18 +7,9 @@ import signal
 
 import pytest
 
-from ..conftest import EXAMPLES
+from rollingtop.explore.server import CHROMIUM_FLAGS
 
-#: Flags for a root, headless chromium on a machine with a closed network.
-CHROMIUM_FLAGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
+from ..conftest import EXAMPLES
 
 
 def chromium_path():
@@ -37,7 +28,7 @@ def browser_type_launch_args(browser_type_launch_args):
         if os.environ.get("CI") == "true":
             pytest.fail(message)
         pytest.skip(message)
-    return {**browser_type_launch_args, "executable_path": path, "args": CHROMIUM_FLAGS}
+    return {**browser_type_launch_args, "executable_path": path, "args": list(CHROMIUM_FLAGS)}
 
 
 @pytest.fixture(scope="module")

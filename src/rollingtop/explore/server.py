@@ -23,8 +23,19 @@ from rollingtop._errors import Interrupted, ScenarioError
 from rollingtop.explore.path import path_view
 from rollingtop.explore.view import ExploreState, level_view
 
-__all__ = ["LOOPBACK", "serve", "spawn", "warm_up"]
+__all__ = ["CHROMIUM_FLAGS", "LOOPBACK", "serve", "spawn", "warm_up"]
 
+#: Flags for a headless chromium driving the page (scripts and tests; root, a closed network):
+#: without the background-networking ones chromium tries to reach Google at every start.
+CHROMIUM_FLAGS = (
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+)
 #: Addresses that only this machine reaches.
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
