@@ -54,7 +54,6 @@ from rollingtop.body import SphericalTop
 from rollingtop.reduction._services import check_level_size, check_level_values
 from rollingtop.reduction.level import (
     POLE_TOLERANCE,
-    ComplexArray,
     LevelSet,
     Real,
     _Analytic,
@@ -175,17 +174,12 @@ class RubberLevel(LevelSet):
         rate: float | FloatArray = -self.w_n(t) / np.sin(t)
         return rate
 
-    def full_energy(self, h: float) -> float:
-        """``E = h + m g R``: the spin's energy is part of ``U`` here."""
-        return h + self.body.m * self.body.g * self.body.R
-
-    #: :meth:`full_energy` in words.
+    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here (``M3 = 0``).
     energy_formula: ClassVar[str] = "h + m g R"
 
-    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
-        """Eigenvalues of the reduced motion linearised at the steady motion at ``gamma3``:
-        :meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`."""
-        return self.curvature_eigenvalues(gamma3)
+    #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
+    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
+    linearised_eigenvalues = LevelSet.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""

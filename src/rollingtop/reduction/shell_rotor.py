@@ -42,7 +42,6 @@ from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import pair_weight
 from rollingtop.reduction._services import check_level_size, check_level_values
 from rollingtop.reduction.level import (
-    ComplexArray,
     LevelSet,
     LevelSetError,
     PoleLevelError,
@@ -210,9 +209,9 @@ class ShellRotorLevel(LevelSet):
             np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau)  # fmt: skip
         return N
 
-    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
-        """:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues` at ``gamma3``."""
-        return self.curvature_eigenvalues(gamma3)
+    #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
+    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
+    linearised_eigenvalues = LevelSet.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -34,7 +34,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.reduction.level import (
-    ComplexArray,
     LevelSet,
     LevelSetError,
     Real,
@@ -127,10 +126,9 @@ class SmoothLevel(LevelSet):
         direction the level does not fix (the horizontal momentum's)."""
         return self.p_horizontal / self.body.m
 
-    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
-        """Eigenvalues of the reduced motion linearised at the steady motion at ``gamma3``:
-        :meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`."""
-        return self.curvature_eigenvalues(gamma3)
+    #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
+    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
+    linearised_eigenvalues = LevelSet.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""
