@@ -3,8 +3,11 @@ rollingtop._compiled._template.invariants): the compiled integrals against their
 definitions, their gradients against gradients written here, the drift of every claimed
 integral with projection, and the period against the reduction's quadrature."""
 
+import subprocess
+import sys
 from dataclasses import replace
 
+import numba
 import numpy as np
 import pytest
 
@@ -237,3 +240,41 @@ def test_a_dip_below_zero_inside_a_step_is_found_on_the_dense_output(paper_body)
     call(for_code(0).dynamics.diagnostics, 0, p, np.ascontiguousarray(dense.y), diag)
     below = np.linspace(0.0, 1.5, 2001)[diag[:, 0] < 0]
     assert below.size and below[-1] - below[0] < 1.5 / run.steps
+
+
+#: A global the pruning test below branches on (numba reads a global as a constant).
+_NEVER = False
+
+
+def test_a_run_without_projection_never_compiles_it():
+    """Issue 26's cold-start cost: the projection lives in the ``stepper_held`` copy of the
+    stepper (``HELD = True``); the plain stepper has ``HELD = False``, and numba prunes a branch
+    on a false global before typing, so the plain run never compiles ``project_integrals``
+    (shown here on a branch that could not even be typed). In a fresh process a plain run
+    compiles or loads the plain stepper only, a held run the held one."""
+    from rollingtop._compiled import for_model
+
+    def untypable(x):
+        return x.no_such_attribute
+
+    @numba.njit
+    def pruned(x):
+        if _NEVER:
+            return numba.njit(untypable)(x)
+        return x + 1.0
+
+    assert pruned(1.0) == 2.0
+    k = for_model("meridian")
+    assert k.stepper.HELD is False and k.stepper_held.HELD is True
+    code = (
+        "from rollingtop import simulate, load_scenario\n"
+        "from rollingtop._compiled import for_model\n"
+        f"sc = load_scenario({str(EXAMPLES / 'paper.toml')!r})\n"
+        "k = for_model('meridian')\n"
+        "simulate(sc, t_end=1.0)\n"
+        "print(len(k.stepper.run.signatures), len(k.stepper_held.run.signatures))\n"
+        "simulate(sc, t_end=1.0, project_integrals=True)\n"
+        "print(len(k.stepper_held.run.signatures))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["1", "0", "1"], out.stdout + out.stderr

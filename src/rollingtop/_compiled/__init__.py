@@ -102,6 +102,7 @@ _GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 ESTIMATES: dict[str, float] = {
     "dynamics": 4.0,
     "integrator": 9.0,
+    "held integrator": 4.0,
     "ensemble": 2.0,
     "chaos": 6.0,
 }
@@ -119,7 +120,8 @@ def group_of(code: int) -> Group:
 def for_code(code: int) -> ModuleType:
     """The compiled package that runs kernel code ``code``.
 
-    Its modules ``dynamics``, ``events``, ``dense``, ``stepper``, ``ensemble``, ``tangent`` and
+    Its modules ``dynamics``, ``events``, ``dense``, ``stepper`` (``stepper_held`` with the
+    projection onto the integrals), ``ensemble``, ``tangent`` and
     ``chaos`` hold the functions of :mod:`rollingtop._compiled._template`, compiled for its
     group's codes only (:data:`GROUPS`; a code of another group is not checked by the compiled
     functions: pick the package by the code).

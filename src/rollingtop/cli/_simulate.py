@@ -42,7 +42,9 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
         # state the run then refuses (huge values) must not warn here first
         with np.errstate(all="ignore"):
             code = get_model(options.get("model") or sc.model).kernel_code(sc.body, sc.y0)
-        compiled = compile_code(code)
+        held = options.get("project_integrals")
+        held = sc.integration.project_integrals if held is None else held
+        compiled = compile_code(code, held=bool(held))
     with _output.timing(sc.integration.t_end) as progress:
         traj = _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
     # the compilation belongs to the run's statistics, wherever it happened

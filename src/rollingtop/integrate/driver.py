@@ -30,7 +30,7 @@ __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "c
 PROGRESS_CHUNK = 20_000
 
 #: Seconds each compiled package's integrator took to compile or load in this process.
-_compiled: dict[str, float] = {}
+_compiled: dict[tuple[str, bool], float] = {}
 
 
 class StepReactions(TypedDict, total=False):
@@ -132,15 +132,18 @@ def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool
     return sum(_compile_package(kernels) for kernels in packages_of(model, variants=variants))
 
 
-def compile_code(code: int) -> float:
+def compile_code(code: int, *, held: bool = False) -> float:
     """:func:`compile_kernels` for the package that runs kernel code ``code`` (a model's own, or
-    its variants'); seconds spent."""
-    return _compile_package(for_code(int(code)))
+    its variants'); ``held``: the stepper that holds integrals by projection instead of the plain
+    one (``project_integrals``: a separate compile, so that a run without it never pays for it);
+    seconds spent."""
+    return _compile_package(for_code(int(code)), held)
 
 
-def _compile_package(kernels: ModuleType) -> float:
-    """:func:`compile_kernels` for one compiled package."""
-    if kernels.PACKAGE in _compiled:
+def _compile_package(kernels: ModuleType, held: bool = False) -> float:
+    """:func:`compile_kernels` for one compiled package (``held``: :func:`compile_code`)."""
+    key = (kernels.PACKAGE, held)
+    if key in _compiled:
         return 0.0
     start = time.perf_counter()
     p = np.array(WARMUP_PARAMS)
@@ -148,14 +151,14 @@ def _compile_package(kernels: ModuleType) -> float:
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
     code = kernels._dispatch.CODES[0]
-    with compiling(kernels, "integrator"):
+    with compiling(kernels, "held integrator" if held else "integrator"):
         call(kernels.dynamics.project, code, p, y, call(new_workspace))
-        # with a projection onto an integral: the same compiled loop (its arrays' types)
+        # with a projection onto an integral (held): the held stepper's loop
         _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1),
-                      np.array([0], dtype=np.int64))  # fmt: skip
+                      np.array([0], dtype=np.int64) if held else None)  # fmt: skip
         call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
-    _compiled[kernels.PACKAGE] = time.perf_counter() - start
-    return _compiled[kernels.PACKAGE]
+    _compiled[key] = time.perf_counter() - start
+    return _compiled[key]
 
 
 def _run_compiled(
@@ -173,7 +176,8 @@ def _run_compiled(
     n = t_eval.shape[0]
     w = _workspace(n)
     icodes, targets, pw = held_arrays(code, p, y0, held)
-    stepper = for_code(code).stepper
+    package = for_code(code)
+    stepper = package.stepper_held if icodes.shape[0] > 0 else package.stepper
     ev_code, ev_direction, capacity = event
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
@@ -347,7 +351,7 @@ def integrate(
     if unknown:
         raise ValueError(f"no compiled integral {unknown[0]!r} (known: {', '.join(CODES)})")
     held = np.array([CODES[n] for n in project_integrals], dtype=np.int64)
-    compile_s = compile_code(code)
+    compile_s = compile_code(code, held=held.shape[0] > 0)
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
         params,

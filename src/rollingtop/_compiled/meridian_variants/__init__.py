@@ -16,6 +16,7 @@ from rollingtop._compiled.meridian_variants import (
     events,
     invariants,
     stepper,
+    stepper_held,
     tangent,
 )
 
@@ -32,5 +33,6 @@ __all__ = [
     "events",
     "invariants",
     "stepper",
+    "stepper_held",
     "tangent",
 ]

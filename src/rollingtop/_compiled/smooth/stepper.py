@@ -76,6 +76,10 @@ from rollingtop._compiled.smooth.invariants import WORK_ROWS, project_integrals
 from rollingtop._jit import compiled, kernel
 from rollingtop._types import FloatArray, IntArray, Workspace
 
+#: Whether :func:`run` holds integrals by projection: ``True`` in the generated ``stepper_held``.
+#: numba prunes a branch on a global constant before typing: a plain run never compiles it.
+HELD = False
+
 
 @compiled()
 def initial_step(
@@ -316,7 +320,7 @@ def run(
             while k < n_samples and t_eval[k] <= t_new:
                 dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
                 project(code, p, out[k], ws)
-                if icodes.shape[0] > 0 and pw.shape[0] == WORK_ROWS:  # samples on the level too
+                if HELD:  # the samples on the level too
                     if project_integrals(code, p, out[k], icodes, targets, pw, ws) < 0:
                         ctrl[T] = t_new
                         return PROJECTION_FAILED
@@ -330,7 +334,7 @@ def run(
             y[i] = ynew[i]
             f[i] = K[12, i]
         project(code, p, y, ws)
-        if icodes.shape[0] > 0 and pw.shape[0] == WORK_ROWS:
+        if HELD:
             passes = project_integrals(code, p, y, icodes, targets, pw, ws)
             if passes < 0:
                 ctrl[T] = t_new
