@@ -3,6 +3,7 @@ independent count of steady motions, resumable, atomic, and bad specs refused in
 
 import json
 import math
+from pathlib import Path
 
 import mpmath as mp
 import numpy as np
@@ -381,3 +382,118 @@ def test_a_cell_the_analysis_cannot_classify_is_marked_whatever_the_axis_order()
         by_a3 = dict(zip(ds["a3"].values.tolist(), ds["status"].values.ravel().tolist(),
                          strict=True))  # fmt: skip
         assert by_a3 == {1.5: 1, 0.5: 0}
+
+
+@pytest.mark.parametrize(
+    "damage",
+    ["truncated", "garbage", "foreign keys", "wrong length", "unknown index"],
+)
+def test_a_damaged_or_foreign_chunk_is_recomputed_with_one_warning(client, tmp_path, damage):
+    """Issue 27: a chunk file of the .partial folder that does not load, or does not hold what
+    its chunk should, is computed again (one AtlasResumeWarning naming the folder), never a
+    traceback; the result equals the in-process atlas."""
+    from rollingtop.atlas import AtlasResumeWarning
+
+    spec = atlas_spec_from_dict(spec_dict(SMALL))
+    out = tmp_path / "a.nc"
+
+    def stop_after_two_chunks(done, n):
+        if done >= 10:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        atlas(spec, out, client=client, chunk=5, progress=stop_after_two_chunks)
+    folder = tmp_path / "a.nc.partial"
+    victim = sorted(folder.glob("chunk-*.npz"))[0]
+    if damage == "truncated":
+        victim.write_bytes(victim.read_bytes()[:40])
+    elif damage == "garbage":
+        victim.write_bytes(b"\x00not a zip file" * 10)
+    elif damage == "foreign keys":
+        np.savez(victim, x=np.zeros(5))
+    elif damage == "wrong length":
+        with np.load(victim) as z:
+            np.savez(victim, **{k: z[k][:2] for k in z.files})
+    else:  # a chunk index beyond the spec's chunks
+        victim.rename(folder / "chunk-999999.npz")
+    with pytest.warns(
+        AtlasResumeWarning, match=r"1 damaged or foreign chunk file\(s\) in .*a\.nc\.partial"
+    ):
+        ds = atlas(spec, out, client=client, chunk=5)
+    assert ds.identical(classify_in_process(spec))
+    assert out.exists() and not folder.exists()
+
+
+def test_a_listener_that_is_no_dask_scheduler_fails_within_the_timeout(capsys, tmp_path):
+    """Issue 27: a --scheduler that accepts connections and never answers (was: still waiting
+    after 150 s) fails in one line after --scheduler-timeout seconds, leaving nothing behind."""
+    import socket
+    import time
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(8)
+    port = listener.getsockname()[1]
+    spec = _spec_file(tmp_path, "C2 = [0.0]")
+    try:
+        start = time.perf_counter()
+        code, out, err = run_cli(capsys, "atlas", str(spec), "-o", str(tmp_path / "a.nc"),
+                                 "--scheduler", f"tcp://127.0.0.1:{port}",
+                                 "--scheduler-timeout", "1.5")  # fmt: skip
+        took = time.perf_counter() - start
+    finally:
+        listener.close()
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and "did not answer within 1.5 s" in err, err
+    assert took < 10.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "1e9"])
+def test_a_bad_scheduler_timeout_is_one_line(capsys, tmp_path, value):
+    spec = _spec_file(tmp_path, "C2 = [0.0]")
+    code, out, err = run_cli(capsys, "atlas", str(spec), "-o", str(tmp_path / "a.nc"),
+                             "--scheduler-timeout", value)  # fmt: skip
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "--scheduler-timeout" in err
+
+
+def test_a_store_that_cannot_be_written_is_named_and_the_cells_are_kept(client, tmp_path,
+                                                                       monkeypatch):  # fmt: skip
+    """Issue 27: an OSError while the Zarr store is written (a file-size limit: EFBIG) is one
+    AtlasError naming the store; no store and no temporary store are left, and the finished
+    cells stay in .partial so that a rerun writes without computing."""
+    import errno
+
+    import rollingtop.atlas._store as store
+
+    spec = atlas_spec_from_dict(spec_dict(SMALL))
+    out = tmp_path / "a.zarr"
+
+    def too_large(self, *args, **kwargs):
+        (Path(args[0]) / "junk").parent.mkdir(parents=True, exist_ok=True)
+        (Path(args[0]) / "junk").write_text("partial")
+        raise OSError(errno.EFBIG, "File too large")
+
+    monkeypatch.setattr(xr.Dataset, "to_zarr", too_large)
+    with pytest.raises(
+        AtlasError,
+        match=r"cannot write '.*a\.zarr': File too large; the "
+        r"finished cells are kept in '.*a\.zarr\.partial'",
+    ):
+        atlas(spec, out, client=client, chunk=5)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.zarr.partial"]
+    monkeypatch.undo()
+    progress = []
+    atlas(spec, out, client=client, chunk=5, progress=lambda d, n: progress.append(d))
+    assert progress == [spec.size] and out.is_dir() and store is not None
+
+
+def test_a_running_scheduler_passes_the_probe(tmp_path):
+    """The probe of --scheduler accepts a real Dask scheduler (and the atlas runs on it)."""
+    from distributed import LocalCluster
+
+    spec = atlas_spec_from_dict(spec_dict({"C2": [-2.0, 0.0]}))
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:  # fmt: skip
+        ds = atlas(spec, scheduler=cluster.scheduler_address, scheduler_timeout=5.0)
+    assert ds["n_steady"].values.tolist() == [3, 1]

@@ -59,7 +59,7 @@ def _tangent_after(body, model, y0, d0, t_end):
     tangent.aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
     status = tangent.advance(code, p, z, fz, ctrl, np.zeros(3, dtype=np.int64), t_end,
                         np.zeros((16, tg.N_AUG)), np.zeros(tg.N_AUG), np.zeros(tg.N_AUG),
-                        scratch, ws, 0.0)  # fmt: skip
+                        scratch, ws, 0.0, 10**9)  # fmt: skip
     assert status == 0
     return start, z[tg.DELTA : tg.N_ERR] * np.exp(ctrl[tg.LOG_SUM])
 

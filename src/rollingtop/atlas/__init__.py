@@ -40,7 +40,7 @@ from rollingtop.atlas._spec import (
     atlas_spec_from_dict,
     load_atlas_spec,
 )
-from rollingtop.atlas._store import check_atlas_output
+from rollingtop.atlas._store import AtlasResumeWarning, check_atlas_output
 
 __all__ = [
     "ATLAS_VERSION",
@@ -56,6 +56,7 @@ __all__ = [
     "STATUS",
     "AtlasAccessor",
     "AtlasError",
+    "AtlasResumeWarning",
     "AtlasSpec",
     "atlas",
     "atlas_spec_from_dict",

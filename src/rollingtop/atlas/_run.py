@@ -18,7 +18,14 @@ from rollingtop._checks import short_repr
 from rollingtop._errors import RollingTopError
 from rollingtop._types import FloatArray
 from rollingtop.atlas._cells import classify_cells
-from rollingtop.atlas._spec import DEFAULT_CHUNK, MAX_WORKERS_PER_CORE, AtlasError, AtlasSpec
+from rollingtop.atlas._spec import (
+    DEFAULT_CHUNK,
+    MAX_SCHEDULER_TIMEOUT,
+    MAX_WORKERS_PER_CORE,
+    SCHEDULER_TIMEOUT,
+    AtlasError,
+    AtlasSpec,
+)
 from rollingtop.atlas._store import (
     _dataset,
     _load_partial,
@@ -36,18 +43,73 @@ if TYPE_CHECKING:
 __all__ = ["atlas", "classify_in_process"]
 
 
+def _probe(address: str, timeout: float) -> None:
+    """Ask ``address`` who it is, within ``timeout`` seconds: :class:`AtlasError` unless a Dask
+    scheduler answers. ``Client``'s own timeout covers the connection, not a listener that
+    accepts and never answers (measured: still waiting after 150 s). The question runs on a
+    loop of its own in a thread, so that a caller's running loop (a notebook) is no obstacle."""
+    import asyncio
+    import concurrent.futures
+
+    from distributed.core import rpc
+
+    async def identity() -> object:
+        remote = rpc(address, timeout=timeout)
+        try:
+            return await asyncio.wait_for(remote.identity(), timeout)
+        finally:
+            await remote.close_rpc()
+
+    where = f"the Dask scheduler at {short_repr(address)}"
+    _connectable(address, timeout, where)
+    pool = concurrent.futures.ThreadPoolExecutor(1)
+    try:
+        answer = pool.submit(asyncio.run, identity()).result(timeout + 5.0)
+    except (TimeoutError, concurrent.futures.TimeoutError):
+        raise AtlasError(f"{where} did not answer within {timeout:g} s "
+                         "(--scheduler-timeout)") from None  # fmt: skip
+    except Exception as exc:  # refused, unresolvable, a garbled answer: distributed's own types
+        why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise AtlasError(f"cannot reach {where}: {why}") from None
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+    if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
+        raise AtlasError(f"{short_repr(address)} answered, but not as a Dask scheduler")
+
+
+def _connectable(address: str, timeout: float, where: str) -> None:
+    """Fail at once where a TCP address refuses the connection (``rpc`` would retry until the
+    timeout and then report no answer)."""
+    import socket
+
+    from distributed.comm.addressing import get_address_host_port, parse_address
+
+    try:
+        if parse_address(address)[0] not in ("tcp", "tls"):
+            return
+        host, port = get_address_host_port(address)
+        socket.create_connection((host, port), timeout=timeout).close()
+    except (OSError, ValueError, TypeError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise AtlasError(f"cannot reach {where}: {why or type(exc).__name__}") from None
+
+
 @contextlib.contextmanager
-def _client(client: Client | None, workers: int | None, scheduler: str | None) -> Iterator[Client]:
-    """The given client; else one connected to ``scheduler``; else an embedded local cluster of
-    ``workers`` processes (default: the cores), closed at the end."""
+def _client(
+    client: Client | None, workers: int | None, scheduler: str | None, timeout: float
+) -> Iterator[Client]:
+    """The given client; else one connected to ``scheduler`` (which must answer as a Dask
+    scheduler within ``timeout`` seconds); else an embedded local cluster of ``workers``
+    processes (default: the cores), closed at the end."""
     if client is not None:
         yield client
         return
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
+        _probe(scheduler, timeout)
         try:
-            remote = Client(scheduler, timeout="10s")
+            remote = Client(scheduler, timeout=f"{timeout}s")
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise AtlasError(f"cannot reach the Dask scheduler at {short_repr(scheduler)}: "
@@ -62,6 +124,9 @@ def _client(client: Client | None, workers: int | None, scheduler: str | None) -
                            dashboard_address=None, silence_logs=50)  # fmt: skip
     try:
         local = Client(cluster)
+        from rollingtop.atlas._quiet import QuietWorker
+
+        local.register_plugin(QuietWorker(), name="rollingtop-quiet-worker")
         try:
             yield local
         finally:
@@ -79,6 +144,7 @@ def atlas(
     scheduler: str | None = None,
     chunk: int = DEFAULT_CHUNK,
     progress: Callable[[int, int], None] | None = None,
+    scheduler_timeout: float = SCHEDULER_TIMEOUT,
 ) -> xr.Dataset:
     """Classify every cell of ``spec`` on Dask; write ``output`` (``.nc`` or ``.zarr``) if given.
 
@@ -99,6 +165,8 @@ def atlas(
         Cells per task.
     progress : callable, optional
         ``progress(done_cells, total_cells)``.
+    scheduler_timeout : float
+        Seconds ``scheduler`` has to answer as a Dask scheduler (:class:`AtlasError` after).
 
     Returns
     -------
@@ -116,28 +184,40 @@ def atlas(
         raise AtlasError(f"workers = {workers} is more than {MAX_WORKERS_PER_CORE} per core "
                          f"({cores} cores) for the local cluster; use a scheduler to go "
                          "wide")  # fmt: skip
+    if not (isinstance(scheduler_timeout, (int, float)) and not isinstance(scheduler_timeout, bool)
+            and 0.0 < scheduler_timeout <= MAX_SCHEDULER_TIMEOUT):  # fmt: skip
+        raise AtlasError(f"scheduler_timeout = {short_repr(scheduler_timeout)} must be a number "
+                         f"of seconds in (0, {MAX_SCHEDULER_TIMEOUT:g}]")  # fmt: skip
     out_path = None if output is None else check_atlas_output(output)
     cells = spec.cells()
     names = tuple(spec.axes)
     starts = list(range(0, spec.size, chunk))
     digest = spec.digest(chunk)
     folder = None if out_path is None else _partial_folder(out_path)
-    done = {} if folder is None else _load_partial(folder, digest)
+    sizes = {k: min(chunk, spec.size - start) for k, start in enumerate(starts)}
+    done = {} if folder is None else _load_partial(folder, digest, sizes)
     created = False
     if folder is not None and not folder.exists():
         folder.mkdir()
         created = True
         write_bytes_atomic(folder / "spec.json", json.dumps({"digest": digest}).encode())
     try:
-        _compute(spec, cells, names, starts, chunk, done, folder, client, workers, scheduler,
-                 progress)  # fmt: skip
+        _compute(spec, cells, names, starts, chunk, done, folder, client, workers,
+                 (scheduler, float(scheduler_timeout)), progress)  # fmt: skip
     except BaseException:
         if created and folder is not None and not any(folder.glob("chunk-*.npz")):
             shutil.rmtree(folder, ignore_errors=True)  # nothing saved: leave no trace
         raise
     ds = _dataset(spec, done)
     if out_path is not None and folder is not None:
-        _write(ds, out_path)
+        try:
+            _write(ds, out_path)
+        except OSError as exc:  # the finished chunks stay: a rerun writes without computing
+            why = exc.strerror or str(exc) or type(exc).__name__
+            raise AtlasError(
+                f"cannot write {str(out_path)!r}: {why}; the finished cells are "
+                f"kept in {str(folder)!r}: run again to write them"
+            ) from None
         shutil.rmtree(folder, ignore_errors=True)
     return ds
 
@@ -152,7 +232,7 @@ def _compute(
     folder: Path | None,
     client: Client | None,
     workers: int | None,
-    scheduler: str | None,
+    scheduler: tuple[str | None, float],
     progress: Callable[[int, int], None] | None,
 ) -> None:
     """Submit the chunks not in ``done`` and collect them into it (saving each at once)."""
@@ -161,7 +241,7 @@ def _compute(
         progress(finished, spec.size)
     todo = [k for k in range(len(starts)) if k not in done]
     if todo:
-        with _client(client, workers, scheduler) as c:
+        with _client(client, workers, *scheduler) as c:
             futures = {c.submit(classify_cells, spec.fixed, names,
                                 cells[starts[k] : starts[k] + chunk], pure=False): k
                        for k in todo}  # fmt: skip

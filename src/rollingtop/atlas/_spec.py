@@ -28,6 +28,9 @@ AXIS_KEYS = (*BODY_KEYS, *LEVEL_KEYS, "model")
 MAX_CELLS = 10_000_000
 #: Cells per Dask task (a chunk, and a file of the partial folder).
 DEFAULT_CHUNK = 200
+#: Seconds a ``--scheduler`` has to answer as a Dask scheduler, by default and at most.
+SCHEDULER_TIMEOUT = 10.0
+MAX_SCHEDULER_TIMEOUT = 3600.0
 #: Bumped when the classification changes: partial results of another version are not reused.
 ATLAS_VERSION = 2
 #: Status of a cell.

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rollingtop._errors import RollingTopError
-from rollingtop.atlas._cells import ATLAS_MODELS
+from rollingtop.atlas._cells import ATLAS_MODELS, FIELDS, MAX_CENTRES
 from rollingtop.atlas._spec import AtlasError, AtlasSpec
 from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
 
@@ -28,28 +28,63 @@ if TYPE_CHECKING:
 #: Largest chunk along each dimension of a Zarr store.
 ZARR_CHUNK = 64
 SUFFIXES = (".nc", ".zarr")
+#: The variables of a chunk with one row of :data:`MAX_CENTRES` per cell.
+CENTRE_FIELDS = ("rotation_centre", "centre_gamma3")
 
 
 def _partial_folder(output: Path) -> Path:
     return output.with_name(output.name + ".partial")
 
 
-def _load_partial(folder: Path, digest: str) -> dict[int, dict[str, np.ndarray]]:
-    """Chunks saved by an earlier run of the same spec (``{}`` if none)."""
+class AtlasResumeWarning(UserWarning):
+    """Damaged or foreign chunk files in an atlas's ``.partial`` folder, recomputed."""
+
+
+def _chunk_fits(part: Mapping[str, np.ndarray], n: int) -> bool:
+    """Whether a loaded chunk has the variables, shapes and kinds of :func:`classify_cells`'
+    output for ``n`` cells (a foreign or truncated file does not)."""
+    if set(part) != {*FIELDS, *CENTRE_FIELDS}:
+        return False
+    flat = all(part[k].shape == (n,) and part[k].dtype.kind == "i" for k in FIELDS)
+    return flat and all(part[k].shape == (n, MAX_CENTRES) and part[k].dtype.kind == "f"
+                        for k in CENTRE_FIELDS)  # fmt: skip
+
+
+def _load_partial(
+    folder: Path, digest: str, sizes: Mapping[int, int]
+) -> dict[int, dict[str, np.ndarray]]:
+    """Chunks saved by an earlier run of the same spec (``{}`` if none); ``sizes``: the cells of
+    each chunk. A file that does not load, or does not hold what its chunk should, is removed
+    and its chunk computed again, with one :class:`AtlasResumeWarning`."""
     if not folder.exists():
         return {}
     try:
         saved = json.loads((folder / "spec.json").read_text())
     except (OSError, ValueError):
         saved = {}
-    if saved.get("digest") != digest:
+    if not isinstance(saved, dict) or saved.get("digest") != digest:
         raise AtlasError(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
                          "remove it to start over")  # fmt: skip
     done = {}
-    for f in folder.glob("chunk-*.npz"):
-        with contextlib.suppress(OSError, ValueError, KeyError):
-            with np.load(f) as z:
-                done[int(f.stem.split("-")[1])] = {key: z[key] for key in z.files}
+    bad = []
+    for f in sorted(folder.glob("chunk-*.npz")):
+        part = None
+        # any failure to read counts as damage: zipfile, zlib, numpy's format and a truncated
+        # file each raise their own type
+        with contextlib.suppress(Exception):
+            k = int(f.stem.split("-")[1])
+            with np.load(f, allow_pickle=False) as z:
+                part = {key: z[key] for key in z.files}
+        if part is None or k not in sizes or not _chunk_fits(part, sizes[k]):
+            bad.append(f.name)
+            with contextlib.suppress(OSError):
+                f.unlink()
+            continue
+        done[k] = part
+    if bad:
+        warnings.warn(AtlasResumeWarning(
+            f"{len(bad)} damaged or foreign chunk file(s) in {folder} (first {bad[0]}): "
+            "computed again"), stacklevel=3)  # fmt: skip
     return done
 
 

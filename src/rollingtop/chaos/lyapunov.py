@@ -29,14 +29,15 @@ from numpy.typing import ArrayLike
 
 from rollingtop._checks import check_memory
 from rollingtop._compiled import compiling, for_code
-from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
-from rollingtop._compiled._tangent import REACHED_VERTICAL
+from rollingtop._compiled._dop853 import BUDGET_EXHAUSTED, FINISHED, STATUS_NAMES
+from rollingtop._compiled._tangent import N_AUG, REACHED_VERTICAL, STEPS
 from rollingtop._errors import IntegrationError, ScenarioError
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE, state_components
 from rollingtop._output import NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
+from rollingtop.chaos.level import VERTICAL_MARGIN
 from rollingtop.contact import ContactModel, get_model
 from rollingtop.dynamics.integrals import evaluate
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals
@@ -184,6 +185,32 @@ class ChaosIndicators(NetCDFOutput):
 _indicators_compiled: set[str] = set()
 
 
+#: Accepted steps of the tangent integration per compiled call: between calls Python runs, and
+#: with it the signal handlers (a SIGTERM ends a long run within about a second).
+CHUNK_STEPS = 4000
+
+
+def _run_chunks(
+    code: int, p: FloatArray, y0: FloatArray, d0: FloatArray, t: FloatArray, rtol: float,
+    atol: float, max_steps: int, out: FloatArray, states: FloatArray, stats: FloatArray,
+    stop: float,
+) -> None:  # fmt: skip
+    """The compiled ``run_indicators`` of kernel ``code``, in calls of at most
+    :data:`CHUNK_STEPS` accepted steps (the same steps as one call)."""
+    kernels = for_code(code).tangent
+    z, fz = np.zeros(N_AUG), np.zeros(N_AUG)
+    ctrl = np.array([0.0, 0.0, rtol, atol, 0.0])
+    counts = np.zeros(3, dtype=np.int64)
+    call(kernels.start_indicators, code, p, y0, d0, float(t[-1]), z, fz, ctrl)
+    k = 0
+    while True:
+        limit = min(max_steps, int(counts[STEPS]) + CHUNK_STEPS)
+        k = call(kernels.indicators_chunk, code, p, z, fz, ctrl, counts, t, k, limit, out,
+                 states, stats, stop)  # fmt: skip
+        if stats[0] != BUDGET_EXHAUSTED or counts[STEPS] >= max_steps:
+            return
+
+
 def _compile_indicators(
     code: int, p: FloatArray, y0: FloatArray, d0: FloatArray, rtol: float, atol: float,
     stop: float,
@@ -197,9 +224,20 @@ def _compile_indicators(
 
     start = time.perf_counter()
     with compiling(kernels, "chaos"):
-        call(kernels.tangent.run_indicators, code, p, y0.copy(), d0.copy(), np.array([1e-9]),
-             float(rtol), atol, 1, np.full((1, 3), np.nan), np.full((1, N_STATE), np.nan),
-             np.zeros(4), stop)  # fmt: skip
+        _run_chunks(
+            code,
+            p,
+            y0.copy(),
+            d0.copy(),
+            np.array([1e-9]),
+            float(rtol),
+            atol,
+            1,
+            np.full((1, 3), np.nan),
+            np.full((1, N_STATE), np.nan),
+            np.zeros(4),
+            stop,
+        )
     _indicators_compiled.add(kernels.PACKAGE)
     return time.perf_counter() - start
 
@@ -257,10 +295,18 @@ def chaos_indicators(
     import time
 
     stop = vertical_stop(model)
+    tilt = math.hypot(y0[12], y0[13])
+    if stop != 0.0 and tilt < VERTICAL_MARGIN:
+        raise IntegrationError(
+            f"the motion starts at the vertical (sqrt(gamma1^2 + gamma2^2) = {tilt:.3g} < "
+            f"{VERTICAL_MARGIN:g}), where the {model.name} model's continuation is not determined "
+            "by the state: the tangent dynamics (Lyapunov exponent, MEGNO) is undefined there; "
+            "start with the axis tilted"
+        )
     compiled = _compile_indicators(code, body.params, y0, d0, rtol, atol, stop)
     start = time.perf_counter()
-    call(for_code(code).tangent.run_indicators, code, body.params, y0, d0, t, float(rtol), atol,
-         int(max_steps), out, states, stats, stop)  # fmt: skip
+    _run_chunks(code, body.params, y0, d0, t, float(rtol), atol, int(max_steps), out, states,
+                stats, stop)  # fmt: skip
     wall = time.perf_counter() - start
     status = int(stats[0])
     if status != FINISHED:

@@ -24,6 +24,9 @@ __all__ = ["atlas"]
               help="Worker processes of the embedded local cluster (default: cores).")  # fmt: skip
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="Run on an existing Dask cluster (tcp://host:port).")  # fmt: skip
+@click.option("--scheduler-timeout", type=float, default=10.0, show_default=True,
+              metavar="SECONDS",
+              help="Seconds the --scheduler has to answer as a Dask scheduler.")  # fmt: skip
 @click.option("--chunk", type=int, default=None, help="Cells per task (default 200).")
 @json_option
 def atlas(
@@ -31,6 +34,7 @@ def atlas(
     output: str,
     workers: int | None,
     scheduler: str | None,
+    scheduler_timeout: float,
     chunk: int | None,
     as_json: bool,
 ) -> None:
@@ -43,12 +47,15 @@ def atlas(
         raise BadInput(f"--workers {workers}: must be >= 1")
     if chunk is not None and chunk < 1:
         raise BadInput(f"--chunk {chunk}: must be >= 1")
+    if not 0.0 < scheduler_timeout <= 3600.0:  # also NaN
+        raise BadInput(f"--scheduler-timeout {scheduler_timeout:g}: must be in (0, 3600] seconds")
     check_atlas_output(output)
     atlas_spec = load_atlas_spec(spec)
     start = time.perf_counter()
     with _output.counting("cells", atlas_spec.size) as progress:
-        ds = atlas(atlas_spec, output, workers=workers, scheduler=scheduler,
-                   chunk=chunk or DEFAULT_CHUNK, progress=progress)  # fmt: skip
+        ds = _output.with_warnings_reported(lambda: atlas(
+            atlas_spec, output, workers=workers, scheduler=scheduler, chunk=chunk or DEFAULT_CHUNK,
+            progress=progress, scheduler_timeout=scheduler_timeout))  # fmt: skip
     wall = time.perf_counter() - start
     classified = ds["status"].values == 0
     counts: dict[str, dict[str, int]] = {}

@@ -119,6 +119,7 @@ def advance(
     scratch: FloatArray,
     ws: Workspace,
     s_stop: float,
+    step_limit: int,
 ) -> int:
     """Advance the augmented state ``z`` (derivative ``fz``) to ``t_end`` exactly.
 
@@ -144,11 +145,14 @@ def advance(
         Nonzero: stop (:data:`REACHED_VERTICAL`) after a step through the vertical, where the
         signed distance ``sigma = (gamma, tau x e3)`` of the axis from it, with the carried
         direction ``tau`` (:mod:`rollingtop.contact.parallel`), changes sign.
+    step_limit : int
+        Stop (``dop.BUDGET_EXHAUSTED``, resumable) before a step once ``counts`` holds this many
+        accepted steps: every call ends after a bounded amount of work.
 
     Returns
     -------
     status : int
-        ``dop.FINISHED``, ``dop.STEP_TOO_SMALL``, ``dop.NOT_FINITE``,
+        ``dop.FINISHED``, ``dop.BUDGET_EXHAUSTED``, ``dop.STEP_TOO_SMALL``, ``dop.NOT_FINITE``,
         ``dop.TOO_MANY_REJECTED`` (the codes of :mod:`rollingtop._compiled._dop853`) or
         :data:`REACHED_VERTICAL`.
     """
@@ -160,7 +164,14 @@ def advance(
     f1, f2, y1, y2 = scratch[0], scratch[1], scratch[2], scratch[3]
     sigma_before = signed_tilt(z)
     while t < t_end:
-        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        if counts[STEPS] >= step_limit:
+            ctrl[T] = t
+            ctrl[H_ABS] = h_abs
+            return dop.BUDGET_EXHAUSTED
+        # ten units in the last place of the time reached or of the target, whichever is
+        # larger: near t = 0 the former alone would let steps of 1e-300 count as progress
+        far = max(abs(t), abs(t_end))
+        min_step = 10.0 * abs(np.nextafter(far, np.inf) - far)
         rejected = 0
         while True:
             if not h_abs >= min_step:
@@ -240,6 +251,88 @@ def advance(
 
 
 @compiled()
+def start_indicators(
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    d0: FloatArray,
+    t_end: float,
+    z: FloatArray,
+    fz: FloatArray,
+    ctrl: FloatArray,
+) -> None:
+    """Set up the augmented state ``z`` (``y0``, then ``d0`` projected onto the tangent space
+    and normalised), its derivative ``fz`` and ``ctrl`` (``t = 0``, the plain integrator's
+    initial step towards ``t_end``, ``rtol`` and ``atol`` as given in ``ctrl[2:4]``)."""
+    ws = new_workspace()
+    znew = np.zeros(N_AUG)
+    ztmp = np.zeros(N_AUG)
+    scratch = np.zeros((4, N_STATE))
+    for i in range(N_AUG):
+        z[i] = 0.0
+    for i in range(N_STATE):
+        z[i] = y0[i]
+        z[DELTA + i] = d0[i]
+    ctrl[T] = 0.0
+    project_tangent(code, p, z[0:N_STATE], z[DELTA:N_ERR], scratch[2], scratch[3], ws)
+    renormalise(z, ctrl)
+    ctrl[LOG_SUM] = 0.0
+    aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
+    # the initial step of the plain integrator, from the motion alone
+    ctrl[H_ABS] = initial_step(code, p, z[0:N_STATE].copy(), fz[0:N_STATE].copy(), t_end, 0.0,
+                               ctrl[RTOL], ctrl[ATOL], znew[0:N_STATE], ztmp[0:N_STATE],
+                               ws)  # fmt: skip
+
+
+@compiled()
+def indicators_chunk(
+    code: int,
+    p: FloatArray,
+    z: FloatArray,
+    fz: FloatArray,
+    ctrl: FloatArray,
+    counts: IntArray,
+    t_samples: FloatArray,
+    k0: int,
+    step_limit: int,
+    out: FloatArray,
+    states: FloatArray,
+    stats: FloatArray,
+    s_stop: float,
+) -> int:
+    """Continue the run set up by :func:`start_indicators` from sample ``k0`` until every
+    sample is written, a failure, or ``step_limit`` accepted steps in ``counts``
+    (``stats[0] = dop.BUDGET_EXHAUSTED``: call again from the returned sample). Writes the
+    samples' ``out`` and ``states`` rows (see :func:`run_indicators`) and ``stats``; returns
+    the next sample to reach."""
+    ws = new_workspace()
+    K = np.zeros((16, N_AUG))
+    znew = np.zeros(N_AUG)
+    ztmp = np.zeros(N_AUG)
+    scratch = np.zeros((4, N_STATE))
+    status = dop.FINISHED
+    k = k0
+    while k < t_samples.shape[0]:
+        status = advance(code, p, z, fz, ctrl, counts, t_samples[k], K, znew, ztmp, scratch, ws,
+                         s_stop, step_limit)  # fmt: skip
+        if status != dop.FINISHED:
+            break
+        t = ctrl[T]
+        out[k, 0] = ctrl[LOG_SUM] / t
+        out[k, 1] = 2.0 * z[W_MEGNO] / t
+        out[k, 2] = z[Z_MEGNO] / t
+        if k < states.shape[0]:
+            for i in range(N_STATE):
+                states[k, i] = z[i]
+        k += 1
+    stats[0] = status
+    stats[1] = counts[STEPS]
+    stats[2] = counts[REJECTED]
+    stats[3] = counts[NFEV]
+    return k
+
+
+@compiled()
 def run_indicators(
     code: int,
     p: FloatArray,
@@ -254,7 +347,9 @@ def run_indicators(
     stats: FloatArray,
     s_stop: float,
 ) -> None:
-    """Integrate the augmented system from ``(y0, d0)`` at ``t = 0`` through ``t_samples``.
+    """Integrate the augmented system from ``(y0, d0)`` at ``t = 0`` through ``t_samples``, in
+    one call (the batches of :mod:`.chaos`; a single run goes through :func:`start_indicators`
+    and :func:`indicators_chunk` to return to Python between chunks).
 
     Parameters
     ----------
@@ -264,6 +359,8 @@ def run_indicators(
         Initial tangent vector (projected onto the tangent space and normalised here).
     t_samples : ndarray, shape (n,)
         Increasing positive sample times.
+    max_steps : int
+        Accepted steps at most (``stats[0] = dop.BUDGET_EXHAUSTED`` when reached).
     out : ndarray, shape (n, 3)
         Filled with ``lambda(t) = sum ln|delta| / t``, ``Y(t) = 2 W / t``, ``<Y>(t) = Z / t``
         (NaN after a failure).
@@ -274,46 +371,13 @@ def run_indicators(
     s_stop : float
         See :func:`advance`.
     """
-    ws = new_workspace()
-    K = np.zeros((16, N_AUG))
-    znew = np.zeros(N_AUG)
-    ztmp = np.zeros(N_AUG)
-    scratch = np.zeros((4, N_STATE))
     z = np.zeros(N_AUG)
     fz = np.zeros(N_AUG)
-    for i in range(N_STATE):
-        z[i] = y0[i]
-        z[DELTA + i] = d0[i]
     ctrl = np.array([0.0, 0.0, rtol, atol, 0.0])
     counts = np.zeros(3, dtype=np.int64)
-    project_tangent(code, p, z[0:N_STATE], z[DELTA:N_ERR], scratch[2], scratch[3], ws)
-    renormalise(z, ctrl)
-    ctrl[LOG_SUM] = 0.0
-    aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
-    # the initial step of the plain integrator, from the motion alone
-    ctrl[H_ABS] = initial_step(code, p, z[0:N_STATE].copy(), fz[0:N_STATE].copy(),
-                                   t_samples[-1], 0.0, rtol, atol, znew[0:N_STATE],
-                                   ztmp[0:N_STATE], ws)  # fmt: skip
-    status = dop.FINISHED
     for k in range(t_samples.shape[0]):
         for j in range(3):
             out[k, j] = np.nan
-    for k in range(t_samples.shape[0]):
-        status = advance(code, p, z, fz, ctrl, counts, t_samples[k], K, znew, ztmp, scratch, ws,
-                         s_stop)  # fmt: skip
-        if status != dop.FINISHED:
-            break
-        t = ctrl[T]
-        out[k, 0] = ctrl[LOG_SUM] / t
-        out[k, 1] = 2.0 * z[W_MEGNO] / t
-        out[k, 2] = z[Z_MEGNO] / t
-        if k < states.shape[0]:
-            for i in range(N_STATE):
-                states[k, i] = z[i]
-        if counts[STEPS] >= max_steps:
-            status = dop.BUDGET_EXHAUSTED
-            break
-    stats[0] = status
-    stats[1] = counts[STEPS]
-    stats[2] = counts[REJECTED]
-    stats[3] = counts[NFEV]
+    start_indicators(code, p, y0, d0, t_samples[-1], z, fz, ctrl)
+    indicators_chunk(code, p, z, fz, ctrl, counts, t_samples, 0, max_steps, out, states, stats,
+                     s_stop)  # fmt: skip
