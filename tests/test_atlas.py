@@ -465,6 +465,7 @@ def test_a_store_that_cannot_be_written_is_named_and_the_cells_are_kept(client, 
     import errno
 
     import rollingtop.atlas._store as store
+    from rollingtop.atlas._store import CellsKept
 
     spec = atlas_spec_from_dict(spec_dict(SMALL))
     out = tmp_path / "a.zarr"
@@ -476,7 +477,7 @@ def test_a_store_that_cannot_be_written_is_named_and_the_cells_are_kept(client, 
 
     monkeypatch.setattr(xr.Dataset, "to_zarr", too_large)
     with pytest.raises(
-        AtlasError,
+        CellsKept,
         match=r"cannot write '.*a\.zarr': File too large; the "
         r"finished cells are kept in '.*a\.zarr\.partial'",
     ):

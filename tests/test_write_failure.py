@@ -173,3 +173,53 @@ def test_encoder_killed_by_the_file_size_limit(tmp_path):
     (line,) = proc.stderr.strip().splitlines()
     assert line.startswith(f"rollingtop: error: cannot write {str(target)!r}: the encoder ")
     assert listing(tmp_path) == []
+
+
+def _atlas_spec(folder):
+    spec = folder / "spec.toml"
+    spec.write_text((EXAMPLES / "paper.toml").read_text().split("[initial]")[0]
+                    + "[level]\nM3 = 1.0\nC1 = 0.5\nC2 = -2.0\n[axes]\n"
+                    "C2 = {start = -3.0, stop = 0.0, num = 40}\n"
+                    "C1 = [0.0, 0.5, 1.0]\n")  # fmt: skip
+    return str(spec)
+
+
+#: Issue 27: the newer outputs under a file-size limit in a real process: (arguments, the
+#: file named in the error, the names left besides the inputs, the message's reason).
+NEWER_CASES = {
+    "atlas-nc": (lambda d: ["atlas", _atlas_spec(d), "--workers", "1", "-o", str(d / "a.nc")],
+                 "a.nc", ["a.nc.partial"], "kept"),
+    "atlas-zarr": (lambda d: ["atlas", _atlas_spec(d), "--workers", "1", "--chunk", "10",
+                              "-o", str(d / "a.zarr")], "a.zarr", ["a.zarr.partial"], "kept"),
+    "section-netcdf": (lambda d: ["section", str(EXAMPLES / "parallel_chaotic.toml"),
+                                  "--crossings", "400", "--trajectories", "2",
+                                  "-o", str(d / "sec.png"), "--netcdf", str(d / "sec.nc")],
+                       None, [], None),
+    "chaos-o": (lambda d: ["chaos", PAPER, "--t-end", "5", "--samples", "20000",
+                           "-o", str(d / "ly.nc")], "ly.nc", [], None),
+    "chaos-figure": (lambda d: ["chaos", PAPER, "--t-end", "5", "--figure", str(d / "ly.png")],
+                     "ly.png", [], None),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(NEWER_CASES))
+@pytest.mark.slow
+def test_newer_outputs_under_a_file_size_limit(tmp_path, case):
+    """Issue 27: exit 1, one line naming the file or store and the reason, no traceback, and no
+    output left: only the atlas's .partial folder stays (named in its message: a rerun writes
+    the finished cells without computing them again)."""
+    args, name, left, kept = NEWER_CASES[case]
+    argv = args(tmp_path)
+    before = set(listing(tmp_path))
+    proc = subprocess.run([sys.executable, "-m", "rollingtop", *argv], capture_output=True,
+                          text=True, check=False,
+                          preexec_fn=_limit(3000 if case == "atlas-zarr" else 16 << 10),
+                          timeout=300)  # fmt: skip
+    lines = [x for x in proc.stderr.strip().splitlines() if "compiling" not in x]
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1 and os.strerror(errno.EFBIG) in lines[0], proc.stderr
+    if name is not None:
+        assert f"cannot write {str(tmp_path / name)!r}" in lines[0]
+    if kept:
+        assert "finished cells are kept" in lines[0]
+    assert set(listing(tmp_path)) == before | set(left)

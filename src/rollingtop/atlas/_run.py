@@ -27,6 +27,7 @@ from rollingtop.atlas._spec import (
     AtlasSpec,
 )
 from rollingtop.atlas._store import (
+    CellsKept,
     _dataset,
     _load_partial,
     _partial_folder,
@@ -214,10 +215,7 @@ def atlas(
             _write(ds, out_path)
         except OSError as exc:  # the finished chunks stay: a rerun writes without computing
             why = exc.strerror or str(exc) or type(exc).__name__
-            raise AtlasError(
-                f"cannot write {str(out_path)!r}: {why}; the finished cells are "
-                f"kept in {str(folder)!r}: run again to write them"
-            ) from None
+            raise CellsKept(out_path, exc.errno, why, folder) from None
         shutil.rmtree(folder, ignore_errors=True)
     return ds
 

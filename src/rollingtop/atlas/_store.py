@@ -19,7 +19,7 @@ import numpy as np
 from rollingtop._errors import RollingTopError
 from rollingtop.atlas._cells import ATLAS_MODELS, FIELDS, MAX_CENTRES
 from rollingtop.atlas._spec import AtlasError, AtlasSpec
-from rollingtop.io import check_output_path, netcdf_bytes, write_bytes_atomic
+from rollingtop.io import WriteFailed, check_output_path, netcdf_bytes, write_bytes_atomic
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -34,6 +34,19 @@ CENTRE_FIELDS = ("rotation_centre", "centre_gamma3")
 
 def _partial_folder(output: Path) -> Path:
     return output.with_name(output.name + ".partial")
+
+
+class CellsKept(WriteFailed):
+    """The finished atlas could not be written (exit status 1); its cells stay in the partial
+    folder ``kept``, so that a rerun writes them without computing them again."""
+
+    def __init__(self, path: Path, errno: int | None, reason: str, kept: Path) -> None:
+        super().__init__(path, errno, reason)
+        self.kept = str(kept)
+
+    def __str__(self) -> str:
+        return (f"cannot write {self.filename!r}: {self.strerror}; the finished cells are kept "
+                f"in {self.kept!r}: run again to write them")  # fmt: skip
 
 
 class AtlasResumeWarning(UserWarning):
