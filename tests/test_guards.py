@@ -229,3 +229,20 @@ def test_ctrl_c_to_the_atlas_process_group_is_one_line(tmp_path):
     ], lines
     assert took < 5.0
     assert not (tmp_path / "a.nc").exists()
+
+
+@pytest.mark.parametrize("inertia", ["0.13333333333333333", "6.6666666666666667e49"])
+def test_a_shell_of_1e50_ends_in_one_line(tmp_path, inertia):
+    """Issue 27: a shell-rotor pair whose shell weighs 1e50 (its inertia kept, or scaled with
+    it) ends at once with one line (exit 1: the state's derivative is not finite) instead of
+    running on."""
+    path = _scenario(tmp_path, "shell_rotor", **{"mass = 0.2": "mass = 1e50",
+                                                 "inertia = 0.13333333333333333":
+                                                 f"inertia = {inertia}"})  # fmt: skip
+    argv = [sys.executable, "-m", "rollingtop.cli", "simulate", path, "--t-end", "1"]
+    out = subprocess.run(argv, capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    lines = [x for x in out.stderr.splitlines() if "compiling" not in x]
+    assert out.returncode in (1, 2) and len(lines) == 1 and "Traceback" not in out.stderr, (
+        out.stderr
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shell_rotor.toml"]

@@ -201,3 +201,20 @@ def test_cli_reports_a_huge_spin_in_one_line(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("rollingtop: error: ")
     assert "not finite" in lines[0] and "Traceback" not in proc.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["huge.toml"]
+
+
+def test_the_pace_guard_refuses_a_run_far_beyond_max_steps():
+    """Issue 27: after PACE_AFTER steps, a pace that needs more than PACE_FACTOR x max_steps to
+    reach t_end is one IntegrationError; a pace within it, or too few steps to judge, is not."""
+    from rollingtop.integrate._pace import PACE_AFTER, PACE_FACTOR, check_pace
+
+    n = PACE_AFTER
+    with pytest.raises(IntegrationError, match=r"needs about 4e\+17 steps, more than 100 times"):
+        check_pace(0.0, 1e-13, 1.0, n, 10**8)
+    with pytest.raises(IntegrationError, match="needs about inf steps"):
+        check_pace(5.0, 5.0, 6.0, n, 10**8)  # no progress at all
+    check_pace(0.0, 1e-13, 1.0, n - 1, 10**8)  # too early to judge
+    limit = n * 10 / PACE_FACTOR  # needs 10 n steps: exactly the factor
+    check_pace(0.0, 0.1, 1.0, n, int(limit))
+    with pytest.raises(IntegrationError):
+        check_pace(0.0, 0.1, 1.0, n, int(limit) - 1)

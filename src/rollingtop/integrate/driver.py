@@ -21,6 +21,7 @@ from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
 from rollingtop.integrate._held import held_arrays
+from rollingtop.integrate._pace import check_pace
 
 __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "compile_kernels"]
 
@@ -222,6 +223,9 @@ def _run_compiled(
             progress(float(ctrl[dop.T]))
         if status != dop.BUDGET_EXHAUSTED:
             break
+        if max_steps is not None:
+            check_pace(float(t_eval[0]), float(ctrl[dop.T]), t_end, int(counts[dop.STEPS]),
+                        max_steps)  # fmt: skip
         if max_steps is not None and counts[dop.STEPS] >= max_steps:
             raise IntegrationError(
                 f"max_steps = {max_steps} accepted steps reached at t = {ctrl[dop.T]:.6g} "
