@@ -110,7 +110,7 @@ def test_atlas_progress_only_on_a_terminal(capsys, tmp_path, monkeypatch, client
 
     real = rollingtop.atlas.atlas
 
-    def in_process(spec, output, *, workers, scheduler, chunk, progress):
+    def in_process(spec, output, *, workers, scheduler, chunk, progress, scheduler_timeout):
         return real(spec, output, client=client, chunk=2, progress=progress)
 
     monkeypatch.setattr(rollingtop.atlas, "atlas", in_process)
