@@ -11,7 +11,7 @@ import math
 import os
 import re
 
-from rollingtop._errors import ScenarioError
+from rollingtop._errors import QUOTE_CHARS, ScenarioError, short_repr
 from rollingtop.io import format_bytes
 
 __all__ = [
@@ -25,28 +25,8 @@ __all__ = [
     "vector",
 ]
 
-#: Longest quotation of a value in a message.
-QUOTE_CHARS = 80
 #: Cap on the memory a run may plan for, before the physical-memory bound.
 MEMORY_CAP_BYTES = 8 << 30
-
-
-def short_repr(value: object, limit: int = QUOTE_CHARS) -> str:
-    """``repr(value)`` cut to ``limit`` characters (with an ellipsis), for error messages."""
-    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:
-        try:
-            return f"<integer of {len(str(abs(value)))} digits>"
-        except ValueError:  # longer than Python converts to text
-            return f"<integer of about {int(value.bit_length() * 0.30103)} digits>"
-    if isinstance(value, str) and len(value) > limit:
-        return repr(value[: limit - 3] + "…")
-    if isinstance(value, list | tuple | dict) and len(value) > limit:
-        return f"<{type(value).__name__} of {len(value)} items>"
-    try:
-        text = repr(value)
-    except (RecursionError, ValueError):
-        return f"<{type(value).__name__}>"
-    return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
 def short_name(key: str, limit: int = QUOTE_CHARS) -> str:

@@ -48,3 +48,25 @@ class Interrupted(KeyboardInterrupt):
 
 class ContactLostWarning(UserWarning):
     """The normal reaction turned negative: the body would leave the plane."""
+
+
+#: Characters a quoted value keeps in a message (:func:`short_repr`).
+QUOTE_CHARS = 80
+
+
+def short_repr(value: object, limit: int = QUOTE_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters (with an ellipsis), for error messages."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:
+        try:
+            return f"<integer of {len(str(abs(value)))} digits>"
+        except ValueError:  # longer than Python converts to text
+            return f"<integer of about {int(value.bit_length() * 0.30103)} digits>"
+    if isinstance(value, str) and len(value) > limit:
+        return repr(value[: limit - 3] + "…")
+    if isinstance(value, list | tuple | dict) and len(value) > limit:
+        return f"<{type(value).__name__} of {len(value)} items>"
+    try:
+        text = repr(value)
+    except (RecursionError, ValueError):
+        return f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[: limit - 1] + "…"

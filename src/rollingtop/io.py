@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeAlias
 
-from rollingtop._errors import OutputError
+from rollingtop._errors import OutputError, short_repr
 
 if TYPE_CHECKING:
     from _typeshed import ReadableBuffer
@@ -109,17 +109,20 @@ def check_output_path(path: PathArg, suffixes: Iterable[str]) -> Path:
     path = Path(path)
     suffixes = tuple(suffixes)
     if path.suffix.lower() not in suffixes:
+        given = short_repr(path.suffix) if path.suffix else repr("(none)")
         raise OutputError(
-            f"cannot write {str(path)!r}: unknown output format {path.suffix or '(none)'!r} "
+            f"cannot write {short_repr(str(path))}: unknown output format {given} "
             f"(use {' or '.join(suffixes)})"
         )
     parent = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
-        raise OutputError(f"cannot write {str(path)!r}: it is a folder")
+        raise OutputError(f"cannot write {short_repr(str(path))}: it is a folder")
     if not parent.is_dir():
-        raise OutputError(f"cannot write {str(path)!r}: folder {str(parent)!r} does not exist")
+        raise OutputError(
+            f"cannot write {short_repr(str(path))}: folder {short_repr(str(parent))} does not exist"
+        )
     if not os.access(parent, os.W_OK | os.X_OK) or (path.exists() and not os.access(path, os.W_OK)):
-        raise OutputError(f"cannot write {str(path)!r}: permission denied")
+        raise OutputError(f"cannot write {short_repr(str(path))}: permission denied")
     return path
 
 

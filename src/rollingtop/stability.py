@@ -75,6 +75,12 @@ def _state(x: FloatArray) -> FloatArray:
     return y
 
 
+_OVERFLOW = (
+    "the linearisation at omega3 = {:.3g} overflows double precision (a spin this "
+    "large has no finite Jacobian): choose a smaller omega3"
+)
+
+
 def _generic_eigenvalues(
     model: ContactModel, body: SphericalTop, omega3: float, pole: int
 ) -> ComplexArray:
@@ -97,10 +103,14 @@ def _generic_eigenvalues(
         return np.concatenate([[x[6:9] @ x[6:9] - 1.0], J[:nc] @ x[0:6]])
 
     G = central_jacobian(constraints, x0)
+    if not np.all(np.isfinite(G)):
+        raise StabilityError(_OVERFLOW.format(omega3))
     _, sv, vt = np.linalg.svd(G)
     rank = int(np.sum(sv > 1e-9 * sv[0]))
     T = vt[rank:].T  # orthonormal basis of the tangent space of the constraint manifold
     A = T.T @ central_jacobian(rhs, x0) @ T
+    if not np.all(np.isfinite(A)):
+        raise StabilityError(_OVERFLOW.format(omega3))
     out: ComplexArray = np.linalg.eigvals(A).astype(complex)
     return out
 

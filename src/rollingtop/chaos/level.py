@@ -33,6 +33,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from rollingtop._checks import short_repr
 from rollingtop._compiled import for_code
 from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import InitialStateError
@@ -73,8 +74,8 @@ def held_integrals(
     unknown = [n for n in names if n not in own]
     if unknown:
         raise InitialStateError(
-            f"{', '.join(unknown)} is not an integral of model {model.name!r} for this body "
-            f"(it has: {', '.join(own)})"
+            f"{short_repr(', '.join(unknown))} is not an integral of model {model.name!r} for "
+            f"this body (it has: {', '.join(own)})"
         )
     return names
 

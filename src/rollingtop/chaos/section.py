@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rollingtop._checks import short_repr
 from rollingtop._compiled import by_package, compiling
 from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
 from rollingtop._compiled._section import SECTION_STATS
@@ -165,6 +166,12 @@ def poincare_section(
         raise ScenarioError(f"atol = {atol!r} must be > 0")
     if not (isinstance(t_max, int | float) and t_max > 0):
         raise ScenarioError(f"t_max = {t_max!r} must be > 0")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int | np.integer)
+                             or seed < 0):  # fmt: skip
+        raise ScenarioError(f"seed = {short_repr(seed)} must be an integer >= 0")
+    if trajectories is not None and trajectories * crossings > MAX_POINTS:  # before sampling
+        raise ScenarioError(f"{trajectories} trajectories x {crossings} crossings exceeds "
+                            f"{MAX_POINTS}")  # fmt: skip
     names = held_integrals(body, model, hold)
     Y0 = _initial_states(body, model, states, trajectories, hold, seed)
     K = Y0.shape[0]

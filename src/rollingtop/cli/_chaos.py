@@ -140,9 +140,10 @@ def section(
         click.echo(json.dumps(summary))
         return
     found, K = summary["crossings_found"], summary["trajectories"]
+    worst = summary["max_abs_w_tau"]
     click.echo(f"{found} crossings of {K} trajectories (model {summary['model']}, held: "
-               f"{', '.join(summary['held'])}); max |w_tau| at the crossings "
-               f"{summary['max_abs_w_tau']:.2g}")  # fmt: skip
+               f"{', '.join(summary['held'])})" + ("" if worst is None else
+               f"; max |w_tau| at the crossings {worst:.2g}"))  # fmt: skip
     for line in _stopped_lines(summary["stopped_early"], crossings):
         click.echo(line)
     click.echo(f"wrote {output}" + ("" if netcdf is None else f" and {netcdf}"))

@@ -22,7 +22,7 @@ from typing import IO, Any
 
 import click
 
-from rollingtop._errors import IntegrationError, Interrupted, RollingTopError
+from rollingtop._errors import IntegrationError, Interrupted, RollingTopError, short_repr
 from rollingtop.io import WriteFailed
 
 __all__ = ["BadInput", "Reported", "RunFailed", "Stopped", "one_line", "reported"]
@@ -99,7 +99,8 @@ def reported() -> Iterator[None]:
     except Interrupted as exc:
         raise Stopped.of(exc.signum)(exc.signum) from None
     except OSError as exc:
-        raise RunFailed(f"{exc.filename or ''}: {exc.strerror or exc}".lstrip(": ")) from None
+        where = "" if exc.filename is None else f"{short_repr(str(exc.filename))}: "
+        raise RunFailed(f"{where}{exc.strerror or exc}") from None
     except OverflowError:  # Python's float arithmetic raises where numpy's gives inf
         raise BadInput(
             "a derived quantity overflows double precision (a product or power "

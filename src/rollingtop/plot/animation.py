@@ -20,6 +20,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from rollingtop._errors import ScenarioError
 from rollingtop.io import PathArg, atomic_write, check_output_path
 from rollingtop.plot._frames import frame_geometry
 from rollingtop.plot.looks import LOOKS
@@ -188,7 +189,10 @@ def animate(
         duration = (t1 - t0) / speed
     n_frames = int(round(duration * fps))
     if n_frames < 1:
-        raise ValueError(f"duration * fps = {duration * fps:g} gives no frame")
+        raise ScenarioError(
+            f"duration * fps = {duration * fps:g} gives no frame (at least one "
+            "is needed: a longer duration or a higher fps)"
+        )
     if t0 + (n_frames - 1) / fps * speed > t1 * (1 + 1e-12) + 1e-12:
         raise ValueError(
             f"the video needs t up to {t0 + (n_frames - 1) / fps * speed:g} but the trajectory "
