@@ -102,13 +102,15 @@ def _generic_eigenvalues(
         nc = call(dynamics.constraint_rows, code, p, _state(x), J, bias, dirs)
         return np.concatenate([[x[6:9] @ x[6:9] - 1.0], J[:nc] @ x[0:6]])
 
-    G = central_jacobian(constraints, x0)
+    with np.errstate(all="ignore"):  # an overflow is refused below, in one line
+        G = central_jacobian(constraints, x0)
     if not np.all(np.isfinite(G)):
         raise StabilityError(_OVERFLOW.format(omega3))
     _, sv, vt = np.linalg.svd(G)
     rank = int(np.sum(sv > 1e-9 * sv[0]))
     T = vt[rank:].T  # orthonormal basis of the tangent space of the constraint manifold
-    A = T.T @ central_jacobian(rhs, x0) @ T
+    with np.errstate(all="ignore"):
+        A = T.T @ central_jacobian(rhs, x0) @ T
     if not np.all(np.isfinite(A)):
         raise StabilityError(_OVERFLOW.format(omega3))
     out: ComplexArray = np.linalg.eigvals(A).astype(complex)
