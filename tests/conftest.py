@@ -27,8 +27,29 @@ FREE = {
 }
 
 
+#: Default of ``--fuzz-budget``: keeps test_fuzz.py's click-driven section near a minute on 2 cores.
+FUZZ_BUDGET = 6
+
+
 def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addoption("--slow", action="store_true", default=False, help="run the slow tests too")
+    parser.addoption(
+        "--fuzz-budget",
+        type=int,
+        default=FUZZ_BUDGET,
+        metavar="N",
+        help=f"random examples per command of test_fuzz.py's click-driven fuzz (default "
+        f"{FUZZ_BUDGET})",
+    )
+
+
+@pytest.fixture
+def fuzz_budget(request: pytest.FixtureRequest) -> int:
+    """``--fuzz-budget N``: hypothesis examples per command (tests/test_fuzz.py)."""
+    budget = request.config.getoption("--fuzz-budget")
+    if budget < 1:
+        raise pytest.UsageError(f"--fuzz-budget {budget}: must be >= 1")
+    return budget
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
