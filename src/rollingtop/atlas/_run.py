@@ -5,6 +5,7 @@ the same Dataset computed in process."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import shutil
@@ -203,8 +204,8 @@ def atlas(
         created = True
         write_bytes_atomic(folder / "spec.json", json.dumps({"digest": digest}).encode())
     try:
-        _compute(spec, cells, names, starts, chunk, done, folder, client, workers,
-                 (scheduler, float(scheduler_timeout)), progress)  # fmt: skip
+        connect = functools.partial(_client, client, workers, scheduler, float(scheduler_timeout))
+        _compute(spec, cells, names, starts, chunk, done, folder, connect, progress)
     except BaseException:
         if created and folder is not None and not any(folder.glob("chunk-*.npz")):
             shutil.rmtree(folder, ignore_errors=True)  # nothing saved: leave no trace
@@ -228,9 +229,7 @@ def _compute(
     chunk: int,
     done: dict[int, dict[str, np.ndarray]],
     folder: Path | None,
-    client: Client | None,
-    workers: int | None,
-    scheduler: tuple[str | None, float],
+    connect: Callable[[], contextlib.AbstractContextManager[Client]],
     progress: Callable[[int, int], None] | None,
 ) -> None:
     """Submit the chunks not in ``done`` and collect them into it (saving each at once)."""
@@ -239,7 +238,7 @@ def _compute(
         progress(finished, spec.size)
     todo = [k for k in range(len(starts)) if k not in done]
     if todo:
-        with _client(client, workers, *scheduler) as c:
+        with connect() as c:
             futures = {c.submit(classify_cells, spec.fixed, names,
                                 cells[starts[k] : starts[k] + chunk], pure=False): k
                        for k in todo}  # fmt: skip

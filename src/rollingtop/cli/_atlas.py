@@ -41,14 +41,21 @@ def atlas(
     """Classify every cell of SPEC's grid: a scenario file whose [axes] table sets the axes
     (body keys a3, I1, I3, R, m, g and level keys M3, C1, C2; each a list or {start, stop,
     num}). An interrupted run resumes where it stopped (OUTPUT.partial/)."""
-    from rollingtop.atlas import DEFAULT_CHUNK, atlas, check_atlas_output, load_atlas_spec
+    from rollingtop.atlas import (
+        DEFAULT_CHUNK,
+        MAX_SCHEDULER_TIMEOUT,
+        atlas,
+        check_atlas_output,
+        load_atlas_spec,
+    )
 
     if workers is not None and workers < 1:
         raise BadInput(f"--workers {workers}: must be >= 1")
     if chunk is not None and chunk < 1:
         raise BadInput(f"--chunk {chunk}: must be >= 1")
-    if not 0.0 < scheduler_timeout <= 3600.0:  # also NaN
-        raise BadInput(f"--scheduler-timeout {scheduler_timeout:g}: must be in (0, 3600] seconds")
+    if not 0.0 < scheduler_timeout <= MAX_SCHEDULER_TIMEOUT:  # also NaN
+        raise BadInput(f"--scheduler-timeout {scheduler_timeout:g}: must be in "
+                       f"(0, {MAX_SCHEDULER_TIMEOUT:g}] seconds")  # fmt: skip
     check_atlas_output(output)
     atlas_spec = load_atlas_spec(spec)
     start = time.perf_counter()
