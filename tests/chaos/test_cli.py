@@ -99,7 +99,9 @@ def test_section_reports_the_motions_that_would_leave_the_plane(capsys, tmp_path
         starts, t_last = ds["initial_state"].values, ds["t_last"].values
     assert summary["contact_lost"] == int(np.sum(least < 0)) >= 1  # measured: 1 of 4
     assert f"{summary['contact_lost']} of 4 trajectories need a negative normal force" in err
-    assert err.count("\n") == 1
+    # one line (besides a compile notice, printed where this test is the first to compile the
+    # section kernels: it depends on the order of the tests and the state of the cache)
+    assert len([ln for ln in err.splitlines() if not ln.startswith("rollingtop: compiling")]) == 1
     sc = load_scenario(scenario)
     for y0, t, f in zip(starts, t_last, least, strict=True):
         with warnings.catch_warnings():  # the lost contact is what is measured here
