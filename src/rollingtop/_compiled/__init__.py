@@ -103,6 +103,7 @@ ESTIMATES: dict[str, float] = {
     "dynamics": 4.0,
     "integrator": 9.0,
     "held integrator": 4.0,
+    "event integrator": 4.0,
     "ensemble": 2.0,
     "chaos": 6.0,
 }

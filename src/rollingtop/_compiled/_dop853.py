@@ -68,8 +68,9 @@ STATUS_NAMES = {
 #: means the error control cannot meet the tolerance here (too tight, or a singular point).
 MAX_REJECTED_IN_A_ROW = 100
 
-# Indices into the float control array ``ctrl``.
-T, H_ABS, T_END, RTOL, ATOL, G_OLD = 0, 1, 2, 3, 4, 5
+# Indices into the float control array ``ctrl``: the event function at ``t`` (``G_OLD``) and,
+# for the pairs of crossings inside one step, the one before it (``EV_PREV_G`` at ``EV_PREV_T``).
+T, H_ABS, T_END, RTOL, ATOL, G_OLD, EV_PREV_T, EV_PREV_G = 0, 1, 2, 3, 4, 5, 6, 7
 # Indices into the integer counter array ``counts``: the projection's passes and the steps at
 # which it left a nonlinear integral (the energy at a turning point) for the next ones, then the
 # right-hand sides spent on monitoring the normal force inside steps (not in ``NFEV``, which
@@ -97,7 +98,8 @@ def new_track() -> FloatArray:
 def dip_predicted(t0: float, n0: float, t1: float, n1: float, t2: float, n2: float) -> bool:
     """Whether the parabola through the normal force at the last three step ends ``t0 < t1 <
     t2`` has its minimum inside the last step ``(t1, t2)``: the force may dip there below both
-    ends, which the dense output then resolves (:func:`.dense.dip_minimum`)."""
+    ends, which the dense output then resolves (:func:`.dense.dip_minimum`; the same test finds
+    the extrema of an event function, :func:`.dense.step_events`)."""
     if not (math.isfinite(t0) and math.isfinite(n0)):
         return False
     d1 = (n1 - n0) / (t1 - t0)

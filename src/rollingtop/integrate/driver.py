@@ -31,7 +31,7 @@ __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "c
 PROGRESS_CHUNK = 20_000
 
 #: Seconds each compiled package's integrator took to compile or load in this process.
-_compiled: dict[tuple[str, bool], float] = {}
+_compiled: dict[tuple[str, bool, bool], float] = {}
 
 
 class StepReactions(TypedDict, total=False):
@@ -133,17 +133,26 @@ def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool
     return sum(_compile_package(kernels) for kernels in packages_of(model, variants=variants))
 
 
-def compile_code(code: int, *, held: bool = False) -> float:
+def compile_code(code: int, *, held: bool = False, events: bool = False) -> float:
     """:func:`compile_kernels` for the package that runs kernel code ``code`` (a model's own, or
     its variants'); ``held``: the stepper that holds integrals by projection instead of the plain
     one (``project_integrals``: a separate compile, so that a run without it never pays for it);
-    seconds spent."""
-    return _compile_package(for_code(int(code)), held)
+    ``events``: the stepper that locates events (the held one does too); seconds spent."""
+    return _compile_package(for_code(int(code)), held, events)
 
 
-def _compile_package(kernels: ModuleType, held: bool = False) -> float:
-    """:func:`compile_kernels` for one compiled package (``held``: :func:`compile_code`)."""
-    key = (kernels.PACKAGE, held)
+def _stepper(kernels: ModuleType, held: bool, events: bool) -> ModuleType:
+    """The copy of the stepper a run needs (:mod:`rollingtop._compiled._codegen`)."""
+    if held:
+        return kernels.stepper_held  # type: ignore[no-any-return]
+    return kernels.stepper_events if events else kernels.stepper  # type: ignore[no-any-return]
+
+
+def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
+    """:func:`compile_kernels` for one compiled package (``held``, ``events``:
+    :func:`compile_code`)."""
+    events = events and not held  # the held stepper locates events too
+    key = (kernels.PACKAGE, held, events)
     if key in _compiled:
         return 0.0
     start = time.perf_counter()
@@ -152,10 +161,12 @@ def _compile_package(kernels: ModuleType, held: bool = False) -> float:
     y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
     y[3:6] = (0.1, 0.2, 0.3)
     code = kernels._dispatch.CODES[0]
-    with compiling(kernels, "held integrator" if held else "integrator"):
+    what = "held integrator" if held else "event integrator" if events else "integrator"
+    with compiling(kernels, what):
         call(kernels.dynamics.project, code, p, y, call(new_workspace))
         # with a projection onto an integral (held): the held stepper's loop
-        _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None, (1, 0, 1),
+        _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None,
+                      (1, 0, 1) if events or held else (0, 0, 0),
                       np.array([0], dtype=np.int64) if held else None)  # fmt: skip
         call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
     _compiled[key] = time.perf_counter() - start
@@ -178,8 +189,8 @@ def _run_compiled(
     w = _workspace(n)
     icodes, targets, pw = held_arrays(code, p, y0, held)
     package = for_code(code)
-    stepper = package.stepper_held if icodes.shape[0] > 0 else package.stepper
     ev_code, ev_direction, capacity = event
+    stepper = _stepper(package, icodes.shape[0] > 0, ev_code != 0)
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
     ev_t = np.empty(capacity)
@@ -355,7 +366,7 @@ def integrate(
     if unknown:
         raise ValueError(f"no compiled integral {unknown[0]!r} (known: {', '.join(CODES)})")
     held = np.array([CODES[n] for n in project_integrals], dtype=np.int64)
-    compile_s = compile_code(code, held=held.shape[0] > 0)
+    compile_s = compile_code(code, held=held.shape[0] > 0, events=event[0] != 0)
     out, counts, track, wall, (ev_t, ev_y, dropped) = _run_compiled(
         int(code),
         params,

@@ -16,7 +16,7 @@ from rollingtop._compiled._kernel import new_workspace
 from rollingtop._compiled._section import POLISH_DT, POLISH_ITERATIONS
 from rollingtop._compiled.meridian_variants.dynamics import project, rhs
 from rollingtop._compiled.meridian_variants.events import event_value
-from rollingtop._compiled.meridian_variants.stepper import run, start
+from rollingtop._compiled.meridian_variants.stepper_events import run, start
 from rollingtop._compiled.meridian_variants.tangent import run_indicators
 from rollingtop._jit import compiled, kernel
 from rollingtop._layout import N_STATE

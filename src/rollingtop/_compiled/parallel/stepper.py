@@ -26,9 +26,7 @@ from rollingtop._compiled._dop853 import (
     BUDGET_EXHAUSTED,
     ERROR_EXPONENT,
     EV_CODE,
-    EV_DIRECTION,
     FINISHED,
-    G_OLD,
     H_ABS,
     LAST_NORMAL,
     MAX_FACTOR,
@@ -37,7 +35,6 @@ from rollingtop._compiled._dop853 import (
     MIN_FACTOR,
     MONITOR_EVALS,
     N_COUNTS,
-    N_EVENTS,
     NEXT_SAMPLE,
     NFEV,
     NOT_FINITE,
@@ -66,9 +63,9 @@ from rollingtop._compiled._kernel import reaction
 from rollingtop._compiled.parallel._dispatch import INLINE_RHS
 from rollingtop._compiled.parallel.dense import (
     dip_minimum,
-    event_root,
     normal_root,
     prepare_dense,
+    step_events,
 )
 from rollingtop._compiled.parallel.dynamics import project, rhs, rhs_inline
 from rollingtop._compiled.parallel.events import event_value
@@ -79,6 +76,9 @@ from rollingtop._types import FloatArray, IntArray, Workspace
 #: Whether :func:`run` holds integrals by projection: ``True`` in the generated ``stepper_held``.
 #: numba prunes a branch on a global constant before typing: a plain run never compiles it.
 HELD = False
+#: Whether :func:`run` locates the zeros of an event function (:func:`.dense.step_events`):
+#: ``True`` in the generated ``stepper_events`` (and ``stepper_held``); pruned like ``HELD``.
+EVENTS = False
 
 
 @compiled()
@@ -154,7 +154,7 @@ def start(
     track[LAST_NORMAL] = N0
     t0, t_end = t_eval[0], t_eval[-1]
     h0 = initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ynew, ws)
-    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y)])
+    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y), np.nan, np.nan])
     counts = np.zeros(N_COUNTS, dtype=np.int64)
     counts[NFEV] = 2
     for i in range(y.shape[0]):
@@ -373,24 +373,9 @@ def run(
         track[PREV_T], track[PREV_NORMAL] = t, N_old
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
-        if ev_spec[EV_CODE] != 0:
-            g_new = event_value(ev_spec[EV_CODE], code, y)
-            g_old = ctrl[G_OLD]
-            crossed = (g_old < 0.0 and g_new >= 0.0) or (g_old > 0.0 and g_new <= 0.0)
-            rising = g_new > g_old
-            if crossed and (ev_spec[EV_DIRECTION] == 0 or (ev_spec[EV_DIRECTION] > 0) == rising):
-                if not dense_ready:
-                    prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
-                    counts[NFEV] += 3
-                    dense_ready = True
-                x = event_root(ev_spec[EV_CODE], code, Fd, y_old, t, h, ytmp)
-                m = counts[N_EVENTS]
-                if m < ev_t.shape[0]:
-                    ev_t[m] = t + x * h
-                    dense_eval(Fd, y_old, x, ev_y[m])
-                    project(code, p, ev_y[m], ws)
-                counts[N_EVENTS] += 1
-            ctrl[G_OLD] = g_new
+        if EVENTS and ev_spec[EV_CODE] != 0:
+            dense_ready = step_events(code, p, K, Fd, y_old, ynew, t, h, y, ctrl, counts,
+                                      ev_spec, ev_t, ev_y, ytmp, ws, dense_ready)  # fmt: skip
         t = t_new
         counts[STEPS] += 1
         taken += 1

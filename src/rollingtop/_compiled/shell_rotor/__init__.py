@@ -16,6 +16,7 @@ from rollingtop._compiled.shell_rotor import (
     events,
     invariants,
     stepper,
+    stepper_events,
     stepper_held,
     tangent,
 )
@@ -33,6 +34,7 @@ __all__ = [
     "events",
     "invariants",
     "stepper",
+    "stepper_events",
     "stepper_held",
     "tangent",
 ]

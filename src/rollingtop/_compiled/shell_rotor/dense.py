@@ -14,6 +14,16 @@ from __future__ import annotations
 
 import math
 
+from rollingtop._compiled._dop853 import (
+    EV_CODE,
+    EV_DIRECTION,
+    EV_PREV_G,
+    EV_PREV_T,
+    G_OLD,
+    N_EVENTS,
+    NFEV,
+    dip_predicted,
+)
 from rollingtop._compiled._dop853_dense import dense_eval
 from rollingtop._compiled._dop853_stages import stage
 from rollingtop._compiled._dop853_tableau import D
@@ -21,7 +31,7 @@ from rollingtop._compiled._kernel import reaction
 from rollingtop._compiled.shell_rotor.dynamics import project, rhs
 from rollingtop._compiled.shell_rotor.events import event_value
 from rollingtop._jit import kernel
-from rollingtop._types import FloatArray, Workspace
+from rollingtop._types import FloatArray, IntArray, Workspace
 
 
 @kernel
@@ -169,16 +179,14 @@ def event_root(
     code: int,
     Fd: FloatArray,
     y: FloatArray,
-    t: float,
-    h: float,
+    lo: float,
+    hi: float,
     ytmp: FloatArray,
 ) -> float:
-    """Fraction ``x`` in ``[0, 1]`` of the step ``[t, t + h]`` where the event function changes
-    sign, by bisection on the dense output (60 halvings: to the resolution of the
-    interpolant)."""
-    dense_eval(Fd, y, 0.0, ytmp)
+    """Fraction ``x`` in ``[lo, hi]`` of the step where the event function changes sign (once),
+    by bisection on the dense output (60 halvings: to the resolution of the interpolant)."""
+    dense_eval(Fd, y, lo, ytmp)
     g_lo = event_value(ev_code, code, ytmp)
-    lo, hi = 0.0, 1.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         dense_eval(Fd, y, mid, ytmp)
@@ -188,3 +196,109 @@ def event_root(
         else:
             hi = mid
     return 0.5 * (lo + hi)
+
+
+@kernel
+def event_turn(
+    ev_code: int, code: int, Fd: FloatArray, y: FloatArray, sign: float, ytmp: FloatArray
+) -> float:
+    """Inside a step whose ends have the event function's sign ``sign``, the fraction ``x``
+    where it comes closest to zero on the dense output, or a point past zero: sampled at
+    :data:`DIP_SAMPLES` - 1 interior points (any of the other sign is returned at once), the
+    best refined by golden sections. The caller reads the sign there."""
+    best_x, best = 0.0, math.inf
+    for j in range(1, DIP_SAMPLES):
+        x = j / DIP_SAMPLES
+        dense_eval(Fd, y, x, ytmp)
+        v = sign * event_value(ev_code, code, ytmp)
+        if v <= 0.0:
+            return x
+        if v < best:
+            best_x, best = x, v
+    a = max(0.0, best_x - 1.0 / DIP_SAMPLES)
+    b = min(1.0, best_x + 1.0 / DIP_SAMPLES)
+    c = a + _GOLDEN * (b - a)
+    d = b - _GOLDEN * (b - a)
+    dense_eval(Fd, y, c, ytmp)
+    fc = sign * event_value(ev_code, code, ytmp)
+    dense_eval(Fd, y, d, ytmp)
+    fd = sign * event_value(ev_code, code, ytmp)
+    for _ in range(DIP_REFINE):
+        if fc <= 0.0:
+            return c
+        if fd <= 0.0:
+            return d
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = a + _GOLDEN * (b - a)
+            dense_eval(Fd, y, c, ytmp)
+            fc = sign * event_value(ev_code, code, ytmp)
+        else:
+            a, c, fc = c, d, fd
+            d = b - _GOLDEN * (b - a)
+            dense_eval(Fd, y, d, ytmp)
+            fd = sign * event_value(ev_code, code, ytmp)
+    return c if fc < fd else d
+
+
+@kernel
+def _record_event(
+    ev_code: int, code: int, p: FloatArray, Fd: FloatArray, y: FloatArray, t: float, h: float,
+    lo: float, hi: float, counts: IntArray, ev_t: FloatArray, ev_y: FloatArray,
+    ytmp: FloatArray, ws: Workspace,
+) -> None:  # fmt: skip
+    """Locate the zero in ``[lo, hi]`` of the step and record its time and projected state."""
+    x = event_root(ev_code, code, Fd, y, lo, hi, ytmp)
+    m = counts[N_EVENTS]
+    if m < ev_t.shape[0]:
+        ev_t[m] = t + x * h
+        dense_eval(Fd, y, x, ev_y[m])
+        project(code, p, ev_y[m], ws)
+    counts[N_EVENTS] += 1
+
+
+@kernel
+def step_events(
+    code: int, p: FloatArray, K: FloatArray, Fd: FloatArray, y: FloatArray, ynew: FloatArray,
+    t: float, h: float, y_acc: FloatArray, ctrl: FloatArray, counts: IntArray,
+    ev_spec: IntArray, ev_t: FloatArray, ev_y: FloatArray, ytmp: FloatArray, ws: Workspace,
+    dense_ready: bool,
+) -> bool:  # fmt: skip
+    """The zeros of the event function inside the accepted step ``[t, t + h]`` from ``y``
+    (``y_acc``: the accepted, projected new state), in the direction asked, recorded in time
+    order. A sign change between the ends is one zero. Ends of one sign hide two zeros where
+    the function turns back inside the step: the parabola through its values at the last three
+    step ends (:func:`.dip_predicted`) says when a turn lies inside, and the dense output then
+    finds how close to zero it comes (:func:`event_turn`) and, past it, both zeros. Returns
+    whether the dense output is built."""
+    ev_code, direction = ev_spec[EV_CODE], ev_spec[EV_DIRECTION]
+    g_new = event_value(ev_code, code, y_acc)
+    g_old = ctrl[G_OLD]
+    crossed = (g_old < 0.0 and g_new >= 0.0) or (g_old > 0.0 and g_new <= 0.0)
+    sign = 1.0 if g_old > 0.0 else -1.0
+    if crossed:
+        rising = g_new > g_old
+        if direction == 0 or (direction > 0) == rising:
+            if not dense_ready:
+                prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
+                counts[NFEV] += 3
+                dense_ready = True
+            _record_event(ev_code, code, p, Fd, y, t, h, 0.0, 1.0, counts, ev_t, ev_y, ytmp, ws)
+    elif g_old != 0.0 and dip_predicted(ctrl[EV_PREV_T], sign * ctrl[EV_PREV_G], t,
+                                        sign * g_old, t + h, sign * g_new):  # fmt: skip
+        if not dense_ready:
+            prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
+            counts[NFEV] += 3
+            dense_ready = True
+        x = event_turn(ev_code, code, Fd, y, sign, ytmp)
+        dense_eval(Fd, y, x, ytmp)
+        if sign * event_value(ev_code, code, ytmp) < 0.0:  # two zeros: away, then back
+            if direction == 0 or (direction > 0) == (sign < 0.0):
+                _record_event(ev_code, code, p, Fd, y, t, h, 0.0, x, counts, ev_t, ev_y, ytmp,
+                              ws)  # fmt: skip
+            if direction == 0 or (direction > 0) == (sign > 0.0):
+                _record_event(ev_code, code, p, Fd, y, t, h, x, 1.0, counts, ev_t, ev_y, ytmp,
+                              ws)  # fmt: skip
+    ctrl[EV_PREV_T], ctrl[EV_PREV_G] = t, g_old
+    ctrl[G_OLD] = g_new
+    return dense_ready

@@ -16,7 +16,7 @@ from rollingtop._compiled._kernel import new_workspace
 from rollingtop._compiled._section import POLISH_DT, POLISH_ITERATIONS
 from rollingtop._compiled.smooth.dynamics import project, rhs
 from rollingtop._compiled.smooth.events import event_value
-from rollingtop._compiled.smooth.stepper import run, start
+from rollingtop._compiled.smooth.stepper_events import run, start
 from rollingtop._compiled.smooth.tangent import run_indicators
 from rollingtop._jit import compiled, kernel
 from rollingtop._layout import N_STATE
