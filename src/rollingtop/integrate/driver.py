@@ -141,13 +141,6 @@ def compile_code(code: int, *, held: bool = False, events: bool = False) -> floa
     return _compile_package(for_code(int(code)), held, events)
 
 
-def _stepper(kernels: ModuleType, held: bool, events: bool) -> ModuleType:
-    """The copy of the stepper a run needs (:mod:`rollingtop._compiled._codegen`)."""
-    if held:
-        return kernels.stepper_held  # type: ignore[no-any-return]
-    return kernels.stepper_events if events else kernels.stepper  # type: ignore[no-any-return]
-
-
 def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
     """:func:`compile_kernels` for one compiled package (``held``, ``events``:
     :func:`compile_code`)."""
@@ -190,7 +183,9 @@ def _run_compiled(
     icodes, targets, pw = held_arrays(code, p, y0, held)
     package = for_code(code)
     ev_code, ev_direction, capacity = event
-    stepper = _stepper(package, icodes.shape[0] > 0, ev_code != 0)
+    # the copy of the stepper the run needs (rollingtop._compiled._codegen)
+    stepper = (package.stepper_held if icodes.shape[0] > 0
+               else package.stepper_events if ev_code != 0 else package.stepper)  # fmt: skip
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
     ev_t = np.empty(capacity)
