@@ -102,10 +102,11 @@ _GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 ESTIMATES: dict[str, float] = {
     "dynamics": 4.0,
     "integrator": 9.0,
-    "held integrator": 4.0,
-    "event integrator": 4.0,
+    "held integrator": 6.0,
+    "event integrator": 5.0,
     "ensemble": 2.0,
-    "chaos": 6.0,
+    # the section batches run the event stepper (``stepper_events``): compiled with them
+    "chaos": 11.0,
 }
 
 
