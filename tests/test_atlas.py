@@ -156,8 +156,15 @@ def _spec_file(tmp_path, axes_toml):
 
 
 @pytest.mark.slow
-def test_cli_atlas_on_the_embedded_cluster(capsys, tmp_path):
-    """The default: an embedded local cluster of worker processes."""
+def test_cli_atlas_on_the_embedded_cluster(capsys, tmp_path, monkeypatch):
+    """The default: an embedded local cluster of worker processes; it leaves nothing in the
+    temporary folder (Dask's ``dask-scratch-space`` stayed there)."""
+    import tempfile
+
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    monkeypatch.setenv("TMPDIR", str(temp))
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))
     spec = _spec_file(tmp_path, "C2 = [-2.0, -1.0]\nC1 = [0.0, 0.5]")
     out = tmp_path / "a.nc"
     code, stdout, err = run_cli(capsys, "atlas", str(spec), "-o", str(out), "--workers", "2",
@@ -167,6 +174,7 @@ def test_cli_atlas_on_the_embedded_cluster(capsys, tmp_path):
     assert summary["dims"] == {"C2": 2, "C1": 2} and summary["classified"] == 4
     with xr.open_dataset(out) as f:
         assert f["n_steady"].values.tolist() == [[3, 3], [1, 1]]
+    assert list(temp.iterdir()) == []
 
 
 @pytest.mark.parametrize(

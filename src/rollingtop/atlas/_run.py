@@ -9,6 +9,7 @@ import functools
 import json
 import os
 import shutil
+import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -121,20 +122,26 @@ def _client(
         finally:
             remote.close()
         return
-    n = workers if workers is not None else (os.cpu_count() or 1)
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=50)  # fmt: skip
-    try:
-        local = Client(cluster)
-        from rollingtop.atlas._quiet import QuietWorker
+    import dask
 
-        local.register_plugin(QuietWorker(), name="rollingtop-quiet-worker")
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    # the cluster's scratch space (``dask-scratch-space``) in a folder of its own, removed with
+    # it: Dask would leave it in the temporary folder
+    scratch = tempfile.TemporaryDirectory(prefix="rollingtop-dask-", ignore_cleanup_errors=True)
+    with scratch as tmp, dask.config.set({"temporary-directory": tmp}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=50)  # fmt: skip
         try:
-            yield local
+            local = Client(cluster)
+            from rollingtop.atlas._quiet import QuietWorker
+
+            local.register_plugin(QuietWorker(), name="rollingtop-quiet-worker")
+            try:
+                yield local
+            finally:
+                local.close()
         finally:
-            local.close()
-    finally:
-        cluster.close()
+            cluster.close()
 
 
 def atlas(
