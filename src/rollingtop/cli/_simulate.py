@@ -44,7 +44,7 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
             code = get_model(options.get("model") or sc.model).kernel_code(sc.body, sc.y0)
         held = options.get("project_integrals")
         held = sc.integration.project_integrals if held is None else held
-        compiled = compile_code(code, held=bool(held))
+        compiled = compile_code(code, held=bool(held), events=options.get("events") is not None)
     with _output.timing(sc.integration.t_end) as progress:
         traj = _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
     # the compilation belongs to the run's statistics, wherever it happened

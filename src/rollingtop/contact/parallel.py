@@ -40,8 +40,8 @@ reaction at the contact point).
 azimuth of ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``, ``tau = nu x gamma``). Away from the
 vertical it turns with the axis azimuth ``psi = atan2(beta3, alpha3)`` (``psi_nu' = psi'``), and
 any offset ``delta = psi_nu - psi`` (modulo ``pi``: ``tau`` and ``-tau`` are one constraint)
-relaxes at the rate ``k``, about ``RELAX`` far from the vertical and ``PASS_RELAX |e3'_h| / s``
-near it (:func:`carried_rate`); the offset is round-off there, so this is the model's
+relaxes at the rate ``k = sqrt(RELAX^2 + PASS_RELAX^2 |e3'_h|^2 / (s^2 + S_POLE^2))``, at
+least ``RELAX`` (:func:`carried_rate`); the offset is round-off there, so this is the model's
 constraint to round-off. Inside the disk ``s < S_POLE`` (``1e-6``, 0.2 seconds of arc) the
 rate is weighted down by ``W = 1 - (1 - s^2 / S_POLE^2)^3``, so that it stays of order
 ``|e3'_h| / S_POLE`` (:func:`carried_rate`): the constraint direction, undefined at the

@@ -197,8 +197,9 @@ def run(
         Body parameters.
     y, f : ndarray, shape (18,)
         Current state (projected) and its derivative; updated in place.
-    ctrl : ndarray, shape (6,)
-        ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``); updated.
+    ctrl : ndarray, shape (8,)
+        ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``), and the time and
+        event function at the previous step end (``EV_PREV_T, EV_PREV_G``); updated.
     counts : ndarray of int64, shape (8,)
         Next sample index, accepted steps, rejected steps, right-hand-side evaluations, events
         found (also those beyond the capacity of ``ev_t``), the projection's passes, the steps
@@ -212,7 +213,9 @@ def run(
         Samples, each projected onto the constraints.
     ev_spec : ndarray of int64, shape (2,)
         Event function code (:mod:`rollingtop._compiled._events`, 0 for none) and direction
-        (+1: rising zeros only, -1: falling, 0: both).
+        (+1: rising zeros only, -1: falling, 0: both). Located only by the copies compiled
+        with ``EVENTS = True`` (``stepper_events``, ``stepper_held``): the plain stepper
+        ignores a code, so callers pick the copy (the driver does).
     ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 18)
         Times and projected states of the located events.
     budget : int

@@ -247,10 +247,11 @@ def _record_event(
     lo: float, hi: float, counts: IntArray, ev_t: FloatArray, ev_y: FloatArray,
     ytmp: FloatArray, ws: Workspace,
 ) -> None:  # fmt: skip
-    """Locate the zero in ``[lo, hi]`` of the step and record its time and projected state."""
-    x = event_root(ev_code, code, Fd, y, lo, hi, ytmp)
+    """Locate the zero in ``[lo, hi]`` of the step and record its time and projected state
+    (only counted once the capacity is full)."""
     m = counts[N_EVENTS]
     if m < ev_t.shape[0]:
+        x = event_root(ev_code, code, Fd, y, lo, hi, ytmp)
         ev_t[m] = t + x * h
         dense_eval(Fd, y, x, ev_y[m])
         project(code, p, ev_y[m], ws)
@@ -270,7 +271,9 @@ def step_events(
     the function turns back inside the step: the parabola through its values at the last three
     step ends (:func:`.dip_predicted`) says when a turn lies inside, and the dense output then
     finds how close to zero it comes (:func:`event_turn`) and, past it, both zeros. Returns
-    whether the dense output is built."""
+    whether the dense output is built. Limits: one pair per step; none in the step right after
+    a crossing (the parabola through values of both signs predicts no turn back); a turn that
+    touches zero exactly is no crossing (a step that ends on zero is one)."""
     ev_code, direction = ev_spec[EV_CODE], ev_spec[EV_DIRECTION]
     g_new = event_value(ev_code, code, y_acc)
     g_old = ctrl[G_OLD]
