@@ -121,9 +121,8 @@ def _workspace(n_samples: int) -> _Work:
 
 def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:
     """Compile (or load from numba's cache) ``model``'s integrator kernels -- its projection,
-    plain stepper and diagnostics -- and no other model's; returns the seconds spent. The copies
-    of the stepper that locate events or hold integrals compile on their first run
-    (:func:`compile_code`).
+    plain stepper and diagnostics -- and no other model's; returns the seconds spent (the event
+    and held steppers compile on their first run: :func:`compile_code`).
 
     ``variants``: also the kernels of the model's variants (the meridian model's pole cases,
     a package of their own: :data:`rollingtop._compiled.GROUPS`). Only the first call for a
