@@ -104,18 +104,28 @@ def test_arrival_in_finite_time_with_a_finite_pole_rate():
 PASSAGE_DRIFT = 1e-6
 
 
+def _random_bodies_and_states(seed, n, i3_min=0.05):
+    """``n`` random bodies and states (I3 from ``i3_min`` to min(2 I1, 1.5), a3 from -0.5 to 0.5;
+    with the default, as issue 26 drew them)."""
+    rng = np.random.default_rng(seed)
+    bodies, states = [], []
+    for _ in range(n):
+        I1 = rng.uniform(0.2, 1.0)
+        body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=rng.uniform(-0.5, 0.5), I1=I1,
+                            I3=rng.uniform(i3_min, min(2 * I1, 1.5)))  # fmt: skip
+        gamma = rng.normal(size=3)
+        states.append(initial_state(body, "parallel", gamma=gamma / np.linalg.norm(gamma),
+                                    omega=rng.normal(size=3),
+                                    free={"v_nu": rng.normal() * 0.5}))  # fmt: skip
+        bodies.append(body)
+    return bodies, np.array(states)
+
+
 def test_random_bodies_and_states_pass_their_poles():
     """100 random bodies and states (seeded) to t = 50: every run finishes, through (measured)
     ~1000 pole passages in all, with energy and Jellett's integral conserved."""
-    rng = np.random.default_rng(5)
     passages = 0
-    for _ in range(100):
-        I1 = rng.uniform(0.2, 1.0)
-        body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=rng.uniform(-0.5, 0.5), I1=I1,
-                            I3=rng.uniform(0.2, min(2 * I1, 1.5)))  # fmt: skip
-        gamma = rng.normal(size=3)
-        y0 = initial_state(body, "parallel", gamma=gamma / np.linalg.norm(gamma),
-                           omega=rng.normal(size=3), free={"v_nu": rng.normal() * 0.5})  # fmt: skip
+    for body, y0 in zip(*_random_bodies_and_states(5, 100, i3_min=0.2), strict=True):
         res = integrate(MODELS["parallel"].code, body.params, y0, np.linspace(0.0, 50.0, 10001),
                         rtol=1e-10, atol=1e-12)  # fmt: skip
         s = np.hypot(res.y[:, 12], res.y[:, 13])
@@ -123,23 +133,6 @@ def test_random_bodies_and_states_pass_their_poles():
         for v in evaluate(body, res.y, ["energy", "jellett"]).values():
             assert np.max(np.abs(v - v[0])) / max(1.0, abs(v[0])) < PASSAGE_DRIFT
     assert passages > 500
-
-
-def _random_bodies_and_states(seed, n):
-    """``n`` random bodies and states (I3 from 0.05 to min(2 I1, 1.5), a3 from -0.5 to 0.5), as
-    issue 26 drew them."""
-    rng = np.random.default_rng(seed)
-    bodies, states = [], []
-    for _ in range(n):
-        I1 = rng.uniform(0.2, 1.0)
-        body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=rng.uniform(-0.5, 0.5), I1=I1,
-                            I3=rng.uniform(0.05, min(2 * I1, 1.5)))  # fmt: skip
-        gamma = rng.normal(size=3)
-        states.append(initial_state(body, "parallel", gamma=gamma / np.linalg.norm(gamma),
-                                    omega=rng.normal(size=3),
-                                    free={"v_nu": rng.normal() * 0.5}))  # fmt: skip
-        bodies.append(body)
-    return bodies, np.array(states)
 
 
 #: Relative drift of energy and Jellett's integral over t = 1e4 with passages (rtol 1e-10;

@@ -131,8 +131,7 @@ def _spin_rate(
 ) -> Float3:  # fmt: skip
     """``w'`` under the rows ``(vp, gamma) = 0`` and ``(vp, t) = 0`` with ``t' = td``: the
     2x2 multiplier system of :mod:`rollingtop._compiled._kernel`, written out for the pole rate
-    (which needs ``w'`` at two trial rates, and is also used by :func:`rows`, where there is no
-    workspace to run :func:`rollingtop.contact._closed.rhs_contact` in)."""
+    (which needs ``w'`` at two trial rates, without a workspace)."""
     w1, w2, w3 = y[3], y[4], y[5]
     g1, g2, g3 = y[12], y[13], y[14]
     r1, r2, r3, rd1, rd2, rd3 = contact_arm_rate(p, y)
@@ -179,7 +178,7 @@ def _pole_residual(
     return residual
 
 
-@kernel  # a call of its own: taken only near the pole; inlined, it doubled the compile time
+@kernel  # the analysis of the exact model's pole; the integration does not call it
 def pole_rate(p: FloatArray, y: FloatArray) -> float:
     """``K*``: the rate of the carried direction at which ``K'`` has no ``1/sigma`` term (the
     limit of ``psi' = -w_n / s`` along every motion that reaches the pole; module docstring).
