@@ -37,7 +37,7 @@ def disabled(monkeypatch):
 
 
 def test_a_failed_cache_save_is_retried_and_reported_once(monkeypatch, disabled):
-    monkeypatch.setattr(_jit, "_warned", False)
+    monkeypatch.setattr(_jit._state, "warned", False)
     fail = _raiser_in(NUMBA_CACHING)
     calls = []
 
@@ -58,7 +58,7 @@ def test_a_failed_cache_save_is_retried_and_reported_once(monkeypatch, disabled)
 
 
 def test_other_os_errors_propagate(monkeypatch, disabled):
-    monkeypatch.setattr(_jit, "_warned", False)
+    monkeypatch.setattr(_jit._state, "warned", False)
     fail = _raiser_in(os.path.join("somewhere", "else.py"))
 
     def compiled():
@@ -70,7 +70,7 @@ def test_other_os_errors_propagate(monkeypatch, disabled):
 
 
 def test_a_bounded_number_of_retries(monkeypatch, disabled):
-    monkeypatch.setattr(_jit, "_warned", True)
+    monkeypatch.setattr(_jit._state, "warned", True)
     fail = _raiser_in(NUMBA_CACHING)
     calls = []
 
@@ -151,8 +151,14 @@ def test_compiling_one_model_compiles_no_other(tmp_path):
     packages = {g.package for g in GROUPS}
     imported = {m.split(".")[2] for m in eval(proc.stdout)} & packages
     assert imported == {"rough"}
-    # numba's user cache folder: one sub-folder per source folder, named after it
-    folders = {p.parent.name.rsplit("_", 1)[0] for p in cache.rglob("*.nbi")}
+    # the kernel cache: one folder per module (rollingtop._kernel_cache)
+    modules = {p.parent.name for p in cache.rglob("*.nbi")}
+    folders = {m.split(".")[2] for m in modules if m.startswith("rollingtop._compiled.")}
     assert "rough" in folders
     others = packages - {"rough"}
     assert not folders & others, folders
+    assert not {m for m in modules if m.startswith("rollingtop.contact.")} - {
+        "rollingtop.contact.rough",
+        "rollingtop.contact._rows",
+        "rollingtop.contact._closed",
+    }

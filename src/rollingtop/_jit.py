@@ -1,10 +1,11 @@
 """The compiler options of rollingtop's numba kernels, defined once.
 
-Every compiled function is cached on disk (``cache=True``, numba's supported mechanism; the
-directory follows ``NUMBA_CACHE_DIR``), uses numpy's floating-point error model (a division by
-zero gives ``inf``/``nan``, which the integrator reports, instead of raising) and allows only
-fused multiply-add among the fast-math rewrites (``contract``: results stay within an ulp of
-the written expression and do not depend on reassociation).
+Every compiled function is cached on disk, keyed on every source compiled into it
+(:mod:`rollingtop._kernel_cache`: numba's own ``cache=True`` keys it on the function's file
+alone; the folder follows ``NUMBA_CACHE_DIR``), uses numpy's floating-point error model (a
+division by zero gives ``inf``/``nan``, which the integrator reports, instead of raising) and
+allows only fused multiply-add among the fast-math rewrites (``contract``: results stay within
+an ulp of the written expression and do not depend on reassociation).
 
 - :func:`kernel`: called at every stage of the integrator; compiled with ``_nrt=False``
   (numba's flag, used the same way in numba's own string kernels): with numba's reference
@@ -26,13 +27,32 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
+from rollingtop import _kernel_cache
+
 F = TypeVar("F", bound=Callable[..., Any])
 
-#: Options shared by every compiled function of the package.
+#: Options shared by every compiled function of the package (``cache``: the cache of
+#: :mod:`rollingtop._kernel_cache`, not numba's own).
 BASE_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy", "fastmath": {"contract"}}
+
+
+@dataclass
+class _State:
+    """What this module learns while the process runs. Kept out of plain module globals: the
+    cache key hashes the constants of every module compiled in, and these are no constants."""
+
+    numba_loaded: bool = False
+    #: every cache of the package switched off (:func:`disable_caching`)
+    caching_off: bool = False
+    #: the one warning about the cache given
+    warned: bool = False
+
+
+_state = _State()
 
 
 #: Every dispatcher made by the decorators below (their caches are switched off together when
@@ -42,9 +62,49 @@ _DISPATCHERS: list[Any] = []
 
 def _registered(dispatcher: Any) -> Any:
     _DISPATCHERS.append(dispatcher)
-    if _caching_off:
+    if _state.caching_off:
         _disable_cache(dispatcher)
     return dispatcher
+
+
+def _njit(func: Callable[..., Any], options: dict[str, Any]) -> Any:
+    """numba's dispatcher of ``func``; with ``cache``, the cache of
+    :mod:`rollingtop._kernel_cache` (keyed on every source compiled in) instead of numba's."""
+    from numba import njit
+
+    dispatcher = njit(**{**options, "cache": False})(func)
+    if options.get("cache") and not _state.caching_off:
+        root, failures = _kernel_cache.cache_root()
+        if root is None:
+            _no_cache_folder(failures)
+        else:
+            if failures and not _state.warned:
+                _state.warned = True
+                where, exc = failures[0]
+                warnings.warn(
+                    CacheNotSaved(
+                        f"cannot write {where} ({exc.strerror or exc}): compiled kernels are "
+                        f"cached in {root} instead"
+                    ),
+                    stacklevel=4,
+                )
+            dispatcher._cache = _kernel_cache.KernelCache(func)
+    return _registered(dispatcher)
+
+
+def _no_cache_folder(failures: list[tuple[Path, OSError]]) -> None:
+    """No cache folder can be written: caching off, said once."""
+    _state.caching_off = True
+    if not _state.warned:
+        _state.warned = True
+        tried = "; ".join(f"{p}: {e.strerror or e}" for p, e in failures)
+        warnings.warn(
+            CacheNotSaved(
+                f"no folder for compiled kernels can be written ({tried}): they are compiled "
+                "again in every run"
+            ),
+            stacklevel=5,
+        )
 
 
 class _Deferred:
@@ -78,22 +138,18 @@ class _Deferred:
 
 
 _pending: list[_Deferred] = []
-_numba_loaded = False
 _load_lock = threading.RLock()
 
 
 def load_numba() -> None:
     """Load numba and make every function of the package that the decorators recorded a numba
     dispatcher, in place in the package's modules (see :class:`_Deferred`); done once."""
-    global _numba_loaded
     with _load_lock:
-        if _numba_loaded:
+        if _state.numba_loaded:
             return
-        from numba import njit
-
         for deferred in _pending:
-            deferred.dispatcher = _registered(njit(**deferred.options)(deferred.func))
-        _numba_loaded = True
+            deferred.dispatcher = _njit(deferred.func, deferred.options)
+        _state.numba_loaded = True
         for name, module in list(sys.modules.items()):
             if module is None or not (name == "rollingtop" or name.startswith("rollingtop.")):
                 continue
@@ -104,10 +160,8 @@ def load_numba() -> None:
 
 
 def _make(func: F, options: dict[str, Any]) -> F:
-    if _numba_loaded:  # a module imported after numba: its dispatcher at once
-        from numba import njit
-
-        return cast(F, _registered(njit(**options)(func)))
+    if _state.numba_loaded:  # a module imported after numba: its dispatcher at once
+        return cast(F, _njit(func, options))
     deferred = _Deferred(func, options)
     _pending.append(deferred)
     return cast(F, deferred)
@@ -140,8 +194,6 @@ class CacheNotSaved(UserWarning):
 #: Most failed cache saves tolerated in one :func:`call`: after the first, every cache of the
 #: package is switched off, so a second failure would come from somewhere else.
 MAX_SAVE_FAILURES = 3
-_warned = False
-_caching_off = False
 
 
 def _disable_cache(dispatcher: Any) -> None:
@@ -154,8 +206,7 @@ def _disable_cache(dispatcher: Any) -> None:
 def disable_caching() -> None:
     """Stop saving (and loading) compiled kernels to numba's on-disk cache in this process: every
     dispatcher of the package, those made from now on included."""
-    global _caching_off
-    _caching_off = True
+    _state.caching_off = True
     load_numba()
     for dispatcher in _DISPATCHERS:
         _disable_cache(dispatcher)
@@ -163,7 +214,7 @@ def disable_caching() -> None:
 
 def caching_disabled() -> bool:
     """Whether :func:`disable_caching` was called (numba could not save its cache)."""
-    return _caching_off
+    return _state.caching_off
 
 
 R = TypeVar("R")
@@ -194,7 +245,6 @@ def call(func: Callable[..., R], *args: Any) -> R:
     the caller per cached function of the chain (minutes). The failure is reported once, as a
     :class:`CacheNotSaved` warning.
     """
-    global _warned
     for _ in range(MAX_SAVE_FAILURES):
         try:
             return func(*args)
@@ -202,8 +252,8 @@ def call(func: Callable[..., R], *args: Any) -> R:
             if not _from_numba_cache(exc):
                 raise
             disable_caching()
-            if not _warned:
-                _warned = True
+            if not _state.warned:
+                _state.warned = True
                 where = exc.filename or "numba's cache folder"
                 warnings.warn(
                     CacheNotSaved(

@@ -1,18 +1,16 @@
 """Compile the kernels of some or all contact models once, ahead of the first command that needs
 them.
 
-Each model's kernels are compiled by numba on first use and kept in numba's on-disk cache
-(``cache=True``: ``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR`` when set), so only the
-first run after an installation pays for a model's compilation, and only for the models it runs
-(:mod:`rollingtop._compiled`). :func:`warmup` pays it up front, for a container image, a
-cluster's workers, or before timing: one process per model, in parallel, since each model's
-kernels are independent (their own source files, their own cache entries).
+Each model's kernels are compiled by numba on first use and kept on disk
+(:mod:`rollingtop._kernel_cache`: ``NUMBA_CACHE_DIR/rollingtop`` when set, else
+``__pycache__/kernels`` beside the package), so only the first run pays for a model's
+compilation, and only for the models it runs (:mod:`rollingtop._compiled`). :func:`warmup` pays
+it up front, for a container image, a cluster's workers, or before timing: one process per
+package, in parallel, since each model's kernels are independent (their own cache entries).
 
-numba invalidates a cached function when its own source file changes, not when a function it
-calls from another file does; installing rollingtop rewrites every file, so an installation never
-runs stale code. An editable (development) checkout should keep its cache in a folder named by the
-sources (the test suite does: the repository's root ``conftest.py``) or clear ``__pycache__``
-after editing a kernel. Nothing here deletes files.
+An entry is keyed on every source compiled into it, so an edit of a model, an upgrade
+installed over an old cache, or a cache folder shared between checkouts never runs stale
+machine code: what changed is compiled again. Nothing here deletes files.
 """
 
 from __future__ import annotations

@@ -2,16 +2,18 @@
 compiled on first use.
 
 Each registered contact model has a package here (``rollingtop._compiled.meridian``, ...),
-generated from :mod:`rollingtop._compiled._template` by :mod:`rollingtop._compiled._codegen`:
-its right-hand side, projection, diagnostics, DOP853 stepper, ensemble kernel, tangent dynamics
-and chaos batches, compiled against that model's functions alone. A model with variants (the
-meridian model's pole cases, :class:`rollingtop.contact.Kernel`) has a second package for them,
+made from the template :mod:`rollingtop._compiled._template` when first imported
+(:mod:`rollingtop._compiled._instances`; no file is generated): its right-hand side,
+projection, diagnostics, DOP853 stepper, ensemble kernel, tangent dynamics and chaos batches,
+compiled against that model's functions alone. A model with variants (the meridian model's pole
+cases, :class:`rollingtop.contact.Kernel`) has a second package for them,
 ``meridian_variants``: its own kernel's code is then straight-line, with no branch on the
 variant, and a run that needs no variant compiles none (:data:`GROUPS`). :func:`for_code`
 imports the package of a kernel code (cheap: nothing is compiled at import); numba compiles each
-function on its first call, or loads it from its on-disk cache, so a command pays only for the
-kernels it runs. The modules beside the packages (``_kernel``, ``_dop853``, ...) are the
-compiled pieces every model shares, compiled once.
+function on its first call, or loads it from the on-disk cache, keyed on every source compiled
+into it (:mod:`rollingtop._kernel_cache`), so a command pays only for the kernels it runs and
+never runs machine code older than its sources. The modules beside the packages (``_kernel``,
+``_dop853``, ...) are the compiled pieces every model shares, compiled once.
 
 :func:`compiling` wraps a first call that may compile: when numba actually compiles (a cache
 miss, not a load), the notifier (:func:`set_notifier`; the command line's prints one line on
@@ -26,7 +28,6 @@ import importlib
 import logging
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, Protocol
 
@@ -34,8 +35,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop import _jit
+from rollingtop._compiled._instances import GROUPS, Group, install
 from rollingtop._types import IntArray
-from rollingtop.contact import MODULES, ContactModel, get_model, kernels_of
+from rollingtop.contact import ContactModel, get_model
+
+install(GROUPS)
 
 __all__ = [
     "ESTIMATES",
@@ -51,49 +55,6 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class Group:
-    """Kernels compiled together, in one generated package.
-
-    Attributes
-    ----------
-    package : str
-        The package's name under :mod:`rollingtop._compiled` (``meridian``,
-        ``meridian_variants``).
-    model : str
-        The contact model.
-    codes : tuple of int
-        The kernel codes it runs.
-    base : int
-        The code of the model's own kernel (a kernel's variant index is its code minus it).
-    label : str
-        What it is, in words (``the meridian model's``).
-    """
-
-    package: str
-    model: str
-    codes: tuple[int, ...]
-    base: int
-    label: str
-
-
-def _groups() -> tuple[Group, ...]:
-    out = []
-    for module in MODULES:
-        name = module.__name__.rsplit(".", 1)[1]
-        kernels = kernels_of(module.MODEL)
-        base = kernels[0].code
-        model = module.MODEL.name
-        out.append(Group(name, model, (base,), base, f"the {model} model's"))
-        if len(kernels) > 1:
-            variants = ", ".join(str(k.variant) for k in kernels[1:])
-            out.append(Group(f"{name}_variants", model, tuple(k.code for k in kernels[1:]), base,
-                             f"the {model} model's variants ({variants})"))  # fmt: skip
-    return tuple(out)
-
-
-#: The compiled packages: each model's own kernel, then its variants if it has any.
-GROUPS: tuple[Group, ...] = _groups()
 _GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 
 #: Rough seconds a cold compilation of one model's group of kernels takes on a 2-core machine,

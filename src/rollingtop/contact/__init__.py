@@ -16,10 +16,10 @@ reduction) and its compiled functions, all with the same signatures:
 The variant argument is the kernel's index among the model's kernels (0 its own); a model with
 variants receives it at run time, one without receives the constant 0.
 
-**Adding a model** is one module here plus one line in :data:`MODULES`, then
-``python -m rollingtop._compiled._codegen`` writes the model's compiled package
-(:mod:`rollingtop._compiled`, generated; a test fails while it is stale). The shared model
-battery (``tests/contact/test_models.py``) then runs for it.
+**Adding a model** is one module here plus one line in :data:`MODULES`: its compiled package
+(:mod:`rollingtop._compiled`) is made from the template when first imported, and its cache
+entries are keyed on this module's source among others. The shared model battery
+(``tests/contact/test_models.py``) then runs for it.
 """
 
 from __future__ import annotations

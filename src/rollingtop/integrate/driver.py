@@ -183,7 +183,7 @@ def _run_compiled(
     icodes, targets, pw = held_arrays(code, p, y0, held)
     package = for_code(code)
     ev_code, ev_direction, capacity = event
-    # the copy of the stepper the run needs (rollingtop._compiled._codegen)
+    # the copy of the stepper the run needs (rollingtop._compiled._instances)
     stepper = (package.stepper_held if icodes.shape[0] > 0
                else package.stepper_events if ev_code != 0 else package.stepper)  # fmt: skip
     ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)

@@ -1,7 +1,7 @@
 """What each model's compiled dispatch provides: the template's stand-in, never compiled.
 
-The generator (:mod:`rollingtop._compiled._codegen`) writes one ``_dispatch`` module per contact
-model with these names and signatures, each calling the model module's own functions
+:func:`rollingtop._compiled._instances.dispatch_source` writes one ``_dispatch`` module per
+group of kernels with these names and signatures, each calling the model module's own functions
 (:mod:`rollingtop.contact`, whose package docstring lists them) with the kernel's variant: the
 code minus the model's first code where the model has variants, the constant 0 otherwise.
 """
@@ -27,7 +27,7 @@ INLINE_RHS = False
 CODES: tuple[int, ...] = ()
 
 
-#: What the stand-ins raise if called: the generated modules replace them.
+#: What the stand-ins raise if called: the instances' dispatch modules replace them.
 NEVER_CALLED = "the template's dispatch is a stand-in, never called: see the module docstring"
 
 
