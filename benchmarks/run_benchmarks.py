@@ -17,7 +17,9 @@ W2  ensemble of 1e4 initial states, t = 100: trajectories per second on 1 and 2 
 W3  work-precision: final-state error at t = 100 against a reference solved at rtol 1e-14 by two
     methods (rollingtop and solve_ivp), for rtol 1e-6 ... 1e-13.
 Cold start: what a newcomer waits for (portrait, simulate, a second model, warmup), each a whole
-    process with an empty numba cache, and with a warm one (:func:`cold_start`).
+    process with an empty numba cache, and with a warm one (:func:`cold_start`); then the
+    compile estimates of the notice, each group in a fresh process (compile_estimates.py,
+    written to src/rollingtop/_compiled/estimates.json with --write-docs).
 
 Timings are medians of repeated runs in this one process (the slow baselines run fewer times);
 nothing here is asserted: this is not part of the test suite.
@@ -535,6 +537,10 @@ def main() -> None:
     if "cold_start" in only:
         print("cold start ...", flush=True)
         res["cold_start"] = cold_start()
+        print("compile estimates ...", flush=True)
+        from compile_estimates import estimates
+
+        res["compile_estimates"] = estimates()
     if "scaling" in only:
         print("scaling ...", flush=True)
         res["scaling"] = run_scaling(quick)
@@ -566,6 +572,11 @@ def main() -> None:
         write_docs(res)
         write_readme(res)
         print(f"wrote {DOCS_PAGE.relative_to(ROOT)} and {README.relative_to(ROOT)}")
+        if "compile_estimates" in res and "cold_start" in only:
+            from compile_estimates import write as write_estimates
+
+            write_estimates(res["compile_estimates"])
+            print("wrote src/rollingtop/_compiled/estimates.json")
 
 
 if __name__ == "__main__":

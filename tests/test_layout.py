@@ -11,7 +11,8 @@ import rollingtop
 from rollingtop.contact import MODELS
 
 SRC = Path(rollingtop.__file__).parent
-MAX_LINES = 400
+#: ``../shared/STYLE.md``: split a file along a seam when it grows past about 600 lines.
+MAX_LINES = 600
 
 
 def test_no_module_is_over_the_line_limit():

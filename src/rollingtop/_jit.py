@@ -147,6 +147,7 @@ def load_numba() -> None:
     with _load_lock:
         if _state.numba_loaded:
             return
+        _answer_blas_probe()
         for deferred in _pending:
             deferred.dispatcher = _njit(deferred.func, deferred.options)
         _state.numba_loaded = True
@@ -157,6 +158,30 @@ def load_numba() -> None:
                 if type(value) is _Deferred:
                     setattr(module, attr, value.dispatcher)
         _pending.clear()
+
+
+def _answer_blas_probe() -> None:
+    """Import numba's array support with its probe for BLAS answered from scipy's presence.
+
+    ``numba.np.arraymath``, which numba imports before it compiles or loads anything, probes
+    for BLAS by importing ``scipy.linalg`` (a quarter of a second of every process that runs a
+    kernel); no kernel of ours calls BLAS, and scipy, a dependency, provides it. So for that one
+    import the probe (``numba.np.linalg.ensure_blas``) only checks that scipy is installed;
+    the real one is put back for everything after it (numba's calls of BLAS check again when
+    they are compiled)."""
+    import importlib.util
+
+    if "numba.np.arraymath" in sys.modules or importlib.util.find_spec("scipy") is None:
+        return
+    from numba.np import linalg
+
+    probe = linalg.ensure_blas
+    linalg.ensure_blas = lambda: None
+    try:
+        from numba.np import arraymath
+    finally:
+        linalg.ensure_blas = probe
+    setattr(arraymath, "ensure_blas", probe)  # noqa: B010 (not an exported name)
 
 
 def _make(func: F, options: dict[str, Any]) -> F:

@@ -66,3 +66,5 @@ def test_short_w1_takes_the_same_steps_to_the_same_state(c_limit, lib):
     assert c["steps"] > 1000  # a real run, with rejections to compare too
     assert c["rejected"] > 0
     np.testing.assert_array_equal(c["y"], rt["y"])
+    # the same work: the reactions monitored at the same step ends (no dip search)
+    assert c["reactions"]["min_normal_force"] == rt["reactions"]["min_normal_force"]

@@ -25,9 +25,11 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import json
 import logging
 import time
 from collections.abc import Iterator
+from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
 
@@ -57,17 +59,15 @@ __all__ = [
 
 _GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 
-#: Rough seconds a cold compilation of one model's group of kernels takes on a 2-core machine,
-#: rounded from the paper's model's (``benchmarks/run_benchmarks.py --only cold_start`` measures
-#: whole commands); the models differ by a few seconds. Only the announcement uses them.
+#: Seconds a cold compilation of each group of the paper's model's kernels took, measured (each
+#: group in a fresh process with an empty cache) by ``benchmarks/compile_estimates.py --write``
+#: into ``estimates.json`` beside this file; the models differ by a few seconds. Only the
+#: announcement uses them.
 ESTIMATES: dict[str, float] = {
-    "dynamics": 4.0,
-    "integrator": 9.0,
-    "held integrator": 6.0,
-    "event integrator": 5.0,
-    "ensemble": 2.0,
-    # the section batches run the event stepper (``stepper_events``): compiled with them
-    "chaos": 11.0,
+    str(k): float(v)
+    for k, v in json.loads((Path(__file__).with_name("estimates.json")).read_text())[
+        "seconds"
+    ].items()
 }
 
 

@@ -79,8 +79,12 @@ NEXT_SAMPLE, STEPS, REJECTED, NFEV, N_EVENTS, PROJ_PASSES, PROJ_DEFERRED = 0, 1,
 MONITOR_EVALS = 7
 #: Length of ``counts``.
 N_COUNTS = 8
-# Indices into the integer event specification ``ev_spec``.
-EV_CODE, EV_DIRECTION = 0, 1
+# Indices into the integer specification ``ev_spec``: the event function's code and direction,
+# and whether the normal force's minima inside steps are located (``dip_predicted``; a run that
+# does not locate them pays one comparison a step for it).
+EV_CODE, EV_DIRECTION, EV_DIPS = 0, 1, 2
+#: Length of ``ev_spec``.
+N_EV_SPEC = 3
 # Indices into the reaction-tracking array ``track``: the normal force at the last accepted step
 # and, for the dips between steps, the one before it (``PREV_NORMAL`` at ``PREV_T``).
 MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 0, 1, 2, 3, 4, 5

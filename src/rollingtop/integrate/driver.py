@@ -177,6 +177,7 @@ def _run_compiled(
     progress: Callable[[float], None] | None,
     event: tuple[int, int, int],
     held: IntArray | None = None,
+    dips: bool = True,
 ) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
     n = t_eval.shape[0]
     w = _workspace(n)
@@ -186,7 +187,7 @@ def _run_compiled(
     # the copy of the stepper the run needs (rollingtop._compiled._instances)
     stepper = (package.stepper_held if icodes.shape[0] > 0
                else package.stepper_events if ev_code != 0 else package.stepper)  # fmt: skip
-    ev_spec = np.array([ev_code, ev_direction], dtype=np.int64)
+    ev_spec = np.array([ev_code, ev_direction, int(dips)], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
     ev_t = np.empty(capacity)
     ev_y = np.empty((capacity, N_STATE))
@@ -294,6 +295,7 @@ def integrate(
     event_direction: int = 0,
     max_events: int = 100_000,
     project_integrals: tuple[str, ...] = (),
+    locate_dips: bool = True,
 ) -> IntegrationResult:
     """Integrate the constrained equations from ``y0`` at ``t_eval[0]`` to ``t_eval[-1]``.
 
@@ -338,6 +340,13 @@ def integrate(
         Integrals (names of :data:`rollingtop.dynamics.integrals.INTEGRALS`) held at their
         values at ``y0`` by a projection of the velocity after every accepted step
         (:mod:`rollingtop._compiled._template.invariants`); empty: none.
+    locate_dips : bool
+        Locate the normal force's minima inside steps on the dense output (default): the
+        reported minimum normal force, largest friction ratio and loss of contact then hold
+        between step ends too (:func:`rollingtop._compiled._dop853.dip_predicted`; about a
+        tenth more right-hand sides on the paper's motions, ``monitor_evals``). ``False``
+        monitors the reactions at step ends only, as the C limit (``benchmarks/c_limit.py``)
+        does; a run without dips pays one comparison a step for the search.
     """
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     y0 = np.ascontiguousarray(y0, dtype=float)
@@ -373,6 +382,7 @@ def integrate(
         progress,
         event,
         held if held.size else None,
+        bool(locate_dips),
     )
     return IntegrationResult(
         t=t_eval,

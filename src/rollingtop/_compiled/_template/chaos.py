@@ -79,7 +79,7 @@ def section_one(
     f = np.zeros(n)
     t_eval = np.array([0.0, t_max])
     out = np.zeros((2, n))
-    ev_spec = np.array([W_TAU, 1], dtype=np.int64)
+    ev_spec = np.array([W_TAU, 1, 1], dtype=np.int64)  # rising zeros; dips located
     no_codes = np.zeros(0, dtype=np.int64)  # no projection onto the integrals here
     no_targets = np.zeros(0)
     no_work = np.zeros((1, 8))

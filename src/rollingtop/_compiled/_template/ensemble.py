@@ -51,7 +51,8 @@ def batch(
     ws = new_workspace()
     y = np.zeros(n)
     f = np.zeros(n)
-    ev_spec = np.zeros(2, dtype=np.int64)
+    ev_spec = np.zeros(dop.N_EV_SPEC, dtype=np.int64)
+    ev_spec[dop.EV_DIPS] = 1  # the normal force's minima inside steps located, as a single run does
     ev_t = np.zeros(1)
     no_codes = np.zeros(0, dtype=np.int64)  # no projection onto the integrals here
     no_targets = np.zeros(0)

@@ -25,6 +25,7 @@ from rollingtop._compiled._dop853 import (
     BUDGET_EXHAUSTED,
     ERROR_EXPONENT,
     EV_CODE,
+    EV_DIPS,
     FINISHED,
     H_ABS,
     LAST_NORMAL,
@@ -72,11 +73,11 @@ from rollingtop._compiled._template.invariants import WORK_ROWS, project_integra
 from rollingtop._jit import compiled, kernel
 from rollingtop._types import FloatArray, IntArray, Workspace
 
-#: Whether :func:`run` holds integrals by projection: ``True`` in the generated ``stepper_held``.
+#: Whether :func:`run` holds integrals by projection: ``True`` in the instance ``stepper_held``.
 #: numba prunes a branch on a global constant before typing: a plain run never compiles it.
 HELD = False
 #: Whether :func:`run` locates the zeros of an event function (:func:`.dense.step_events`):
-#: ``True`` in the generated ``stepper_events`` (and ``stepper_held``); pruned like ``HELD``.
+#: ``True`` in the instances ``stepper_events`` and ``stepper_held``; pruned like ``HELD``.
 EVENTS = False
 
 
@@ -211,9 +212,11 @@ def run(
         Increasing sample times within ``[t0, t_end]``.
     out : ndarray, shape (n_samples, 18)
         Samples, each projected onto the constraints.
-    ev_spec : ndarray of int64, shape (2,)
+    ev_spec : ndarray of int64, shape (3,)
         Event function code (:mod:`rollingtop._compiled._events`, 0 for none) and direction
-        (+1: rising zeros only, -1: falling, 0: both). Located only by the copies compiled
+        (+1: rising zeros only, -1: falling, 0: both), then 1 to locate the normal force's
+        minima inside steps (0: the reactions are monitored at step ends, and a loss of contact
+        located where a step ends with a negative normal force). Located only by the copies compiled
         with ``EVENTS = True`` (``stepper_events``, ``stepper_held``): the plain stepper
         ignores a code, so callers pick the copy (the driver does).
     ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 18)
@@ -357,7 +360,9 @@ def run(
                 dense_ready = True
             track[T_CONTACT_LOST] = normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
             counts[NFEV] += 60
-        elif dip_predicted(track[PREV_T], track[PREV_NORMAL], t, N_old, t_new, N):
+        elif ev_spec[EV_DIPS] != 0 and dip_predicted(
+            track[PREV_T], track[PREV_NORMAL], t, N_old, t_new, N
+        ):
             # a minimum of the normal force inside the step: found on the dense output, with
             # its loss of contact if it dips below zero between two positive ends
             if not dense_ready:
