@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 import warnings
 from collections.abc import Callable, Iterator
 from typing import IO, TYPE_CHECKING, TypeVar
@@ -76,7 +77,15 @@ def with_warnings_reported(run: Callable[[], T]) -> T:
     return result
 
 
+#: The variables by which rich treats a stream that is no terminal as one.
+FORCE_TERMINAL = ("FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE")
+
+
 def _terminal_stderr() -> Console | None:
+    # rich's console and progress modules take a tenth of a second to import: a run whose
+    # stderr is a pipe or a file (scripts, CI) asks the stream first
+    if not sys.stderr.isatty() and not any(os.environ.get(v) for v in FORCE_TERMINAL):
+        return None
     from rich.console import Console
 
     stderr = Console(stderr=True)
@@ -86,11 +95,11 @@ def _terminal_stderr() -> Console | None:
 def progress_bar(label: str = "integrating") -> Progress | None:
     """A bar of simulated time on stderr when it is a terminal, else ``None``; ``label`` may
     name the task (``{task.description}``)."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-
     stderr = _terminal_stderr()
     if stderr is None:
         return None
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
     return Progress(
         TextColumn(label),
         BarColumn(),
