@@ -349,7 +349,8 @@ def table(res) -> str:
                  if "processes" in c else f"{len(c['ratios'])} paired rounds")  # fmt: skip
         rows += ["", f"C limit (benchmarks/c_limit/dop853.c, {c['flags']}): identical steps "
                  f"{c['identical_steps']} ({c['counts']['c'][0]} accepted, {c['counts']['c'][1]} "
-                 f"rejected), final states differ by {c['final_state_difference']:.1e}; rollingtop "
+                 f"rejected), final states differ by {c['final_state_difference']:.1e}, the "
+                 f"reactions monitored at the same step ends (locate_dips=False); rollingtop "
                  f"/ C = {c['ratio_median']:.2f} (median of {where}; "
                  f"{min(c['ratios']):.2f}-{max(c['ratios']):.2f}), {c['ratio_fastest']:.2f} "
                  f"between the fastest rounds."]  # fmt: skip
@@ -434,7 +435,8 @@ def readme_block(res) -> str:
         "|---|---|",
     ]
     if c:
-        rows.append(f"| the same integration hand-written in C ({c['flags']}; identical steps) | "
+        rows.append(f"| the same integration hand-written in C ({c['flags']}; identical steps; "
+                    "over rollingtop's with the reactions at step ends, as C) | "
                     f"{1.0 / c['ratio_median']:.2f} |")  # fmt: skip
     if peer:
         import peers
