@@ -152,7 +152,7 @@ def test_compiling_one_model_compiles_no_other(tmp_path):
     imported = {m.split(".")[2] for m in eval(proc.stdout)} & packages
     assert imported == {"rough"}
     # the kernel cache: one folder per module (rollingtop._kernel_cache)
-    modules = {p.parent.name for p in cache.rglob("*.nbi")}
+    modules = {p.parent.parent.name for p in cache.rglob("*.nbi")}  # <module>/<digest>/
     folders = {m.split(".")[2] for m in modules if m.startswith("rollingtop._compiled.")}
     assert "rough" in folders
     others = packages - {"rough"}

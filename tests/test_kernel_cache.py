@@ -8,6 +8,7 @@ only what its script calls: one model's right-hand side, or its plain stepper.
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -148,8 +149,12 @@ def test_two_models_never_share_an_entry(tmp_path):
     after, _ = _run(src, shared, "rough", "rhs")
     assert _ours(after["compiled"], "rollingtop._compiled.rough.dynamics.rhs")
     assert after["dy"] == alone["dy"]
-    index = {p.parent.name for p in (shared / "rollingtop").rglob("dynamics.rhs-*.nbi")}
+    index = {p.parent.parent.name for p in (shared / "rollingtop").rglob("dynamics.rhs-*.nbi")}
     assert {"rollingtop._compiled.smooth.dynamics", "rollingtop._compiled.rough.dynamics"} <= index
+    # data files are named by their key, not numbered from the index a process last read
+    data = [p.name for p in (shared / "rollingtop").rglob("dynamics.rhs-*.nbc")]
+    named = re.compile(r"dynamics\.rhs-\d+\.py\d+\.[0-9a-f]{16}\.nbc")
+    assert data and all(named.fullmatch(n) for n in data), data
 
 
 def test_a_fresh_process_imports_a_models_kernels_by_name(tmp_path):
@@ -290,3 +295,91 @@ def test_the_key_of_a_models_kernels_covers_its_sources_and_no_other_models():
     )
     held = _kernel_cache.module_digest(smooth.stepper_held.__name__)
     assert held != _kernel_cache.module_digest(smooth.stepper.__name__)
+
+
+def test_an_edit_after_the_import_does_not_stamp_the_old_code(tmp_path):
+    """A long-lived process (a notebook, a worker) imports the smooth model, the file is then
+    edited, and only then does the process compile: its entries are keyed on the code it
+    compiled (read from memory), so a fresh process with the same cache folder compiles and
+    runs the edited physics instead of loading the old machine code."""
+    src, cache = _copy_tree(tmp_path), tmp_path / "cache"
+    smooth = src / "rollingtop" / "contact" / "smooth.py"
+    edited = smooth.read_text().replace(
+        "    return rhs_contact(p, y, dy, ws, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)\n",
+        "    n = rhs_contact(p, y, dy, ws, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)\n"
+        "    for i in range(6):\n        dy[i] = 0.0\n    return n\n",
+    )
+    script = SCRIPT.replace(
+        "model, what = sys.argv[1], sys.argv[2]",
+        "model, what = sys.argv[1], sys.argv[2]\n"
+        "import pathlib, rollingtop._compiled\n"
+        "rollingtop._compiled.for_model(model)\n"
+        f"pathlib.Path({str(smooth)!r}).write_text({edited!r})",
+    )
+    env = os.environ | {"NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": str(src)}
+    proc = subprocess.run([sys.executable, "-c", script, "smooth", "rhs"], cwd=tmp_path,
+                          env=env, capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    old = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert np.max(np.abs(np.array(old["dy"][:6]))) > 0.1  # the code it had imported
+    new, _ = _run(src, cache, "smooth", "rhs")
+    assert _ours(new["compiled"], "rollingtop._compiled.smooth.dynamics.rhs")
+    assert np.all(np.array(new["dy"][:6]) == 0.0)
+
+
+def test_the_key_is_the_same_in_every_process_and_ignores_line_numbers():
+    """Two processes with different hash seeds compute the same digests (no set order, address
+    or path in the key); a function moved down by a comment keeps its part of the key."""
+    script = (
+        "from rollingtop import _compiled, _jit, _kernel_cache as kc\n"
+        "_jit.load_numba()\n"
+        "k = _compiled.for_model('rough')\n"
+        "print(kc.module_digest(k.stepper.__name__), kc.module_digest(k.ensemble.__name__))\n"
+    )
+    digests = set()
+    for seed in ("1", "2"):
+        env = os.environ | {"PYTHONHASHSEED": seed}
+        proc = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env,
+                              capture_output=True, text=True, timeout=300)  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        digests.add(proc.stdout.strip())
+    assert len(digests) == 1
+    text = 'def f(x):\n    "doc"\n    return x + len({"a", "b", "c"})\n'
+    a, b = {}, {}
+    exec(compile(text, "a.py", "exec"), a)
+    exec(compile("# moved\n\n" + text, "b.py", "exec"), b)
+    assert _kernel_cache._code(a["f"].__code__) == _kernel_cache._code(b["f"].__code__)
+
+
+def test_a_models_key_reaches_the_flag_intrinsic_and_no_other_model():
+    """numba intrinsics (the stop flag's atomic read, ``_flags.read_flag``) are followed to
+    their module like dispatchers; the module's state (lists, dicts) is neither hashed nor
+    followed, so the registry of every dispatcher does not pull other models in; a global
+    replaced in a module changes its part of the key in the same process."""
+    from rollingtop import _jit
+
+    _jit.load_numba()
+    _compiled.for_model("meridian")  # another model imported: never part of rough's key
+    ensemble = _compiled.for_model("rough").ensemble
+    reached = _kernel_cache.closure(ensemble.__name__)
+    assert "rollingtop._compiled._flags" in reached
+    assert not [m for m in reached if "meridian" in m or "smooth" in m], reached
+    from rollingtop._compiled import _dop853
+
+    before = _kernel_cache.module_digest(ensemble.__name__)
+    saved = _dop853.SAFETY
+    try:
+        _dop853.SAFETY = 0.5
+        assert _kernel_cache.module_digest(ensemble.__name__) != before
+    finally:
+        _dop853.SAFETY = saved
+    assert _kernel_cache.module_digest(ensemble.__name__) == before
+
+
+def test_old_versions_of_a_module_are_pruned(tmp_path):
+    folder = tmp_path / "rollingtop._compiled.smooth.dynamics"
+    for i in range(6):
+        (folder / f"{i:016x}").mkdir(parents=True)
+        os.utime(folder / f"{i:016x}", (1000 + i, 1000 + i))
+    _kernel_cache.prune(folder, keep=3)
+    assert sorted(p.name for p in folder.iterdir()) == [f"{i:016x}" for i in (3, 4, 5)]

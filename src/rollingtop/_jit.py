@@ -48,8 +48,10 @@ class _State:
     numba_loaded: bool = False
     #: every cache of the package switched off (:func:`disable_caching`)
     caching_off: bool = False
-    #: the one warning about the cache given
+    #: the one warning about saving the cache given
     warned: bool = False
+    #: the one notice that NUMBA_CACHE_DIR cannot be written given
+    told_moved: bool = False
 
 
 _state = _State()
@@ -78,12 +80,16 @@ def _njit(func: Callable[..., Any], options: dict[str, Any]) -> Any:
         if root is None:
             _no_cache_folder(failures)
         else:
-            if failures and not _state.warned:
-                _state.warned = True
-                where, exc = failures[0]
+            chosen = _kernel_cache.explicit_folder()
+            failed = dict(failures)
+            # numba's order falls back silently from a read-only installation's folder; a
+            # folder the user chose (NUMBA_CACHE_DIR) that cannot be written is said, once
+            if chosen in failed and not _state.told_moved:
+                _state.told_moved = True
+                exc = failed[chosen]
                 warnings.warn(
                     CacheNotSaved(
-                        f"cannot write {where} ({exc.strerror or exc}): compiled kernels are "
+                        f"cannot write {chosen} ({exc.strerror or exc}): compiled kernels are "
                         f"cached in {root} instead"
                     ),
                     stacklevel=4,

@@ -41,7 +41,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 
-from rollingtop._kernel_cache import SOURCE_ATTRIBUTE
 from rollingtop.contact import MODULES, kernel_by_code, kernels_of
 
 __all__ = [
@@ -254,7 +253,6 @@ class _Loader(importlib.abc.Loader):
         text, filename = module_source(self.group, self.module)
         if filename.startswith("<"):  # tracebacks and numba's messages show its lines
             linecache.cache[filename] = (len(text), None, text.splitlines(True), filename)
-        setattr(module, SOURCE_ATTRIBUTE, text)
         exec(compile(text, filename, "exec", dont_inherit=True), module.__dict__)
 
 
