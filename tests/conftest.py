@@ -115,8 +115,10 @@ def kernels_compiled_in_parallel(request):
     """Compile (or load) every model's integrator and ensemble kernels before the first test,
     one process per model on every core (:func:`rollingtop.warmup`): on a cold numba cache the
     tests would otherwise compile them one after the other, on one core. A warm cache loads in
-    seconds. Says so on the terminal, and each model as it is done: a cold start is about 45 s
-    of otherwise silent work on 2 cores."""
+    seconds. Says so on the terminal, and each model as it is done: a cold start is a minute
+    or more of otherwise silent work on 2 cores (the start-up table's ``rollingtop warmup``,
+    measured by ``benchmarks/run_benchmarks.py``)."""
+    import json
     import time
 
     from rollingtop import warmup
@@ -130,10 +132,15 @@ def kernels_compiled_in_parallel(request):
         with capture.global_and_fixture_disabled() if capture else contextlib.nullcontext():
             reporter.write_line(text)
 
+    try:
+        measured = json.loads((ROOT / "benchmarks" / "results.json").read_text())
+        cold = f"{measured['cold_start']['warmup_empty_cache_s']:.0f} s in the start-up table"
+    except (OSError, KeyError, ValueError):
+        cold = "a minute or more on 2 cores"
     start = time.perf_counter()
     say(
         "rollingtop: compiling or loading every model's kernels before the first test (a cold "
-        "numba cache: about 45 s on 2 cores, one process per model; a warm one: seconds)"
+        f"numba cache: {cold}, one process per compiled package; a warm one: seconds)"
     )
     warmup(progress=lambda model, seconds: say(
         f"  {model}: {sum(seconds.values()):.1f} s"))  # fmt: skip
