@@ -5,12 +5,18 @@ complete and flushed to disk. Data that can be built in memory (NetCDF, CSV) is 
 plain checked ``os.write`` calls (:func:`write_bytes_atomic`), so that a full disk, a file-size
 limit or an I/O error is an ordinary :class:`WriteFailed` and never reaches a C library in the
 middle of its own writes (HDF5 crashed the interpreter under ``ulimit -f``).
+
+Within :func:`published_on_success` (every command of the command line runs in one), the
+renames wait for the end of the block: a command that refuses its input or fails after it has
+written a file leaves no file behind (a figure written before a later check refused the run, say).
+Files that must survive a failure (the atlas's resumable chunks) are written ``now=True``.
 """
 
 from __future__ import annotations
 
 import codecs
 import contextlib
+import contextvars
 import errno as _errno
 import os
 import signal
@@ -34,6 +40,7 @@ __all__ = [
     "check_output_path",
     "format_bytes",
     "netcdf_bytes",
+    "published_on_success",
     "read_input_text",
     "write_bytes_atomic",
     "write_together",
@@ -44,6 +51,11 @@ PathArg: TypeAlias = str | os.PathLike[str]
 
 #: Largest piece handed to one ``os.write`` call.
 _CHUNK = 1 << 20
+
+#: The renames :func:`published_on_success` holds back: ``(temporary, target)`` in write order.
+_PENDING: contextvars.ContextVar[list[tuple[Path, Path]] | None] = contextvars.ContextVar(
+    "rollingtop_pending_outputs", default=None
+)
 
 
 class WriteFailed(OSError):
@@ -167,8 +179,13 @@ def _flush(fd: int, data: memoryview | None = None) -> None:
         os.close(fd)
 
 
-def _rename(tmp: Path, path: Path) -> None:
-    """Rename ``tmp`` onto ``path``, and make the rename durable where possible."""
+def _rename(tmp: Path, path: Path, *, now: bool = False) -> None:
+    """Rename ``tmp`` onto ``path``, and make the rename durable where possible; within
+    :func:`published_on_success` (unless ``now``), at the end of its block."""
+    pending = None if now else _PENDING.get()
+    if pending is not None:
+        pending.append((tmp, path))
+        return
     os.replace(tmp, path)
     with contextlib.suppress(OSError):
         dir_fd = os.open(path.parent, os.O_RDONLY)
@@ -178,11 +195,46 @@ def _rename(tmp: Path, path: Path) -> None:
             os.close(dir_fd)
 
 
-def _publish(fd: int, tmp: Path, path: Path, data: memoryview | None = None) -> None:
+def _publish(
+    fd: int, tmp: Path, path: Path, data: memoryview | None = None, *, now: bool = False
+) -> None:
     """:func:`_flush` ``data`` into ``tmp`` (open as ``fd``), then :func:`_rename` it onto
     ``path``."""
     _flush(fd, data)
-    _rename(tmp, path)
+    _rename(tmp, path, now=now)
+
+
+@contextlib.contextmanager
+def published_on_success() -> Iterator[None]:
+    """Hold back the renames of the files written in the block until it ends without an
+    exception (``SystemExit(0)`` and click's ``Exit(0)`` count as success); otherwise remove
+    their temporary files, so that nothing the block wrote appears. Files written ``now=True``
+    are not held. The writes are complete and flushed when made, so the renames at the end
+    cannot fail for lack of space; a file written twice ends with the later content."""
+    pending: list[tuple[Path, Path]] = []
+    token = _PENDING.set(pending)
+    ok = False
+    try:
+        yield
+        ok = True
+    except SystemExit as exc:
+        ok = exc.code in (0, None)
+        raise
+    except BaseException as exc:
+        ok = getattr(exc, "exit_code", None) == 0  # click's Exit(0)
+        raise
+    finally:
+        _PENDING.reset(token)
+        try:
+            while ok and pending:
+                tmp, path = pending[0]
+                with _failures_named(path):
+                    _rename(tmp, path)
+                del pending[0]
+        finally:  # not published (a failure, or a rename refused): no temporary file stays
+            for tmp, _ in pending:
+                with contextlib.suppress(OSError):
+                    tmp.unlink()
 
 
 @contextlib.contextmanager
@@ -200,8 +252,9 @@ def _failures_named(path: Path) -> Iterator[None]:
         raise WriteFailed(path, *_reason(cause)) from None
 
 
-def write_bytes_atomic(path: PathArg, data: ReadableBuffer) -> Path:
-    """Write the bytes ``data`` (any buffer) to ``path`` atomically.
+def write_bytes_atomic(path: PathArg, data: ReadableBuffer, *, now: bool = False) -> Path:
+    """Write the bytes ``data`` (any buffer) to ``path`` atomically; with ``now``, at once even
+    within :func:`published_on_success`.
 
     Raises
     ------
@@ -213,7 +266,7 @@ def write_bytes_atomic(path: PathArg, data: ReadableBuffer) -> Path:
     view = memoryview(data).cast("B")
     with _temporary_beside(path, ".tmp") as (fd, tmp):
         try:
-            _publish(fd, tmp, path, view)
+            _publish(fd, tmp, path, view, now=now)
         except OSError as exc:
             raise WriteFailed(path, *_reason(exc)) from None
     return path

@@ -217,15 +217,23 @@ class Scenario:
         Returns
         -------
         dict or None
-            ``M3, C1, C2, h`` (:meth:`level_integrals`, :meth:`level_h`), ``energy = h +
+            ``None`` also where the model's reduction refuses the level (a pole level it does
+            not reduce): the run needs no reduction. Otherwise ``M3, C1, C2, h``
+            (:meth:`level_integrals`, :meth:`level_h`), ``energy = h +
             spin_energy + mgR`` (:func:`~rollingtop.reduction.start.level_energy`), ``source``
             (``"[level]"`` where it gives ``h``, else ``"initial state"``).
         """
         if not (self.model.reduction and self.body.symmetric) or self.y0 is None:
             return None
-        level = self.level_set()
-        values = level.values()
-        h, given = self.level_h(), self.level is not None and self.level.h is not None
+        from rollingtop.reduction.level import LevelSetError
+
+        try:  # a level the reduction refuses (a rough pole level) is not shown; the run stands
+            level = self.level_set()
+            values = level.values()
+            h = self.level_h()
+        except LevelSetError:
+            return None
+        given = self.level is not None and self.level.h is not None
         body = self.body
         M3 = values.get("M3")
         return {**values, "C2": values.get("C2"), "h": h, "energy": level.full_energy(h),

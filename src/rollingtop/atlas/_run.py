@@ -209,7 +209,7 @@ def atlas(
     if folder is not None and not folder.exists():
         folder.mkdir()
         created = True
-        write_bytes_atomic(folder / "spec.json", json.dumps({"digest": digest}).encode())
+        write_bytes_atomic(folder / "spec.json", json.dumps({"digest": digest}).encode(), now=True)
     try:
         connect = functools.partial(_client, client, workers, scheduler, float(scheduler_timeout))
         _compute(spec, cells, names, starts, chunk, done, folder, connect, progress)

@@ -104,7 +104,8 @@ def _load_partial(
 def _save_chunk(folder: Path, k: int, result: Mapping[str, np.ndarray]) -> None:
     buf = io.BytesIO()
     np.savez(buf, **result)  # type: ignore[arg-type]
-    write_bytes_atomic(folder / f"chunk-{k:06d}.npz", buf.getvalue())
+    # now: a chunk is kept for a resumed run even when this one fails
+    write_bytes_atomic(folder / f"chunk-{k:06d}.npz", buf.getvalue(), now=True)
 
 
 def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> xr.Dataset:
@@ -146,7 +147,9 @@ def _write(ds: xr.Dataset, output: Path) -> None:
     """The finished atlas, atomically: NetCDF through a temporary file, Zarr through a
     temporary store renamed into place."""
     if output.suffix.lower() == ".nc":
-        write_bytes_atomic(output, netcdf_bytes(ds))
+        # now: the chunks are removed next, so the atlas must be in place (a failure after
+        # this point cannot refuse the run that computed it)
+        write_bytes_atomic(output, netcdf_bytes(ds), now=True)
         return
     tmp = output.with_name(f".{output.name}.tmp{os.getpid()}")
     shutil.rmtree(tmp, ignore_errors=True)

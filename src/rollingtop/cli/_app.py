@@ -11,6 +11,7 @@ from rollingtop._signals import handle_signals
 from rollingtop.cli._compile_notice import compile_notices
 from rollingtop.cli._errors import reported
 from rollingtop.cli._output import warnings_as_lines
+from rollingtop.io import published_on_success
 
 __all__ = ["CommandLine", "cli"]
 
@@ -18,14 +19,16 @@ __all__ = ["CommandLine", "cli"]
 class CommandLine(click.Group):
     """A click group whose commands report every error they meet as one line
     (:func:`rollingtop.cli._errors.reported`) and stop cleanly on SIGINT or SIGTERM
-    (:func:`rollingtop._signals.handle_signals`)."""
+    (:func:`rollingtop._signals.handle_signals`); the files a command writes appear only when it
+    succeeds (:func:`rollingtop.io.published_on_success`)."""
 
     def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
         with reported():  # the group's own options
             return super().parse_args(ctx, args)
 
     def invoke(self, ctx: click.Context) -> Any:
-        with reported(), handle_signals():  # a command: its options, then its run
+        # a command: its options, then its run; its files appear only if it succeeds
+        with reported(), handle_signals(), published_on_success():
             return super().invoke(ctx)
 
 

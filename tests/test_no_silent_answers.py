@@ -1,0 +1,105 @@
+"""Regression tests of the defects of issue 36, each in a real process where the defect showed:
+a valid run is never refused, a refusal leaves no file, a printed number was achieved."""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from rollingtop.io import published_on_success, write_bytes_atomic
+
+from .conftest import EXAMPLES
+
+
+def rollingtop(*args, cwd=None):
+    """``python -m rollingtop ARGS`` in a real process: ``(status, stdout, stderr)``."""
+    proc = subprocess.run([sys.executable, "-m", "rollingtop", *map(str, args)],
+                          capture_output=True, text=True, check=False, cwd=cwd,
+                          env=os.environ | {"COLUMNS": "120"})  # fmt: skip
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def scenario(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+BODY = "[body]\nR = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n"
+
+
+# ---- row 1: the full system needs no reduction; a refusal never leaves a file ----------------
+def test_held_back_files_appear_only_on_success(tmp_path):
+    kept, dropped, chunk = tmp_path / "kept.bin", tmp_path / "dropped.bin", tmp_path / "c.bin"
+    with published_on_success():
+        write_bytes_atomic(kept, b"1")
+        assert not kept.exists()  # held back until the block ends
+    assert kept.read_bytes() == b"1"
+    with pytest.raises(ValueError), published_on_success():
+        write_bytes_atomic(dropped, b"2")
+        write_bytes_atomic(chunk, b"3", now=True)
+        raise ValueError("refused")
+    assert not dropped.exists() and chunk.read_bytes() == b"3"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.bin", "kept.bin"]
+
+
+@pytest.mark.parametrize("suffix", [".nc", ".csv", None])
+def test_rough_pole_level_runs_and_writes(tmp_path, suffix):
+    """Issue 36 row 1: ``omega = (1, 0, 0)`` puts the rough model on a pole level (jellett =
+    routh = 0); the run needs no reduction, exits 0 and writes its file."""
+    text = (EXAMPLES / "rough.toml").read_text().replace(
+        "omega = [0.7, -0.3, 2.0]", "omega = [1.0, 0.0, 0.0]")  # fmt: skip
+    path = scenario(tmp_path, "rw.toml", text)
+    out = [] if suffix is None else ["-o", tmp_path / f"rw{suffix}"]
+    code, stdout, err = rollingtop("simulate", path, "--t-end", "1", "--json", *out)
+    assert code == 0, err
+    summary = json.loads(stdout)
+    assert "level" not in summary  # the reduction refuses a pole level: not shown
+    assert summary["integrals"]["jellett"]["max_abs_drift"] < 1e-9
+    if suffix is not None:
+        assert (tmp_path / f"rw{suffix}").stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    ("model", "initial"),
+    [("rough", 'gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\n'),
+     ("meridian", 'gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\nv_tau = 0.0\n')],
+)  # fmt: skip
+def test_sleeping_top_simulates(tmp_path, model, initial):
+    """The sleeping top stays asleep: exit 0 and omega3 exact."""
+    path = scenario(tmp_path, "s.toml", f'{BODY}[contact]\nmodel = "{model}"\n[initial]\n'
+                    f"{initial}[integration]\nt_end = 3.0\n")  # fmt: skip
+    code, stdout, err = rollingtop("simulate", path, "--json")
+    assert code == 0, err
+    final = json.loads(stdout)["final"]
+    assert abs(final["omega"][2] - 2.0) < 1e-12
+
+
+def test_refusal_after_writing_leaves_no_file(tmp_path, capsys):
+    """Every command runs with its files held back: one that writes its output and then refuses
+    (a check after the run) exits 2 in one line and leaves nothing; the same command that
+    succeeds leaves its file."""
+    import click
+
+    from rollingtop._errors import ScenarioError
+    from rollingtop.cli import cli, main
+
+    @click.command("write-then-refuse")
+    @click.argument("refuse", type=bool)
+    def write_then_refuse(refuse):
+        write_bytes_atomic(tmp_path / "out.nc", b"data")
+        if refuse:
+            raise ScenarioError("refused after the write")
+
+    cli.add_command(write_then_refuse)
+    try:
+        for refuse, listing in ((True, []), (False, ["out.nc"])):
+            with pytest.raises(SystemExit) as exc:
+                main(["write-then-refuse", str(refuse)])
+            assert exc.value.code == (2 if refuse else 0)
+            assert sorted(p.name for p in tmp_path.iterdir()) == listing
+    finally:
+        cli.commands.pop("write-then-refuse")
+    assert capsys.readouterr().err == "rollingtop: error: refused after the write\n"
