@@ -118,7 +118,7 @@ def trajectory_html(
                "contact lost at": react["contact_lost_at"],
                "max constraint residual": Num(cons["max_abs_residual"], 3),
                "frame orthonormality error": Num(cons["orthonormality_max_error"], 3)}  # fmt: skip
-    header = ["integral", "initial", "final", "max |I - I0|", "max |I - I0| / |I0|"]
+    header = ["integral", "initial", "final", "max |I - I0|", "max |I - I0| / size"]
     return block(
         "rollingtop.Trajectory",
         f"{head['model']} model ({head['description']})",

@@ -207,7 +207,8 @@ def _publish(
 @contextlib.contextmanager
 def published_on_success() -> Iterator[None]:
     """Hold back the renames of the files written in the block until it ends without an
-    exception (``SystemExit(0)`` and click's ``Exit(0)`` count as success); otherwise remove
+    exception (``SystemExit(0)``, click's ``Exit(0)`` and an exception whose ``keeps_outputs``
+    is true count as success: a run that finished but missed a claim); otherwise remove
     their temporary files, so that nothing the block wrote appears. Files written ``now=True``
     are not held. The writes are complete and flushed when made, so the renames at the end
     cannot fail for lack of space; a file written twice ends with the later content."""
@@ -221,7 +222,8 @@ def published_on_success() -> Iterator[None]:
         ok = exc.code in (0, None)
         raise
     except BaseException as exc:
-        ok = getattr(exc, "exit_code", None) == 0  # click's Exit(0)
+        # click's Exit(0), or a failure whose outputs are its evidence (``keeps_outputs``)
+        ok = getattr(exc, "exit_code", None) == 0 or getattr(exc, "keeps_outputs", False)
         raise
     finally:
         _PENDING.reset(token)

@@ -22,7 +22,7 @@ from rollingtop._output import TRAJECTORY_UNITS, NetCDFOutput
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.contact import ContactModel, kernel_by_code
-from rollingtop.dynamics.integrals import evaluate
+from rollingtop.dynamics.integrals import HELD_TOLERANCE, evaluate, natural_scales
 from rollingtop.integrate.driver import StepReactions
 from rollingtop.io import check_output_path, write_bytes_atomic
 
@@ -199,6 +199,11 @@ class Trajectory(NetCDFOutput):
         """Summary as a JSON-ready dict (the output of ``rollingtop simulate --json``).
 
         Keys: ``model, t_end, final, integrals, constraints, reactions, stats`` (see README).
+        Each integral's ``max_rel_drift`` is its largest drift over its natural size (the sum of
+        its terms' magnitudes: :func:`~rollingtop.dynamics.integrals.natural_scales`). A run that
+        held its integrals by projection adds ``projection``: ``held`` (every drift within
+        ``tolerance``, :data:`~rollingtop.dynamics.integrals.HELD_TOLERANCE`), ``worst`` (the
+        integral of largest relative drift) and its ``max_rel_drift``.
         """
         last = self.y[-1]
         final = {
@@ -214,14 +219,16 @@ class Trajectory(NetCDFOutput):
         for name, values in self.model_outputs.items():
             final[name] = values[-1].tolist()
         integrals = {}
+        scales = natural_scales(self.body, self.y, self.integrals, self.pole_case,
+                                slot_is_velocity=self.model.slot_name != "psi_nu")  # fmt: skip
         for name, values in self.integrals.items():
             drift = float(np.max(np.abs(values - values[0])))
-            initial = float(values[0])
             integrals[name] = {
-                "initial": initial,
+                "initial": float(values[0]),
                 "final": float(values[-1]),
                 "max_abs_drift": drift,
-                "max_rel_drift": drift / abs(initial) if initial != 0 else None,
+                # on the integral's natural size: the sum of its terms' magnitudes
+                "max_rel_drift": drift / scales[name] if scales[name] > 0 else None,
             }
         min_normal = min(
             float(np.min(self.normal_force)), self.step_reactions.get("min_normal_force", np.inf)
@@ -231,6 +238,13 @@ class Trajectory(NetCDFOutput):
             float(ratio) if np.isfinite(ratio) else 0.0,
             self.step_reactions.get("max_friction_ratio", 0.0),
         )
+        held = {}
+        if "projection_passes" in self.stats:  # a run that claims its integrals held
+            worst = max(integrals, key=lambda k: integrals[k]["max_rel_drift"] or 0.0)
+            drift = integrals[worst]["max_rel_drift"] or 0.0
+            verdict = {"held": bool(drift <= HELD_TOLERANCE), "worst": worst,
+                       "max_rel_drift": drift, "tolerance": HELD_TOLERANCE}  # fmt: skip
+            held = {"projection": verdict}
         return {
             "model": self.model.name,
             "t_end": float(self.t[-1]),
@@ -257,6 +271,7 @@ class Trajectory(NetCDFOutput):
                     if k in self.stats
                 },
             },
+            **held,
         }
 
     # ---- notebooks ---------------------------------------------------------------------------

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rollingtop import SphericalTop, get_model, simulate
-from rollingtop.dynamics.integrals import INTEGRALS, evaluate
+from rollingtop.dynamics.integrals import INTEGRALS, evaluate, natural_scales
 from rollingtop.scenario import InitialConditions, IntegrationOptions, Scenario
 
 from ..conftest import FREE, GAMMA0, OMEGA0, PAPER_BODY, admissible_omega
@@ -117,3 +117,28 @@ def test_energy_by_hand(paper_body):
     y[12:15] = (0.0, 0.6, 0.8)
     expected = 0.5 * 0.14 + 0.5 * (0.3 * 0.25 + 0.5 * 1.0) + 1.0 * (1.0 + 0.1 * 0.8)
     assert evaluate(paper_body, y, ["energy"])["energy"] == pytest.approx(expected, rel=1e-15)
+
+
+def test_natural_scales_by_hand(paper_body):
+    """The natural size of each integral, written out for two states of the paper's body: the
+    energy's is the kinetic energy plus |m g (r, gamma)|; a linear integral's the sum of its
+    terms' magnitudes (``I1 = I2 = 0.3, I3 = 0.5, a3 = 0.1, R = m = g = 1``)."""
+    Y = np.zeros((2, 18))
+    Y[0, 0:6] = (0.1, -0.2, 0.3, 0.5, 0.0, -1.0)
+    Y[0, 12:15] = (0.0, 0.6, 0.8)
+    Y[1, 0:6] = (0.0, 0.0, 0.0, 0.2, 0.1, 2.0)
+    Y[1, 12:15] = (0.6, 0.0, -0.8)
+    sizes = natural_scales(paper_body, Y, ("energy", "lagrange", "jellett", "area"))
+    kinetic = [0.5 * 0.14 + 0.5 * (0.3 * 0.25 + 0.5 * 1.0), 0.5 * (0.3 * 0.05 + 0.5 * 4.0)]
+    potential = [1.0 + 0.1 * 0.8, 1.0 - 0.1 * 0.8]
+    assert sizes["energy"] == pytest.approx(max(map(sum, zip(kinetic, potential))), rel=1e-15)
+    assert sizes["lagrange"] == pytest.approx(0.5 * 2.0, rel=1e-15)
+    # jellett = (I w, r), r = -R gamma - a3 e3: terms I_i w_i r_i
+    r = [(0.0, -0.6, -0.9), (-0.6, 0.0, 0.7)]
+    w = [(0.5, 0.0, -1.0), (0.2, 0.1, 2.0)]
+    inertia = (0.3, 0.3, 0.5)
+    jellett = [sum(abs(i * a * b) for i, a, b in zip(inertia, wk, rk)) for wk, rk in zip(w, r)]
+    assert sizes["jellett"] == pytest.approx(max(jellett), rel=1e-15)
+    gammas = [(0.0, 0.6, 0.8), (0.6, 0.0, -0.8)]
+    area = [sum(abs(i * a * b) for i, a, b in zip(inertia, wk, gk)) for wk, gk in zip(w, gammas)]
+    assert sizes["area"] == pytest.approx(max(area), rel=1e-15)

@@ -8,8 +8,8 @@ the tests hold them to those definitions. Every one is a polynomial of degree at
 the velocity ``u = (v, w)`` at a fixed attitude -- the linear ones (Lagrange, Jellett, area,
 ``F6``, the momenta, Routh's, rubber rolling's) of degree one, the energy of degree two -- so a
 central difference of step ``h`` gives their gradient in ``u`` exactly, up to round-off
-(:func:`velocity_gradient`); ``slip_nu``, a norm, is the one exception (its gradient is then
-approximate, which Newton's iteration tolerates). The shell-rotor pair's integrals (with the
+(:func:`velocity_gradient`); ``slip_nu``, a norm, is the one exception: its gradient is
+written out. The shell-rotor pair's integrals (with the
 shell's terms) are not here: the projection refuses that model.
 """
 
@@ -85,7 +85,21 @@ def integral_value(icode: int, p: FloatArray, y: FloatArray) -> float:
 def velocity_gradient(icode: int, p: FloatArray, y: FloatArray, out: FloatArray) -> None:
     """The gradient of the integral ``icode`` in the velocity ``u = y[0:6]`` at a fixed attitude,
     into ``out[0:6]``: central differences of step ``h = max(1, max |u_k|)``, exact for the
-    integrals of degree at most two in ``u`` (all but ``slip_nu``). ``y`` is restored."""
+    integrals of degree at most two in ``u`` (all but ``slip_nu``, whose gradient is written
+    out). ``y`` is restored."""
+    if icode == SLIP_NU:  # a signed norm |p|, p = v + w x r: grad_v = p / |p|, grad_w = r x grad_v
+        R, a3 = p[0], p[3]
+        r0, r1, r2 = -R * y[12], -R * y[13], -R * y[14] - a3
+        p0 = y[0] + y[4] * r2 - y[5] * r1
+        p1 = y[1] + y[5] * r0 - y[3] * r2
+        p2 = y[2] + y[3] * r1 - y[4] * r0
+        size = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+        if size > 0.0:
+            sign = 1.0 if integral_value(icode, p, y) >= 0.0 else -1.0
+            p0, p1, p2 = sign * p0 / size, sign * p1 / size, sign * p2 / size
+        out[0], out[1], out[2] = p0, p1, p2
+        out[3], out[4], out[5] = r1 * p2 - r2 * p1, r2 * p0 - r0 * p2, r0 * p1 - r1 * p0
+        return
     h = 1.0
     for k in range(6):
         h = max(h, abs(y[k]))

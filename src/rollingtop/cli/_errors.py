@@ -7,7 +7,8 @@ in one place, :func:`reported`; click's standalone mode then shows it
 - :class:`BadInput`, status 2: a :class:`~rollingtop.RollingTopError` (bad scenario, table,
   value, output path) or click's own usage errors (bad option, missing argument);
 - :class:`RunFailed`, status 1: an :class:`~rollingtop.IntegrationError`, or an output not
-  written (:class:`~rollingtop.io.WriteFailed`, any other ``OSError``);
+  written (:class:`~rollingtop.io.WriteFailed`, any other ``OSError``); :class:`NotHeld`, a run
+  that finished without holding its integrals (its outputs are written);
 - :class:`Stopped`, status ``128 + signum``: SIGINT or SIGTERM
   (:class:`~rollingtop._errors.Interrupted`, raised by :mod:`rollingtop._signals`).
 """
@@ -25,7 +26,7 @@ import click
 from rollingtop._errors import IntegrationError, Interrupted, RollingTopError, short_repr
 from rollingtop.io import WriteFailed
 
-__all__ = ["BadInput", "Reported", "RunFailed", "Stopped", "one_line", "reported"]
+__all__ = ["BadInput", "NotHeld", "Reported", "RunFailed", "Stopped", "one_line", "reported"]
 
 _LINE_BREAKS = {
     ord(c): c.encode("unicode_escape").decode() for c in "\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029"
@@ -62,6 +63,13 @@ class RunFailed(Reported):
     """The run could not finish (integration failed, output not written): exit status 1."""
 
     exit_code = 1
+
+
+class NotHeld(RunFailed):
+    """The run finished but did not hold what it claimed (its integrals, by projection): exit
+    status 1, its outputs written (:func:`rollingtop.io.published_on_success`)."""
+
+    keeps_outputs = True
 
 
 class Stopped(Reported):

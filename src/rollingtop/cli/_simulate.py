@@ -10,6 +10,7 @@ import click
 import numpy as np
 
 from rollingtop.cli import _output
+from rollingtop.cli._errors import NotHeld
 from rollingtop.cli._options import (
     ModelChoice,
     atol_option,
@@ -44,7 +45,10 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
             code = get_model(options.get("model") or sc.model).kernel_code(sc.body, sc.y0)
         held = options.get("project_integrals")
         held = sc.integration.project_integrals if held is None else held
-        compiled = compile_code(code, held=bool(held), events=options.get("events") is not None)
+        model = get_model(options.get("model") or sc.model)
+        if not (held and model.own_inertia):  # else refused by the run, before any compiling
+            compiled = compile_code(code, held=bool(held),
+                                    events=options.get("events") is not None)  # fmt: skip
     with _output.timing(sc.integration.t_end) as progress:
         traj = _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
     # the compilation belongs to the run's statistics, wherever it happened
@@ -176,3 +180,10 @@ def simulate(
         _print_report(summary)
         if output is not None:
             click.echo(f"wrote {output}")
+    held = summary.get("projection")
+    if held is not None and not held["held"]:
+        raise NotHeld(
+            f"the projection did not hold {held['worst']}: drift {held['max_rel_drift']:.2e} of "
+            f"its natural size, above {held['tolerance']:g}"
+            + ("" if output is None else f" (written to {output} all the same)")
+        )

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from rollingtop._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 from rollingtop.body import SphericalTop
 
-__all__ = ["INTEGRALS", "F6_reduced", "evaluate"]
+__all__ = ["HELD_TOLERANCE", "INTEGRALS", "F6_reduced", "evaluate", "natural_scales"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: An integral: ``(body, Y)`` with states ``Y`` of shape ``(..., 18)`` -> values, shape ``(...)``.
@@ -281,3 +281,46 @@ def evaluate(
     Y = np.asarray(Y, dtype=float)
     return {name: F6(body, Y, pole) if name == "F6" else INTEGRALS[name](body, Y)
             for name in names}  # fmt: skip
+
+
+#: Largest drift of a held integral (:func:`rollingtop.simulate`'s ``project_integrals``), as a
+#: fraction of its natural size (:func:`natural_scales`), that a run may report as held.
+HELD_TOLERANCE = 1e-12
+
+
+def natural_scales(
+    body: SphericalTop,
+    Y: ArrayLike,
+    names: Iterable[str],
+    pole: str | None = None,
+    *,
+    slot_is_velocity: bool = False,
+) -> dict[str, float]:
+    """The natural size of each integral ``names`` along the states ``Y`` (shape ``(n, 18)``):
+    the largest, over the states, of the sum of the magnitudes of its terms, so that a drift
+    divided by it is a drift relative to round-off of the integral's evaluation, whatever the
+    integral's own value (which may be zero).
+
+    Every integral but the energy is homogeneous of degree one in the velocity ``u`` (``v``,
+    ``w`` and, with ``slot_is_velocity``, the state's last slot: the shell's spin): its terms
+    are its values at each velocity component alone, ``sum_j |I(u_j e_j)|`` (at least ``|I|``
+    by the triangle inequality). The energy's are the kinetic energy and the magnitude of the
+    potential, ``(E - E|u=0) + |E|u=0|``.
+    """
+    Y = np.atleast_2d(np.asarray(Y, dtype=float))
+    velocity = [*range(6), *([PSI_NU] if slot_is_velocity else [])]
+    still = Y.copy()
+    still[:, velocity] = 0.0
+    out = {}
+    for name in names:
+        if name == "energy":
+            e0 = energy(body, still)
+            size = energy(body, Y) - e0 + np.abs(e0)
+        else:
+            size = np.zeros(Y.shape[0])
+            for j in velocity:
+                one = still.copy()
+                one[:, j] = Y[:, j]
+                size += np.abs(evaluate(body, one, (name,), pole)[name])
+        out[name] = float(np.max(size)) if size.size else 0.0
+    return out

@@ -19,7 +19,7 @@ def held_arrays(
     :mod:`rollingtop._compiled._integrals`; ``None``: no projection): their codes, their values
     at ``y0`` (the compiled evaluation the projection compares with) and its work array."""
     from rollingtop._compiled import _integrals
-    from rollingtop._compiled._template.invariants import WORK_ROWS
+    from rollingtop._compiled._template.invariants import WORK_SHAPE
 
     if held is None or len(held) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8))
@@ -27,4 +27,4 @@ def held_arrays(
     targets = np.array([call(_integrals.integral_value, int(c), p, y0) for c in icodes])
     if not np.all(np.isfinite(targets)):
         raise IntegrationError("the integrals to hold are not finite at the initial state")
-    return icodes, targets, np.zeros((WORK_ROWS, 8))
+    return icodes, targets, np.zeros(WORK_SHAPE)

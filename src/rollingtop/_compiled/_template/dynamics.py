@@ -120,28 +120,41 @@ def rhs_rows(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Worksp
     return nc
 
 
+#: Largest Newton-Schulz steps of the frame in one :func:`project`.
+FRAME_ITERATIONS = 6
+#: ``max |Q Q^T - 1|`` from which one Newton-Schulz step reaches round-off (``1.5 e^2``).
+FRAME_ONE_STEP = 1e-8
+
+
 @kernel
 def project(code: int, p: FloatArray, y: FloatArray, ws: Workspace) -> None:
     """Project ``y`` in place onto the constraint manifold.
 
-    The frame ``Q = [alpha; beta; gamma]`` goes to its nearest orthogonal matrix by one
-    Newton-Schulz step ``Q <- (3 Q - Q Q^T Q) / 2`` (quadratic convergence; the error after an
-    accepted step is at truncation level); ``psi_nu`` is re-synchronised with the axis azimuth
-    (see :mod:`rollingtop.contact.meridian`). The velocity ``u`` then goes to the nearest point,
-    in the kinetic-energy metric, of ``J u = 0``: ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
+    The frame ``Q = [alpha; beta; gamma]`` goes to its nearest orthogonal matrix by
+    Newton-Schulz steps ``Q <- (3 Q - Q Q^T Q) / 2`` (quadratic convergence: a step from an
+    error ``e`` leaves about ``1.5 e^2``) until a step starts within :data:`FRAME_ONE_STEP`:
+    one step after an accepted step at a tight tolerance, a few at a loose one (one step left
+    3e-3 at ``rtol = 1e-2``); ``psi_nu`` is
+    re-synchronised with the axis azimuth (see :mod:`rollingtop.contact.meridian`). The
+    velocity ``u`` then goes to the nearest point, in the kinetic-energy metric, of ``J u = 0``:
+    ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
     """
-    # Q Q^T (rows alpha, beta, gamma at offsets 6, 9, 12)
-    G00 = y[6] * y[6] + y[7] * y[7] + y[8] * y[8]
-    G11 = y[9] * y[9] + y[10] * y[10] + y[11] * y[11]
-    G22 = y[12] * y[12] + y[13] * y[13] + y[14] * y[14]
-    G01 = y[6] * y[9] + y[7] * y[10] + y[8] * y[11]
-    G02 = y[6] * y[12] + y[7] * y[13] + y[8] * y[14]
-    G12 = y[9] * y[12] + y[10] * y[13] + y[11] * y[14]
-    for c in range(3):
-        a, b, g = y[6 + c], y[9 + c], y[12 + c]
-        y[6 + c] = 1.5 * a - 0.5 * (G00 * a + G01 * b + G02 * g)
-        y[9 + c] = 1.5 * b - 0.5 * (G01 * a + G11 * b + G12 * g)
-        y[12 + c] = 1.5 * g - 0.5 * (G02 * a + G12 * b + G22 * g)
+    for _ in range(FRAME_ITERATIONS):
+        # Q Q^T (rows alpha, beta, gamma at offsets 6, 9, 12)
+        G00 = y[6] * y[6] + y[7] * y[7] + y[8] * y[8]
+        G11 = y[9] * y[9] + y[10] * y[10] + y[11] * y[11]
+        G22 = y[12] * y[12] + y[13] * y[13] + y[14] * y[14]
+        G01 = y[6] * y[9] + y[7] * y[10] + y[8] * y[11]
+        G02 = y[6] * y[12] + y[7] * y[13] + y[8] * y[14]
+        G12 = y[9] * y[12] + y[10] * y[13] + y[11] * y[14]
+        for c in range(3):
+            a, b, g = y[6 + c], y[9 + c], y[12 + c]
+            y[6 + c] = 1.5 * a - 0.5 * (G00 * a + G01 * b + G02 * g)
+            y[9 + c] = 1.5 * b - 0.5 * (G01 * a + G11 * b + G12 * g)
+            y[12 + c] = 1.5 * g - 0.5 * (G02 * a + G12 * b + G22 * g)
+        error = max(abs(G00 - 1.0), abs(G11 - 1.0), abs(G22 - 1.0), abs(G01), abs(G02), abs(G12))
+        if error <= FRAME_ONE_STEP:  # the step left about error^2: round-off
+            break
     _dispatch.sync_direction(code, y)
     if CLOSED_PROJECTION:
         _dispatch.project_velocity(code, p, y)

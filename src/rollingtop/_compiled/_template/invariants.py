@@ -21,10 +21,25 @@ constraint residuals and the linear integrals' deviations from their initial val
 ``M^-1 sum_k beta_k q_k``. The energy (and ``slip_nu``) is corrected along the direction of its
 gradient orthogonal to those rows, so the linear integrals and the constraints are not touched:
 along ``d = M^-1 g_perp`` the energy is ``E + q (l + l^2 / 2)`` with ``q = (g_perp, M^-1
-g_perp)``, and ``l`` solves that quadratic exactly. Where no such direction exists -- at a
-turning point of ``gamma3`` of an integrable model, where the other integrals fix every velocity
-component but ``w_tau = 0`` -- the energy is left for the next steps (counted in
-``counts[PROJ_DEFERRED]`` of the stepper); its error there is one step's.
+g_perp)``, and ``l`` solves that quadratic exactly. Each pass re-solves the linear part first,
+so round-off that an energy step leaks into the other rows is taken back.
+
+**The attitude, where the velocity cannot.** Near a turning point of ``gamma3`` (the other
+integrals fix every velocity component but ``w_tau``, which is small there), the energy has no
+root along the velocity direction, or only one far away (``w_tau`` scaled many times over). The
+energy is then corrected by tilting the body about ``gamma x e3`` (the axis that changes
+``gamma3``) by the angle ``phi`` that zeroes ``E(P(tilt(y, phi))) - E0``, ``P`` the linear
+part: a secant step on a central difference. Of the two, the smaller relative change is taken
+(``|l| sqrt(q) / |u|_M`` against ``|phi|``), so the correction never depends on how accurate
+the step was. Only where neither exists (a steady motion whose level is one point, the pole
+itself for the tilt) is the energy left for the next steps (``counts[PROJ_DEFERRED]`` of the
+stepper).
+
+**Round-off is not corrected.** A row's residual (after the earlier rows are taken out) below
+the round-off of its integral's value, ``ROUNDOFF * sqrt(q_k) |u|_M`` (the integral's natural
+size at this velocity), is set to zero: the row still keeps the correction off its direction,
+but a nearly dependent row (the integrals near the vertical, where Jellett's and the area
+integral tend to Lagrange's) no longer turns round-off into a velocity change.
 
 ``F6`` carries ``-M3 a3 theta``, with the signed ``theta`` of the carried direction: its value
 jumps by ``2 pi M3 a3`` where ``atan2`` wraps (a passage of the north pole in a pole case), so
@@ -44,15 +59,29 @@ __all__ = ["project_integrals"]
 
 #: A row whose part orthogonal to the earlier rows is below this fraction of its size (in the
 #: dual metric) is dependent on them: dropped.
-DEPENDENT = 1e-9
-#: A correction of the velocity beyond this fraction of its size is not a round-off correction:
-#: the energy is then left for the next steps (near a turning point).
-MAX_CHANGE = 1e-6
-#: Newton iterations of the nonlinear integrals (the energy is solved exactly in the first).
-NEWTON_ITERATIONS = 4
-#: Rows of the work array ``pw`` (:func:`project_integrals`): orthonormal rows, their
-#: right-hand sides, a gradient and the correction.
+DEPENDENT = 1e-4
+#: A residual below this many units of round-off of its integral's natural size is round-off:
+#: not corrected (module docstring).
+ROUNDOFF = 16.0 * 2.220446049250313e-16
+#: A velocity correction beyond this fraction of the velocity's size is refused (the attitude is
+#: used, or the integral left for later).
+MAX_CHANGE = 0.5
+#: A velocity correction below this relative size is taken without trying the attitude.
+SMALL_CHANGE = 1e-8
+#: Passes (each: the linear part, then one step per nonlinear integral).
+NEWTON_ITERATIONS = 8
+#: After the last pass, a nonlinear residual within this many :data:`ROUNDOFF` s is on the level.
+SETTLED = 4.0
+#: Step of the central difference in the tilt angle (radians).
+TILT_STEP = 1e-5
+#: Below this ``|gamma x e3|`` (the pole) there is no tilt axis.
+MIN_TILT_SINE = 1e-6
+#: Rows of the work array ``pw`` (:func:`project_integrals`) before the two states of the tilt:
+#: orthonormal rows (columns 0-5) with their right-hand sides (column 6), a gradient, and the
+#: metric with the deferral flag.
 WORK_ROWS = 16
+#: Shape of ``pw``: :data:`WORK_ROWS` and two full states (the tilt's source and trial).
+WORK_SHAPE = (WORK_ROWS + 2, 18)
 
 
 @kernel
@@ -78,7 +107,26 @@ def _orthogonalise(pw: FloatArray, n_rows: int, row: int, minv: FloatArray) -> f
 
 
 @kernel
-def project_integrals(
+def _velocity_size(y: FloatArray, minv: FloatArray) -> float:
+    """``|u|_M``, the velocity's size in the kinetic-energy metric."""
+    usize = 0.0
+    for k in range(6):
+        usize += y[k] * y[k] / minv[k]
+    return math.sqrt(usize)
+
+
+@kernel
+def _natural(ic: int, p: FloatArray, usize: float, minv: FloatArray) -> float:
+    """The natural size of the nonlinear integral ``ic`` at the velocity size ``usize``: the
+    energy's, the kinetic energy and the potential's range ``m g (R + |a3|)``; ``slip_nu``'s, a
+    speed, ``|u|_M / sqrt(m)``."""
+    if ic == ENERGY:
+        return 0.5 * usize * usize + p[1] * p[2] * (p[0] + abs(p[3]))
+    return usize * math.sqrt(minv[0])
+
+
+@kernel
+def _linear(
     code: int,
     p: FloatArray,
     y: FloatArray,
@@ -86,22 +134,15 @@ def project_integrals(
     targets: FloatArray,
     pw: FloatArray,
     ws: Workspace,
+    minv: FloatArray,
 ) -> int:
-    """Move the velocity of ``y`` (in place) onto the level set ``I_k(y) = targets[k]`` of the
-    integrals ``icodes`` and the velocity constraints, in the kinetic-energy metric (module
-    docstring). ``pw`` is a work array of shape ``(WORK_ROWS, 8)``.
-
-    Returns the number of passes made (>= 1: the linear part, solved exactly, then each pass
-    that moved a nonlinear integral), or ``-1`` when the corrected state is not finite;
-    ``pw[WORK_ROWS - 1, 7]`` is 1 when a nonlinear integral was left for the next steps.
-    """
+    """The constraints and the linear integrals: one exact minimum-norm correction of the
+    velocity of ``y`` (in place); the orthonormal rows stay in ``pw[0:n_rows]``. Returns
+    ``n_rows``."""
     J, bias, dirs = ws[0], ws[1], ws[2]
-    m, I1, I2, I3, a3 = p[1], p[4], p[5], p[6], p[3]
-    minv = pw[WORK_ROWS - 1, 0:6]
-    minv[0] = minv[1] = minv[2] = 1.0 / m
-    minv[3], minv[4], minv[5] = 1.0 / I1, 1.0 / I2, 1.0 / I3
+    a3, I3 = p[3], p[6]
     n_int = icodes.shape[0]
-    # ---- the constraints and the linear integrals: one exact minimum-norm correction ----------
+    usize = _velocity_size(y, minv)
     nc = constraint_rows(code, p, y, J, bias, dirs)
     n_rows = 0
     for i in range(nc + n_int):
@@ -122,8 +163,14 @@ def project_integrals(
                 period = 2.0 * math.pi * abs(a3 * I3 * y[5])
                 if period > 0.0:
                     res -= period * math.floor(res / period + 0.5)
+        natural = 0.0  # the row's integral at most, at this velocity (Cauchy-Schwarz)
+        for k in range(6):
+            natural += pw[n_rows, k] * pw[n_rows, k] * minv[k]
+        natural = math.sqrt(natural) * usize
         pw[n_rows, 6] = -res
         if _orthogonalise(pw, n_rows, n_rows, minv) > DEPENDENT * DEPENDENT:
+            if abs(pw[n_rows, 6]) <= ROUNDOFF * natural:
+                pw[n_rows, 6] = 0.0  # round-off: kept as a row, not corrected
             size = 0.0
             for k in range(6):
                 size += pw[n_rows, k] * pw[n_rows, k] * minv[k]
@@ -136,50 +183,165 @@ def project_integrals(
         for j in range(n_rows):
             s += pw[j, 6] * pw[j, k]
         y[k] += minv[k] * s
-    # ---- the nonlinear integrals (energy, slip_nu), along directions the rows leave free ---
+    return n_rows
+
+
+@kernel
+def _tilt(y: FloatArray, src: FloatArray, phi: float) -> bool:
+    """``y`` = ``src`` with the body tilted by ``phi`` about ``gamma x e3`` (the fixed axes
+    ``alpha, beta, gamma`` seen in the body frame turned by ``-phi``, exactly: Rodrigues);
+    ``False`` at the pole, where there is no such axis."""
+    for k in range(18):
+        y[k] = src[k]
+    ax, ay = src[13], -src[12]  # gamma x e3 = (gamma2, -gamma1, 0)
+    s = math.hypot(ax, ay)
+    if s < MIN_TILT_SINE:
+        return False
+    ax /= s
+    ay /= s
+    c, sn = math.cos(phi), math.sin(phi)
+    for base in (6, 9, 12):
+        x0, x1, x2 = src[base], src[base + 1], src[base + 2]
+        dot = ax * x0 + ay * x1
+        # rotation by -phi about a = (ax, ay, 0): x c - (a x x) sn + a (a.x)(1 - c)
+        cx0, cx1, cx2 = ay * x2, -ax * x2, ax * x1 - ay * x0
+        y[base] = x0 * c - cx0 * sn + ax * dot * (1.0 - c)
+        y[base + 1] = x1 * c - cx1 * sn + ay * dot * (1.0 - c)
+        y[base + 2] = x2 * c - cx2 * sn
+    return True
+
+
+@kernel
+def _tilted_energy(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    src: FloatArray,
+    phi: float,
+    ic: int,
+    icodes: IntArray,
+    targets: FloatArray,
+    pw: FloatArray,
+    ws: Workspace,
+    minv: FloatArray,
+) -> float:
+    """The integral ``ic`` after the tilt by ``phi`` and the linear part (into ``y``)."""
+    _tilt(y, src, phi)
+    _linear(code, p, y, icodes, targets, pw, ws, minv)
+    return integral_value(ic, p, y)
+
+
+@kernel
+def project_integrals(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    icodes: IntArray,
+    targets: FloatArray,
+    pw: FloatArray,
+    ws: Workspace,
+) -> int:
+    """Move the state ``y`` (in place) onto the level set ``I_k(y) = targets[k]`` of the
+    integrals ``icodes`` and the velocity constraints, in the kinetic-energy metric (module
+    docstring). ``pw`` is a work array of shape :data:`WORK_SHAPE`.
+
+    Returns the number of passes made (>= 1: each solves the linear part exactly, then steps
+    each nonlinear integral), or ``-1`` when the corrected state is not finite;
+    ``pw[WORK_ROWS - 1, 7]`` is 1 when a nonlinear integral was left for the next steps.
+    """
+    minv = pw[WORK_ROWS - 1, 0:6]
+    minv[0] = minv[1] = minv[2] = 1.0 / p[1]
+    minv[3], minv[4], minv[5] = 1.0 / p[4], 1.0 / p[5], 1.0 / p[6]
+    n_int = icodes.shape[0]
     grad = pw[WORK_ROWS - 2]
-    passes = 1
-    pw[WORK_ROWS - 1, 7] = 0.0
+    passes = 0
+    left = moved = False
     for _ in range(NEWTON_ITERATIONS):
+        n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
+        passes += 1
         moved = False
+        left = False
         for i in range(n_int):
             ic = icodes[i]
             if LINEAR[ic]:
                 continue
+            usize = _velocity_size(y, minv)
             res = integral_value(ic, p, y) - targets[i]
-            scale = abs(targets[i]) + 1e-300
-            if abs(res) <= 4e-16 * scale:
+            if abs(res) <= ROUNDOFF * _natural(ic, p, usize, minv):
                 continue
+            # the velocity step, along the gradient orthogonal to the rows
             velocity_gradient(ic, p, y, grad)
             for k in range(6):
                 pw[n_rows, k] = grad[k]
             pw[n_rows, 6] = 0.0
-            if _orthogonalise(pw, n_rows, n_rows, minv) <= DEPENDENT * DEPENDENT:
-                pw[WORK_ROWS - 1, 7] = 1.0
-                continue
-            q = 0.0
-            usize = 0.0
-            for k in range(6):
-                q += pw[n_rows, k] * pw[n_rows, k] * minv[k]
-                usize += y[k] * y[k] / minv[k]
-            if ic == ENERGY:  # the energy, quadratic along d: E + q (l + l^2 / 2) = target
-                disc = 1.0 - 2.0 * res / q
-                if not disc >= 0.0:
-                    pw[WORK_ROWS - 1, 7] = 1.0
+            lam, change = 0.0, math.inf
+            if _orthogonalise(pw, n_rows, n_rows, minv) > DEPENDENT * DEPENDENT:
+                q = 0.0
+                for k in range(6):
+                    q += pw[n_rows, k] * pw[n_rows, k] * minv[k]
+                if ic == ENERGY:  # quadratic along d: E + q (l + l^2 / 2) = target
+                    disc = 1.0 - 2.0 * res / q
+                    if disc >= 0.0:
+                        lam = -2.0 * res / q / (1.0 + math.sqrt(disc))
+                        change = abs(lam) * math.sqrt(q) / max(usize, 1e-300)
+                else:  # Newton
+                    lam = -res / q
+                    change = abs(lam) * math.sqrt(q) / max(usize, 1e-300)
+            phi, tilt = 0.0, math.inf
+            if ic == ENERGY and not change <= SMALL_CHANGE:
+                # the attitude: a secant step on the energy after a tilt (module docstring)
+                src, trial = pw[WORK_ROWS], pw[WORK_ROWS + 1]
+                for k in range(18):
+                    src[k] = y[k]
+                if _tilt(trial, src, 0.0) and _tilt(trial, src, TILT_STEP):
+                    up = _tilted_energy(code, p, trial, src, TILT_STEP, ic, icodes, targets, pw,
+                                        ws, minv)  # fmt: skip
+                    down = _tilted_energy(code, p, trial, src, -TILT_STEP, ic, icodes, targets,
+                                          pw, ws, minv)  # fmt: skip
+                    slope = (up - down) / (2.0 * TILT_STEP)
+                    if slope != 0.0 and math.isfinite(slope):
+                        phi = -res / slope
+                        tilt = abs(phi)
+                # pw's rows were used by the trials: the rows of y again
+                n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
+                if tilt < change and tilt <= MAX_CHANGE:
+                    _tilt(trial, src, phi)
+                    for k in range(18):
+                        y[k] = trial[k]
+                    moved = True
                     continue
-                lam = -2.0 * res / q / (1.0 + math.sqrt(disc))
-            else:  # Newton
-                lam = -res / q
-            if lam * lam * q > MAX_CHANGE * MAX_CHANGE * usize:
-                pw[WORK_ROWS - 1, 7] = 1.0
-                continue
-            for k in range(6):
-                y[k] += lam * minv[k] * pw[n_rows, k]
-            moved = True
+                velocity_gradient(ic, p, y, grad)
+                for k in range(6):
+                    pw[n_rows, k] = grad[k]
+                pw[n_rows, 6] = 0.0
+                _orthogonalise(pw, n_rows, n_rows, minv)
+            if change <= MAX_CHANGE:
+                for k in range(6):
+                    y[k] += lam * minv[k] * pw[n_rows, k]
+                moved = True
+                if n_rows < WORK_ROWS - 3:  # a row: the next integral's step leaves it alone
+                    size = 0.0
+                    for k in range(6):
+                        size += pw[n_rows, k] * pw[n_rows, k] * minv[k]
+                    size = math.sqrt(size)
+                    for k in range(6):
+                        pw[n_rows, k] /= size
+                    n_rows += 1
+            else:
+                left = True
         if not moved:
             break
-        passes += 1
-    for k in range(6):
+    if moved:  # not settled in NEWTON_ITERATIONS passes: the linear part of the last state,
+        _linear(code, p, y, icodes, targets, pw, ws, minv)  # then is it on the level?
+        usize = _velocity_size(y, minv)
+        for i in range(n_int):
+            ic = icodes[i]
+            if not LINEAR[ic]:
+                res = integral_value(ic, p, y) - targets[i]
+                if abs(res) > SETTLED * ROUNDOFF * _natural(ic, p, usize, minv):
+                    left = True
+    pw[WORK_ROWS - 1, 7] = 1.0 if left else 0.0
+    for k in range(18):
         if not math.isfinite(y[k]):
             return -1
     return passes

@@ -226,7 +226,7 @@ def run(
     K, ynew, ytmp, y_old, Fd, ws
         Work arrays: stages ``(16, 18)``, three states, dense-output coefficients ``(7, 18)`` and
         the kernel workspace.
-    icodes, targets, pw : ndarrays, shapes (k,), (k,), (WORK_ROWS, 8)
+    icodes, targets, pw : ndarrays, shapes (k,), (k,), ``invariants.WORK_SHAPE``
         The integrals held by projection after every accepted step (codes of
         :mod:`rollingtop._compiled._integrals`; ``k = 0``: none), their values, and the
         projection's work array (:func:`.invariants.project_integrals`).
@@ -329,6 +329,8 @@ def run(
                     if project_integrals(code, p, out[k], icodes, targets, pw, ws) < 0:
                         ctrl[T] = t_new
                         return PROJECTION_FAILED
+                    if pw[WORK_ROWS - 1, 7] > 0.0:  # a sample off the level is counted too
+                        counts[PROJ_DEFERRED] += 1
                 k += 1
             counts[NEXT_SAMPLE] = k
         # Accept: project onto the constraints. The derivative at the new point is the last
