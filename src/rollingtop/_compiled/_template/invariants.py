@@ -121,8 +121,8 @@ def _natural(ic: int, p: FloatArray, usize: float, minv: FloatArray) -> float:
     energy's, the kinetic energy and the potential's range ``m g (R + |a3|)``; ``slip_nu``'s, a
     speed, ``|u|_M / sqrt(m)``."""
     if ic == ENERGY:
-        return 0.5 * usize * usize + p[1] * p[2] * (p[0] + abs(p[3]))
-    return usize * math.sqrt(minv[0])
+        return float(0.5 * usize * usize + p[1] * p[2] * (p[0] + abs(p[3])))
+    return float(usize * math.sqrt(minv[0]))
 
 
 @kernel
