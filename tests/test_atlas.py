@@ -394,7 +394,7 @@ def test_a_cell_the_analysis_cannot_classify_is_marked_whatever_the_axis_order()
 
 @pytest.mark.parametrize(
     "damage",
-    ["truncated", "garbage", "foreign keys", "wrong length", "unknown index"],
+    ["truncated", "garbage", "foreign keys", "wrong length", "unknown index", "copied over"],
 )
 def test_a_damaged_or_foreign_chunk_is_recomputed_with_one_warning(client, tmp_path, damage):
     """Issue 27: a chunk file of the .partial folder that does not load, or does not hold what
@@ -419,9 +419,12 @@ def test_a_damaged_or_foreign_chunk_is_recomputed_with_one_warning(client, tmp_p
         victim.write_bytes(b"\x00not a zip file" * 10)
     elif damage == "foreign keys":
         np.savez(victim, x=np.zeros(5))
-    elif damage == "wrong length":
+    elif damage == "wrong length":  # its identity intact, its cells cut
         with np.load(victim) as z:
-            np.savez(victim, **{k: z[k][:2] for k in z.files})
+            np.savez(victim, **{k: z[k] if k.startswith("chunk_") else z[k][:2] for k in z.files})
+    elif damage == "copied over":  # issue 36 row 4: a whole chunk file under another's name
+        victim = sorted(folder.glob("chunk-*.npz"))[1]
+        victim.write_bytes(sorted(folder.glob("chunk-*.npz"))[0].read_bytes())
     else:  # a chunk index beyond the spec's chunks
         victim.rename(folder / "chunk-999999.npz")
     with pytest.warns(

@@ -203,8 +203,8 @@ def atlas(
     starts = list(range(0, spec.size, chunk))
     digest = spec.digest(chunk)
     folder = None if out_path is None else _partial_folder(out_path)
-    sizes = {k: min(chunk, spec.size - start) for k, start in enumerate(starts)}
-    done = {} if folder is None else _load_partial(folder, digest, sizes)
+    ranges = {k: (start, min(start + chunk, spec.size)) for k, start in enumerate(starts)}
+    done = {} if folder is None else _load_partial(folder, digest, ranges)
     created = False
     if folder is not None and not folder.exists():
         folder.mkdir()
@@ -250,16 +250,31 @@ def _compute(
                                 cells[starts[k] : starts[k] + chunk], pure=False): k
                        for k in todo}  # fmt: skip
             try:
-                _collect(futures, done, folder, spec.size, finished, progress)
+                save = None if folder is None else functools.partial(_save, folder, spec, starts,
+                                                                     chunk)  # fmt: skip
+                _collect(futures, done, save, spec.size, finished, progress)
             except BaseException:
                 c.cancel(list(futures))  # stop what is still queued before the cluster goes
                 raise
 
 
+def _save(
+    folder: Path,
+    spec: AtlasSpec,
+    starts: list[int],
+    chunk: int,
+    k: int,
+    result: dict[str, np.ndarray],
+) -> None:
+    """Save chunk ``k`` with its identity: its index, its cells and the spec's digest."""
+    cells_k = (starts[k], min(starts[k] + chunk, spec.size))
+    _save_chunk(folder, k, cells_k, spec.digest(chunk), result)
+
+
 def _collect(
     futures: dict[Any, int],
     done: dict[int, dict[str, np.ndarray]],
-    folder: Path | None,
+    save: Callable[[int, dict[str, np.ndarray]], None] | None,
     total: int,
     finished: int,
     progress: Callable[[int, int], None] | None,
@@ -279,8 +294,8 @@ def _collect(
                              f"{str(exc).splitlines()[0] if str(exc) else ''}); the chunks "
                              "finished so far are kept: run again to resume") from None  # fmt: skip
         done[k] = result
-        if folder is not None:
-            _save_chunk(folder, k, result)
+        if save is not None:
+            save(k, result)
         finished += len(result["status"])
         if progress is not None:
             progress(finished, total)

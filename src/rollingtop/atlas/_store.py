@@ -63,12 +63,28 @@ def _chunk_fits(part: Mapping[str, np.ndarray], n: int) -> bool:
                         for k in CENTRE_FIELDS)  # fmt: skip
 
 
+#: The variables of a saved chunk that say which chunk it is: ``[index, first cell, end]``
+#: and the digest of the spec (and chunk size) it was computed for.
+IDENTITY, DIGEST = "chunk_identity", "chunk_digest"
+
+
+def _chunk_is(part: dict[str, np.ndarray], k: int, cells: tuple[int, int], digest: str) -> bool:
+    """Whether a loaded chunk says it is chunk ``k`` of cells ``cells`` of the spec of
+    ``digest`` (the two identity variables are removed from ``part``)."""
+    identity, saved = part.pop(IDENTITY, None), part.pop(DIGEST, None)
+    if identity is None or saved is None or identity.shape != (3,) or saved.shape != ():
+        return False
+    return [int(x) for x in identity] == [k, *cells] and str(saved) == digest
+
+
 def _load_partial(
-    folder: Path, digest: str, sizes: Mapping[int, int]
+    folder: Path, digest: str, ranges: Mapping[int, tuple[int, int]]
 ) -> dict[int, dict[str, np.ndarray]]:
-    """Chunks saved by an earlier run of the same spec (``{}`` if none); ``sizes``: the cells of
-    each chunk. A file that does not load, or does not hold what its chunk should, is removed
-    and its chunk computed again, with one :class:`AtlasResumeWarning`."""
+    """Chunks saved by an earlier run of the same spec (``{}`` if none); ``ranges``: the cells
+    ``[start, end)`` of each chunk. A file that does not load, that is not the chunk its name
+    says (its index, cells and spec digest: a file copied over another), or that does not hold
+    what its chunk should, is removed and its chunk computed again, with one
+    :class:`AtlasResumeWarning`."""
     if not folder.exists():
         return {}
     try:
@@ -88,7 +104,8 @@ def _load_partial(
             k = int(f.stem.split("-")[1])
             with np.load(f, allow_pickle=False) as z:
                 part = {key: z[key] for key in z.files}
-        if part is None or k not in sizes or not _chunk_fits(part, sizes[k]):
+        if (part is None or k not in ranges or not _chunk_is(part, k, ranges[k], digest)
+                or not _chunk_fits(part, ranges[k][1] - ranges[k][0])):  # fmt: skip
             bad.append(f.name)
             with contextlib.suppress(OSError):
                 f.unlink()
@@ -101,9 +118,13 @@ def _load_partial(
     return done
 
 
-def _save_chunk(folder: Path, k: int, result: Mapping[str, np.ndarray]) -> None:
+def _save_chunk(
+    folder: Path, k: int, cells: tuple[int, int], digest: str, result: Mapping[str, np.ndarray]
+) -> None:
+    """Save chunk ``k`` (cells ``[start, end)`` of the spec of ``digest``) with its identity."""
     buf = io.BytesIO()
-    np.savez(buf, **result)  # type: ignore[arg-type]
+    identity = {IDENTITY: np.array([k, *cells], dtype=np.int64), DIGEST: np.array(digest)}
+    np.savez(buf, **result, **identity)  # type: ignore[arg-type]
     # now: a chunk is kept for a resumed run even when this one fails
     write_bytes_atomic(folder / f"chunk-{k:06d}.npz", buf.getvalue(), now=True)
 
