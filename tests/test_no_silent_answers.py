@@ -1,6 +1,7 @@
 """Regression tests of the defects of issue 36, each in a real process where the defect showed:
 a valid run is never refused, a refusal leaves no file, a printed number was achieved."""
 
+import contextlib
 import json
 import os
 import subprocess
@@ -16,9 +17,14 @@ from .conftest import EXAMPLES
 
 def rollingtop(*args, cwd=None):
     """``python -m rollingtop ARGS`` in a real process: ``(status, stdout, stderr)``."""
-    proc = subprocess.run([sys.executable, "-m", "rollingtop", *map(str, args)],
-                          capture_output=True, text=True, check=False, cwd=cwd,
-                          env=os.environ | {"COLUMNS": "120"})  # fmt: skip
+    proc = subprocess.run(
+        [sys.executable, "-m", "rollingtop", *map(str, args)],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=cwd,
+        env=os.environ | {"COLUMNS": "120"},
+    )
     return proc.returncode, proc.stdout, proc.stderr
 
 
@@ -50,8 +56,11 @@ def test_held_back_files_appear_only_on_success(tmp_path):
 def test_rough_pole_level_runs_and_writes(tmp_path, suffix):
     """Issue 36 row 1: ``omega = (1, 0, 0)`` puts the rough model on a pole level (jellett =
     routh = 0); the run needs no reduction, exits 0 and writes its file."""
-    text = (EXAMPLES / "rough.toml").read_text().replace(
-        "omega = [0.7, -0.3, 2.0]", "omega = [1.0, 0.0, 0.0]")  # fmt: skip
+    text = (
+        (EXAMPLES / "rough.toml")
+        .read_text()
+        .replace("omega = [0.7, -0.3, 2.0]", "omega = [1.0, 0.0, 0.0]")
+    )
     path = scenario(tmp_path, "rw.toml", text)
     out = [] if suffix is None else ["-o", tmp_path / f"rw{suffix}"]
     code, stdout, err = rollingtop("simulate", path, "--t-end", "1", "--json", *out)
@@ -65,13 +74,18 @@ def test_rough_pole_level_runs_and_writes(tmp_path, suffix):
 
 @pytest.mark.parametrize(
     ("model", "initial"),
-    [("rough", 'gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\n'),
-     ("meridian", 'gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\nv_tau = 0.0\n')],
-)  # fmt: skip
+    [
+        ("rough", "gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\n"),
+        ("meridian", "gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\nv_tau = 0.0\n"),
+    ],
+)
 def test_sleeping_top_simulates(tmp_path, model, initial):
     """The sleeping top stays asleep: exit 0 and omega3 exact."""
-    path = scenario(tmp_path, "s.toml", f'{BODY}[contact]\nmodel = "{model}"\n[initial]\n'
-                    f"{initial}[integration]\nt_end = 3.0\n")  # fmt: skip
+    path = scenario(
+        tmp_path,
+        "s.toml",
+        f'{BODY}[contact]\nmodel = "{model}"\n[initial]\n{initial}[integration]\nt_end = 3.0\n',
+    )
     code, stdout, err = rollingtop("simulate", path, "--json")
     assert code == 0, err
     final = json.loads(stdout)["final"]
@@ -113,7 +127,9 @@ def plain_energy(final, body):
     v, w, gamma = final["v"], final["omega"], final["gamma"]
     m, g, R, a3 = (body[k] for k in ("m", "g", "R", "a3"))
     inertia = (body["I1"], body.get("I2", body["I1"]), body["I3"])
-    kinetic = 0.5 * m * sum(x * x for x in v) + 0.5 * sum(i * x * x for i, x in zip(inertia, w))
+    kinetic = 0.5 * m * sum(x * x for x in v) + 0.5 * sum(
+        i * x * x for i, x in zip(inertia, w, strict=True)
+    )
     return kinetic + m * g * (R + a3 * gamma[2])
 
 
@@ -131,8 +147,18 @@ def test_projection_holds_at_every_tolerance(example, tol):
     """Issue 36 row 2: at rtol = atol = 1e-2 the energy drifted by 4e-2 with exit 0; now every
     claimed integral stays at round-off, nothing is deferred, and the final energy computed
     here from the final state equals the initial one."""
-    code, out, err = rollingtop("simulate", EXAMPLES / f"{example}.toml", "--project-integrals",
-                                "--json", "--rtol", tol, "--atol", tol, "--t-end", "20")  # fmt: skip
+    code, out, err = rollingtop(
+        "simulate",
+        EXAMPLES / f"{example}.toml",
+        "--project-integrals",
+        "--json",
+        "--rtol",
+        tol,
+        "--atol",
+        tol,
+        "--t-end",
+        "20",
+    )
     assert code == 0, err
     summary = json.loads(out)
     assert summary["projection"]["held"] is True
@@ -150,8 +176,10 @@ def test_projection_at_the_pole_is_never_worse(tmp_path):
     made every integral worse (5e-10 against 9e-12 without) and moved omega3 off its exact
     value; now each linear integral is at round-off and omega3 (Lagrange's) stays exact to a
     few units of round-off."""
-    text = (f'{BODY}[contact]\nmodel = "meridian"\n[initial]\ngamma = [0.0, 0.0, -1.0]\n'
-            "omega = [0.0, 0.0, 2.0]\nv_tau = 0.3\n[integration]\nt_end = 20.0\n")  # fmt: skip
+    text = (
+        f'{BODY}[contact]\nmodel = "meridian"\n[initial]\ngamma = [0.0, 0.0, -1.0]\n'
+        "omega = [0.0, 0.0, 2.0]\nv_tau = 0.3\n[integration]\nt_end = 20.0\n"
+    )
     path = scenario(tmp_path, "pole.toml", text)
     runs = {}
     for flag in ([], ["--project-integrals"]):
@@ -174,11 +202,77 @@ def test_a_run_not_held_says_so_and_keeps_its_file(tmp_path, capsys, monkeypatch
     monkeypatch.setattr(trajectory, "HELD_TOLERANCE", 0.0)  # no run holds to exactly zero
     out = tmp_path / "run.nc"
     with pytest.raises(SystemExit) as exc:
-        main(["simulate", str(EXAMPLES / "paper.toml"), "--t-end", "1", "--project-integrals",
-              "--json", "-o", str(out)])  # fmt: skip
+        main(
+            [
+                "simulate",
+                str(EXAMPLES / "paper.toml"),
+                "--t-end",
+                "1",
+                "--project-integrals",
+                "--json",
+                "-o",
+                str(out),
+            ]
+        )
     stdout, stderr = capsys.readouterr()
     assert exc.value.code == 1
     verdict = json.loads(stdout)["projection"]
     assert verdict["held"] is False and verdict["tolerance"] == 0.0
     assert stderr.startswith(f"rollingtop: error: the projection did not hold {verdict['worst']}")
     assert stderr.count("\n") == 1 and out.stat().st_size > 0
+
+
+# ---- rows 4-7: the atlas ------------------------------------------------------------------
+ATLAS_STATE = (
+    '[contact]\nmodel = "meridian"\n[initial]\ngamma = [0.0, 0.6, 0.8]\n'
+    "omega = [0.7, -0.3, 2.0]\nv_tau = 0.25\n"
+)
+
+
+def atlas_statuses(path):
+    import xarray as xr
+
+    with xr.open_dataset(path) as ds:
+        return ds["status"].values.tolist(), ds["n_steady"].values.tolist()
+
+
+def test_atlas_inadmissible_body_is_one_cells_status(tmp_path):
+    """Issue 36 row 5: a model-axis atlas whose first R (0.05 < a3 = 0.1) makes an
+    inadmissible body exited 2 as a whole; now that cell has status 1 and the others are
+    classified."""
+    spec = scenario(
+        tmp_path,
+        "a.toml",
+        f'{BODY}{ATLAS_STATE}[axes]\nmodel = ["meridian", "smooth"]\nR = [0.05, 1.0]\n',
+    )
+    code, out, err = rollingtop("atlas", spec, "-o", tmp_path / "a.nc", "--workers", "1", "--json")
+    assert code == 0, err
+    status, steady = atlas_statuses(tmp_path / "a.nc")
+    assert status == [[1, 0], [1, 0]]
+    assert steady[0][1] >= 1 and steady[1][1] >= 1
+
+
+def test_atlas_beyond_doubles_and_a_taken_port_print_nothing(tmp_path):
+    """Issue 36 rows 6-7: ``I1 = 1e300`` printed numpy's raw RuntimeWarning lines, and a
+    listener on Dask's default port 8787 three lines of Dask's; now stderr is empty and the
+    huge body's cells have a status of their own."""
+    import socket
+
+    spec = scenario(
+        tmp_path,
+        "a.toml",
+        f'{BODY}{ATLAS_STATE}[axes]\nmodel = ["meridian", "smooth"]\nI1 = [1e300, 0.3]\n',
+    )
+    listener = socket.socket()
+    try:
+        with contextlib.suppress(OSError):  # taken already: the same condition
+            listener.bind(("127.0.0.1", 8787))
+            listener.listen()
+        code, out, err = rollingtop(
+            "atlas", spec, "-o", tmp_path / "a.nc", "--workers", "1", "--json"
+        )
+    finally:
+        listener.close()
+    assert code == 0 and err == ""
+    status, _ = atlas_statuses(tmp_path / "a.nc")
+    assert status[0][1] == status[1][1] == 0 and status[0][0] != 0 and status[1][0] != 0

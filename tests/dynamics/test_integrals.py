@@ -131,14 +131,22 @@ def test_natural_scales_by_hand(paper_body):
     sizes = natural_scales(paper_body, Y, ("energy", "lagrange", "jellett", "area"))
     kinetic = [0.5 * 0.14 + 0.5 * (0.3 * 0.25 + 0.5 * 1.0), 0.5 * (0.3 * 0.05 + 0.5 * 4.0)]
     potential = [1.0 + 0.1 * 0.8, 1.0 - 0.1 * 0.8]
-    assert sizes["energy"] == pytest.approx(max(map(sum, zip(kinetic, potential))), rel=1e-15)
+    assert sizes["energy"] == pytest.approx(
+        max(map(sum, zip(kinetic, potential, strict=True))), rel=1e-15
+    )
     assert sizes["lagrange"] == pytest.approx(0.5 * 2.0, rel=1e-15)
     # jellett = (I w, r), r = -R gamma - a3 e3: terms I_i w_i r_i
     r = [(0.0, -0.6, -0.9), (-0.6, 0.0, 0.7)]
     w = [(0.5, 0.0, -1.0), (0.2, 0.1, 2.0)]
     inertia = (0.3, 0.3, 0.5)
-    jellett = [sum(abs(i * a * b) for i, a, b in zip(inertia, wk, rk)) for wk, rk in zip(w, r)]
+    jellett = [
+        sum(abs(i * a * b) for i, a, b in zip(inertia, wk, rk, strict=True))
+        for wk, rk in zip(w, r, strict=True)
+    ]
     assert sizes["jellett"] == pytest.approx(max(jellett), rel=1e-15)
     gammas = [(0.0, 0.6, 0.8), (0.6, 0.0, -0.8)]
-    area = [sum(abs(i * a * b) for i, a, b in zip(inertia, wk, gk)) for wk, gk in zip(w, gammas)]
+    area = [
+        sum(abs(i * a * b) for i, a, b in zip(inertia, wk, gk, strict=True))
+        for wk, gk in zip(w, gammas, strict=True)
+    ]
     assert sizes["area"] == pytest.approx(max(area), rel=1e-15)

@@ -68,8 +68,9 @@ def classify_cells(
         except BodyError:
             out["status"][n] = 1
             continue
-        if "gamma1" in p:  # each model's level of the initial state
-            _classify_state(body, p, out, n)
+        if "gamma1" in p:  # each model's level of the initial state; a body beyond doubles
+            with np.errstate(all="ignore"):  # (I1 = 1e300) is its cell's status, not warnings
+                _classify_state(body, p, out, n)
             continue
         try:
             level = LevelSet(body, p["M3"], p["C1"], p["C2"])

@@ -129,8 +129,16 @@ def _client(
     # it: Dask would leave it in the temporary folder
     scratch = tempfile.TemporaryDirectory(prefix="rollingtop-dask-", ignore_cleanup_errors=True)
     with scratch as tmp, dask.config.set({"temporary-directory": tmp}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=50)  # fmt: skip
+        # No dashboard; the scheduler's HTTP endpoints (health, metrics) still start, on port
+        # 8787 unless told otherwise, and warn in three lines when it is taken: a free port.
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=50,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+        )
         try:
             local = Client(cluster)
             from rollingtop.atlas._quiet import QuietWorker

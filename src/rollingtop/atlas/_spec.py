@@ -4,10 +4,11 @@ file with an ``[axes]`` table and validated, the constants of a run, and the atl
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import os
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -205,6 +206,13 @@ def _model_axis(value: object) -> FloatArray:
     return np.array(out, dtype=float)
 
 
+def _body_cells(body_t: dict[str, Any], axes: Mapping[str, FloatArray]) -> Iterator[dict[str, Any]]:
+    """The ``[body]`` table with each cell's values of the body axes, in the cells' order."""
+    keys = [key for key in BODY_KEYS if key in axes]
+    for values in itertools.product(*(axes[key] for key in keys)):
+        yield {**body_t, **{key: float(v) for key, v in zip(keys, values, strict=True)}}
+
+
 def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object) -> AtlasSpec:
     """The spec of an atlas whose cells' levels are the ``[initial]`` state's under each model
     (a ``model`` axis, or a model other than the meridian one): body keys and ``model`` as
@@ -222,12 +230,20 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
                          "needs an [initial] table (gamma, omega): each model's level is that "
                          "state's")  # fmt: skip
     body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
-    for key in BODY_KEYS:
-        if key in axes:
-            body_t[key] = float(axes[key][0])
-    data["body"] = body_t
     data.pop("level", None)
-    sc = Scenario.from_dict(data)
+    # The state is checked against the first cell's body that is admissible; a cell whose
+    # body is inadmissible is that cell's status (1), not a refusal of the whole atlas.
+    sc = None
+    for cell in _body_cells(body_t, axes):
+        try:
+            sc = Scenario.from_dict({**data, "body": cell})
+        except BodyError:
+            continue
+        body_t = cell
+        break
+    if sc is None:  # every cell's body is inadmissible: what is wrong with the first
+        Scenario.from_dict({**data, "body": next(_body_cells(body_t, axes))})
+        raise AtlasError("no cell of the atlas has an admissible body")
     if "model" not in axes:
         try:
             reduction_of(sc.model)
