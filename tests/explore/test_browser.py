@@ -154,6 +154,17 @@ def test_a_bad_url_value_is_a_message_and_the_view_stays(page, served):
     assert "steady motions: 3" in _readout(page)
 
 
+def test_a_value_of_5000_digits_is_a_page_not_a_server_error(served):
+    """Issue 36 row 8: ``GET /?C2=<5000 digits>`` was an HTTP 500 with a server traceback
+    (Panel's query parsing, beyond Python's 4300-digit int limit); now the page is served (its
+    message is test_view's ``beyond double precision``)."""
+    import urllib.request
+
+    _, url = served
+    with urllib.request.urlopen(f"{url}?C2={'1' * 5000}", timeout=60) as reply:
+        assert reply.status == 200 and b"<html" in reply.read().lower()
+
+
 def test_another_model_is_chosen_on_the_page(page, served):
     """The rough model: its own integrals as sliders, and the URL names it."""
     _, url = served

@@ -130,6 +130,8 @@ def test_a_click_outside_the_domain_is_refused(fig5):
         ({"model": "ice"}, "not a contact model"),
         ({"I3": "0.9"}, "body:"),  # I3 > I1 + I2
         ({"jellett": "1"}, "unknown parameter 'jellett' for the meridian"),
+        # issue 36 row 8: Panel hands an all-digit value over as an int
+        ({"C2": 10**4999}, r"C2 = <integer of .*digits> is beyond double precision"),
     ],
 )
 def test_a_bad_url_is_one_line_naming_the_parameter(fig5, query, message):

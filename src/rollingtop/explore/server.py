@@ -68,6 +68,10 @@ def _check_address(host: str, port: int) -> None:
                             f"({hint})") from None  # fmt: skip
 
 
+#: Digits of an integer a query value may have: more than Tornado's 64 KiB request header.
+MAX_QUERY_DIGITS = 70_000
+
+
 def serve(
     base: ExploreState,
     *,
@@ -90,6 +94,10 @@ def serve(
     from rollingtop.explore.app import ExplorePage
 
     _check_address(host, port)  # before compiling: a busy port is said at once
+    # Panel reads every all-digit query value as an int, which Python refuses beyond 4300
+    # digits (an HTTP 500 and a traceback for ?C2=<5000 digits>): allow as many as a request
+    # line can hold, so that the page says what is wrong with the value (parse_query).
+    sys.set_int_max_str_digits(max(sys.get_int_max_str_digits(), MAX_QUERY_DIGITS))
     # a tab closed while a result was on its way is not the user's concern
     logging.getLogger("bokeh.server.views.ws").setLevel(logging.ERROR)
     warm_up(base)

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._errors import RollingTopError, ScenarioError, short_repr
 from rollingtop._layout import GAMMA, W
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
@@ -182,10 +182,12 @@ def parse_query(query: Mapping[str, str | list[str]], base: ExploreState) -> Exp
                                 f"(allowed: {', '.join(allowed)})")  # fmt: skip
         try:
             value = float(text)
-        except ValueError:
-            raise ScenarioError(f"{key} = {text!r} is not a number") from None
+        except OverflowError:  # an integer beyond double precision (Panel reads digits as int)
+            raise ScenarioError(f"{key} = {short_repr(text)} is beyond double precision") from None
+        except (TypeError, ValueError):
+            raise ScenarioError(f"{key} = {short_repr(text)} is not a number") from None
         if not math.isfinite(value):
-            raise ScenarioError(f"{key} = {text!r} must be finite")
+            raise ScenarioError(f"{key} = {short_repr(text)} must be finite")
         numbers[key] = value
     body_changes = {k: v for k, v in numbers.items() if k in BODY_KEYS}
     if body_changes:
