@@ -3,6 +3,7 @@ a valid run is never refused, a refusal leaves no file, a printed number was ach
 
 import contextlib
 import json
+import math
 import os
 import subprocess
 import sys
@@ -276,3 +277,116 @@ def test_atlas_beyond_doubles_and_a_taken_port_print_nothing(tmp_path):
     assert code == 0 and err == ""
     status, _ = atlas_statuses(tmp_path / "a.nc")
     assert status[0][1] == status[1][1] == 0 and status[0][0] != 0 and status[1][0] != 0
+
+
+# ---- rows 9-13: the reductions' edges ------------------------------------------------------
+def test_a_steady_motion_at_the_pole_is_its_orbit(tmp_path):
+    """Issue 36 row 9: the smooth model's centre at the north pole, with h read off the state
+    one round-off below U there, was "no motion ... h below the minimum" while `equilibria`
+    listed that centre; now `orbits` reports the steady orbit, with the centre's period,
+    ``2 pi sqrt(I1 / U''_theta)`` at the pole (rho = I1 there: the smooth model has no
+    rolling)."""
+    path = scenario(
+        tmp_path,
+        "s.toml",
+        f'{BODY}[contact]\nmodel = "smooth"\n[initial]\n'
+        "gamma = [0.0, 0.0, -1.0]\nomega = [0.0, 0.0, 2.0]\n"
+        "v_horizontal = [0.25, 0.0]\n",
+    )
+    code, out, err = rollingtop("orbits", path, "--json")
+    assert code == 0, err
+    (orbit,) = json.loads(out)["orbits"]
+    code, out, err = rollingtop("equilibria", path, "--json")
+    (centre,) = json.loads(out)["equilibria"]
+    assert orbit["kind"] == "steady" and orbit["gamma3_min"] == orbit["gamma3_max"] == -1.0
+    by_curvature = 2.0 * math.pi * math.sqrt(0.3 / centre["U2_theta"])
+    assert orbit["period"] == pytest.approx(by_curvature, rel=1e-12)
+    assert orbit["period"] == pytest.approx(centre["period"], rel=1e-12)
+
+
+def test_a_motion_within_1e7_of_the_pole_is_finite(tmp_path):
+    """Issue 36 row 10: a rubber motion whose centre lies 1.2e-7 from the pole (its barrier
+    search stopped farther in) said "U = nan"; now a finite steady orbit at that centre."""
+    path = scenario(
+        tmp_path,
+        "r.toml",
+        f'{BODY}[contact]\nmodel = "rubber"\n[initial]\n'
+        "gamma = [0.0, 4.47e-8, -0.999999999999999]\n"
+        "omega = [0.0, 8.94e-8, 4e-15]\n",
+    )
+    code, out, err = rollingtop("orbits", path, "--json")
+    assert code == 0, err
+    (orbit,) = json.loads(out)["orbits"]
+    assert math.isfinite(orbit["period"]) and 0.0 < math.pi - orbit["theta_min"] < 1e-6
+
+
+@pytest.mark.parametrize(
+    ("model", "table", "named"),
+    [
+        ("rough", "jellett = 1.0\nrouth = 1.5\n", "jellett = 1, routh = 1.5"),
+        ("shell-rotor", "M3 = 1.0\njellett = 1.0\nC2 = -2.0\n", "M3 = 1, jellett = 1, C2 = -2"),
+    ],
+)
+def test_a_level_is_named_as_given(tmp_path, model, table, named):
+    """Issue 36 row 11: a level computed on its mirror image was named by the mirror's values
+    (``routh = -1.5``); now by the user's."""
+    shell = "[shell]\nmass = 0.2\ninertia = 0.13333333333333333\n" if model == "shell-rotor" else ""
+    path = scenario(
+        tmp_path, "l.toml", f'{BODY}{shell}[contact]\nmodel = "{model}"\n[level]\n{table}h = 0.0\n'
+    )
+    for command in ("orbits", "equilibria"):
+        code, _, err = rollingtop(command, path)
+        assert code == 2 and err.count("\n") == 1
+        assert f"no motion on {named} at h = 0" in err
+
+
+@pytest.mark.parametrize("model", ["rough", "meridian", "shell-rotor"])
+def test_a_body_beyond_doubles_is_one_line_naming_it(tmp_path, model):
+    """Issue 36 row 12: ``R = 1e150, a3 = 1e149`` said "jellett = nan must be finite", or two
+    warning lines and a generic overflow; now one line naming the input."""
+    shell = "[shell]\nmass = 0.2\ninertia = 0.13333333333333333\n" if model == "shell-rotor" else ""
+    v = "v_tau = 0.25\n" if model != "rough" else ""
+    body = BODY.replace("R = 1.0", "R = 1e150").replace("a3 = 0.1", "a3 = 1e149")
+    path = scenario(
+        tmp_path,
+        "b.toml",
+        f'{body}{shell}[contact]\nmodel = "{model}"\n'
+        f"[initial]\ngamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 2.0]\n{v}",
+    )
+    code, _, err = rollingtop("orbits", path)
+    assert code == 2 and err.count("\n") == 1
+    assert "overflows double precision" in err and ("R = 1e+150" in err or "|v| = " in err)
+
+
+def test_a_spin_too_small_for_a_diagram_is_said(tmp_path):
+    """Issue 36 row 12: `bifurcation` at ``omega3 = 1e-300`` said "C2 range (2.25e+298,
+    2.25e+298) must be finite and increasing"; now one line naming M3."""
+    text = (
+        (EXAMPLES / "paper.toml")
+        .read_text()
+        .replace("omega = [0.7, -0.3, 2.0]", "omega = [0.0, 0.0, 1e-300]")
+    )
+    path = scenario(tmp_path, "b.toml", text)
+    code, _, err = rollingtop("bifurcation", path, "-o", tmp_path / "b.png")
+    assert code == 2 and err.count("\n") == 1 and "M3 = 5e-301" in err
+    assert list(tmp_path.iterdir()) == [path]
+
+
+def test_a_tiny_rubber_spin_has_its_centre(tmp_path):
+    """Issue 36 row 13: ``rubber_spin = 1e-40`` listed no steady motion (the centre sits 2e-20
+    from the pole, below what theta resolves near pi); now the centre, with the frequency of
+    the centre at rubber_spin = 1e-10 to 1e-8 (both at the small-spin limit), and a portrait."""
+    found = {}
+    for spin in ("1e-40", "1e-10"):
+        path = scenario(
+            tmp_path,
+            f"{spin}.toml",
+            f'{BODY}[contact]\nmodel = "rubber"\n[level]\nrubber_spin = {spin}\n',
+        )
+        code, out, err = rollingtop("equilibria", path, "--json")
+        assert code == 0, err
+        (found[spin],) = json.loads(out)["equilibria"]
+    assert found["1e-40"]["type"] == "center" and found["1e-40"]["gamma3"] == -1.0
+    assert found["1e-40"]["frequency"] == pytest.approx(found["1e-10"]["frequency"], rel=1e-8)
+    code, _, err = rollingtop("portrait", tmp_path / "1e-40.toml", "-o", tmp_path / "p.png")
+    assert code == 0, err

@@ -230,6 +230,13 @@ def bifurcation_diagram(
     if nc < 3 or nh < 3:
         raise LevelSetError(f"resolution = {resolution} must be at least (3, 3)")
     fs = folds(body, M3, C1)
+    lost = [f for f in fs if not (math.isfinite(f.C2) and math.isfinite(f.h))]
+    if lost:  # a spin so small that the folds (which move away like 1/M3) leave double precision
+        raise LevelSetError(
+            f"M3 = {M3:g}: the diagram's fold lies at C2 = {lost[0].C2:.3g}, h = {lost[0].h:g}, "
+            "beyond double precision (the folds move away like 1/M3 as the spin vanishes): the "
+            "spin is too small for a diagram; without spin see rollingtop.reduction.no_spin"
+        )
     branches = _branches(level)
     marks = list(fs)
     t0 = _family(level)

@@ -389,6 +389,11 @@ class LevelSet(LevelServices):
 def near_north(level: LevelSet) -> bool:
     """A level that is no pole case and lies nearer its north pole level than its south one
     (:meth:`LevelSet.pole_offsets`; the meridian model's: ``C1 = -M3`` and ``C1 = M3``): computed
-    on its mirror image (:meth:`LevelSet.mirrored`)."""
+    on its mirror image (:meth:`LevelSet.mirrored`). On a tie (the rubber model's two poles
+    are one level) the pole the weight favours: north for ``a3 > 0``, where a small spin's
+    centre then lies within ``sqrt(rubber_spin)`` of ``theta = pi``, beyond what ``theta``
+    resolves there but not its mirror image near 0."""
     south, north = level.pole_offsets()
+    if abs(north) == abs(south):
+        return level.pole is None and level.body.a3 > 0.0
     return level.pole is None and abs(north) < abs(south)

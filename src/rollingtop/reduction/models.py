@@ -22,6 +22,7 @@ rotor
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -32,7 +33,7 @@ from rollingtop._errors import ScenarioError
 from rollingtop._layout import W
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
-from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.rough import RoughLevel, rough_integrals
 from rollingtop.reduction.rubber import RubberLevel, rubber_integrals
 from rollingtop.reduction.shell_rotor import ShellRotorLevel, shell_rotor_integrals
@@ -92,13 +93,36 @@ class Reduction:
         """The level set the state ``y`` (shape (18,)) lies on; ``|I w|`` is the round-off scale
         of ``M3`` and ``C1`` in the pole decision (:class:`~rollingtop.reduction.LevelSet`)."""
         y = np.asarray(y, dtype=float)
-        values = self.integrals(body, y)
-        scale = float(np.linalg.norm(body.inertia * y[W]))
+        try:
+            with np.errstate(all="ignore"):  # a value beyond doubles is said below, in one line
+                values = self.integrals(body, y)
+                scale = float(np.linalg.norm(body.inertia * y[W]))
+        except OverflowError:  # Python's float arithmetic raises where numpy's gives inf
+            values, scale = {n: math.inf for n in (*self.names, "h")}, math.inf
+        bad = [n for n in (*self.names, "h") if not np.isfinite(values[n])]
+        if bad or not np.isfinite(scale):
+            raise LevelSetError(
+                f"the level of the state is not finite ({', '.join(bad) or '|I w|'} = "
+                f"{float(values[bad[0]]) if bad else scale:g}): {_largest_input(body, y)} "
+                "overflows double precision in the integrals' products; rescale the "
+                "scenario's units"
+            )
         return self.level(body, {n: float(values[n]) for n in self.names}, scale=scale)
 
     def reduced_energy(self, body: SphericalTop, y: ArrayLike) -> float:
         """The reduced energy ``h`` of the state ``y`` (:attr:`energy`)."""
         return float(self.integrals(body, np.asarray(y, dtype=float))["h"])
+
+
+def _largest_input(body: SphericalTop, y: NDArray[np.float64]) -> str:
+    """The body parameter or velocity of ``y`` farthest from 1 in magnitude, as ``name = value``
+    (the input to blame for an overflow)."""
+    named = {k: float(getattr(body, k)) for k in ("R", "m", "g", "a3", "I1", "I2", "I3",
+                                                   "shell_mass", "shell_inertia")}  # fmt: skip
+    named |= {"|v|": float(np.linalg.norm(y[0:3])), "|omega|": float(np.linalg.norm(y[W]))}
+    sizes = {k: abs(math.log10(abs(v))) for k, v in named.items() if v != 0 and np.isfinite(v)}
+    worst = max(sizes, key=sizes.__getitem__)
+    return f"{worst} = {named[worst]:g}"
 
 
 REDUCTIONS: dict[str, Reduction] = {

@@ -40,17 +40,24 @@ __all__ = ["Orbit", "Orbits", "orbits", "period", "half_integral", "canonical_or
 __all__ += ["PERIOD_RTOL", "WALL_RATIO", "SEPARATRIX_TOLERANCE", "STEADY_TOLERANCE"]
 
 
-def _barrier_end(level: LevelSet, h: float, end: float, inward: float) -> float:
-    """A point near a domain end where ``U > h`` (the potential's barrier)."""
+def _barrier_end(
+    level: LevelSet, h: float, end: float, inward: float, crit: Sequence[float], named: str
+) -> float:
+    """A point near a domain end where ``U > h`` (the potential's barrier), nearer the end than
+    every critical point ``crit`` of ``U`` (a motion within 1e-7 of a pole has its centre
+    between the end and a barrier point farther in). ``named``: the level as messages name it
+    (the user's, where ``level`` is its mirror image)."""
     for eps in (1e-6, 1e-9, 1e-12, 1e-15, 1e-20, 1e-30, 1e-50, 1e-100, 1e-200, 1e-300):
         t = end + inward * eps * (1 + abs(end))
         if t == end:
             break
+        if any((c - t) * inward <= 0.0 for c in crit):  # a critical point beyond t
+            continue
         with np.errstate(all="ignore"):
             if level.U(t) > h:
                 return t
     raise LevelSetError(
-        f"the motion reaches within 1e-15 of theta = {end:g} on {level.describe()}, h = {h:g}: "
+        f"the motion reaches within 1e-15 of theta = {end:g} on {named}, h = {h:g}: "
         "the wall of U beside that pole is thinner than double precision resolves there "
         f"({level.pole_advice})"
     )
@@ -75,7 +82,7 @@ def orbits(level: LevelSet, h: float) -> Orbits:
     if level.pole == "both":
         return Orbits(no_spin_orbits(level, h), level, h)
     if near_north(level):
-        mirrored = [_mirror(o) for o in _orbits(level.mirrored(), h)]
+        mirrored = [_mirror(o) for o in _orbits(level.mirrored(), h, level.describe())]
         return Orbits(sorted(mirrored, key=lambda o: (o.gamma3_min, o.theta_min)), level, h)
     return Orbits(_orbits(level, h), level, h)
 
@@ -98,7 +105,7 @@ def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, 
     if not near_north(level):
         return level, orbit
     mirrored = level.mirrored()
-    candidates = _orbits(mirrored, h)
+    candidates = _orbits(mirrored, h, level.describe())
     best = min(
         candidates,
         key=lambda c: (
@@ -109,18 +116,21 @@ def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, 
     return mirrored, best
 
 
-def _orbits(level: LevelSet, h: float) -> list[Orbit]:
-    found = _components(level, h)
+def _orbits(level: LevelSet, h: float, named: str | None = None) -> list[Orbit]:
+    """The orbits of ``level`` at ``h``; ``named``: the level as messages name it (default
+    ``level.describe()``; the user's level where ``level`` is its mirror image)."""
+    found = _components(level, h, level.describe() if named is None else named)
     if level.pole is None:
         found = [replace(o, pole_distance=min(o.theta_min, math.pi - o.theta_max)) for o in found]
     return found
 
 
-def _components(level: LevelSet, h: float) -> list[Orbit]:
+def _components(level: LevelSet, h: float, named: str) -> list[Orbit]:
     lo_end, hi_end = level.theta_domain
-    lo = _barrier_end(level, h, lo_end, +1)
-    hi = _barrier_end(level, h, hi_end, -1)
-    crit = [t for t in critical_points(level) if lo < t < hi]
+    inside = [t for t in critical_points(level) if lo_end < t < hi_end]
+    lo = _barrier_end(level, h, lo_end, +1, inside, named)
+    hi = _barrier_end(level, h, hi_end, -1, inside, named)
+    crit = [t for t in inside if lo < t < hi]
     knots = [lo, *crit, hi]
     values = [float(level.U(t)) for t in knots]
     scale = max(abs(h), max(abs(v) for v in values[1:-1]) if crit else abs(h), 1e-300)
@@ -139,10 +149,14 @@ def _components(level: LevelSet, h: float) -> list[Orbit]:
             end = turning_point(level, h, a, b) if ua < h else a
             result.append(_make_orbit(level, h, start, end, crit, steadies, scale))
             start = None
+    if not result and crit:  # h within round-off below a centre's U: that steady motion
+        umin, c = min(zip(values[1:-1], crit, strict=True))
+        if steadies[c].type == "center" and umin - h <= STEADY_TOLERANCE * scale:
+            result.append(_make_orbit(level, h, c, c, crit, steadies, scale))
     if not result:
         umin = min(values[1:-1]) if crit else math.nan
         raise LevelSetError(
-            f"no motion on {level.describe()} at h = {h:.12g}: h is below the minimum of the "
+            f"no motion on {named} at h = {h:.12g}: h is below the minimum of the "
             f"effective potential U = {umin:.12g}"
         )
     pole = level.pole_theta

@@ -128,7 +128,10 @@ def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
         # near a pole level the wall of U, and a steady motion beside it, can sit as close to
         # the pole as |C1 -+ M3|: add points at geometrically shrinking distances from the ends
         d = (hi - lo) * np.logspace(-18.0, -3.0, 301)
-        grid = np.unique(np.concatenate([grid, lo + d, hi - d]))
+        # at theta = 0 a distance keeps its precision down to the smallest doubles (a mirrored
+        # level's wall at 1e-20, say); at pi it is lost below 1e-16
+        near_zero = lo + (hi - lo) * np.logspace(-300.0, -18.0, 283) if lo == 0.0 else d[:0]
+        grid = np.unique(np.concatenate([grid, near_zero, lo + d, hi - d]))
     return grid
 
 
@@ -161,9 +164,9 @@ def _critical_points(level: LevelSet, points: int) -> NDArray[np.float64]:
         if d[i] == 0.0:
             roots.append(grid[i])
         elif d[i + 1] != 0.0:
-            roots.append(
-                brentq(level.dU, grid[i], grid[i + 1], xtol=1e-15, rtol=8.9e-16, maxiter=200)
-            )
+            a, b = grid[i], grid[i + 1]  # xtol relative near theta = 0, where roots can be tiny
+            xtol = 1e-15 * min(1.0, max(abs(a), abs(b)))
+            roots.append(brentq(level.dU, a, b, xtol=xtol, rtol=8.9e-16, maxiter=200))
     found = np.unique(np.array(roots, dtype=float))
     found.flags.writeable = False
     return found
