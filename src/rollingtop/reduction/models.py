@@ -98,7 +98,7 @@ class Reduction:
                 values = self.integrals(body, y)
                 scale = float(np.linalg.norm(body.inertia * y[W]))
         except OverflowError:  # Python's float arithmetic raises where numpy's gives inf
-            values, scale = {n: math.inf for n in (*self.names, "h")}, math.inf
+            values, scale = {n: np.array(math.inf) for n in (*self.names, "h")}, math.inf
         bad = [n for n in (*self.names, "h") if not np.isfinite(values[n])]
         if bad or not np.isfinite(scale):
             raise LevelSetError(
