@@ -390,3 +390,49 @@ def test_a_tiny_rubber_spin_has_its_centre(tmp_path):
     assert found["1e-40"]["frequency"] == pytest.approx(found["1e-10"]["frequency"], rel=1e-8)
     code, _, err = rollingtop("portrait", tmp_path / "1e-40.toml", "-o", tmp_path / "p.png")
     assert code == 0, err
+
+
+# ---- item 6: budgets honoured --------------------------------------------------------------
+def test_ensemble_honours_the_scenarios_max_steps(tmp_path):
+    """``[integration] max_steps`` was ignored by `ensemble` (its own 1e7 applied): now each
+    trajectory stops there and says so."""
+    text = (
+        (EXAMPLES / "paper.toml")
+        .read_text()
+        .replace("[integration]", "[integration]\nmax_steps = 5")
+    )
+    path = scenario(tmp_path, "e.toml", text)
+    code, out, err = rollingtop(
+        "ensemble", path, "--grid", "omega3=1:2:3", "--t-end", "5", "--json"
+    )
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["status_counts"] == {"max_steps reached": 3} and summary["steps_total"] == 15
+
+
+def test_section_stops_a_trajectory_that_does_not_cross(tmp_path):
+    """A sleeping top never crosses w_tau = 0 upward: it ran to max_steps (1e7 steps); now it
+    stops after ``--max-gap-steps`` steps without a crossing and says why."""
+    path = scenario(
+        tmp_path,
+        "s.toml",
+        f'{BODY}[contact]\nmodel = "meridian"\n[initial]\n'
+        "gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\nv_tau = 0.0\n",
+    )
+    code, out, err = rollingtop(
+        "section",
+        path,
+        "-o",
+        tmp_path / "s.png",
+        "--trajectories",
+        "1",
+        "--crossings",
+        "10",
+        "--max-gap-steps",
+        "2000",
+        "--json",
+    )
+    assert code == 0, err
+    (stopped,) = json.loads(out)["stopped_early"]
+    assert stopped["reason"] == "no crossing within max_gap_steps steps"
+    assert stopped["crossings"] == 0

@@ -199,22 +199,29 @@ static void reaction(const double *y, const Reaction *ws, double *N_out, double 
     *T_out = sqrt(FMA(t3, t3, FMA(t1, t1, t2 * t2)));
 }
 
-/* dynamics/_kernel.py project (code 0): Newton-Schulz step of the frame, psi_nu synchronised with
+/* dynamics/_kernel.py project (code 0): Newton-Schulz steps of the frame, psi_nu synchronised with
  * the axis azimuth (contact/_rows.py sync_direction), closed-form velocity projection
  * (contact/_closed.py project_contact with the geometric nu). */
 static void project(const double *p, double *y)
 {
-    double G00 = FMA(y[8], y[8], FMA(y[6], y[6], y[7] * y[7]));
-    double G11 = FMA(y[11], y[11], FMA(y[9], y[9], y[10] * y[10]));
-    double G22 = FMA(y[14], y[14], FMA(y[12], y[12], y[13] * y[13]));
-    double G01 = FMA(y[8], y[11], FMA(y[6], y[9], y[7] * y[10]));
-    double G02 = FMA(y[8], y[14], FMA(y[6], y[12], y[7] * y[13]));
-    double G12 = FMA(y[11], y[14], FMA(y[9], y[12], y[10] * y[13]));
-    for (int c = 0; c < 3; c++) {
-        double a = y[6 + c], b = y[9 + c], g = y[12 + c];
-        y[6 + c] = FMA(1.5, a, -(0.5 * FMA(G02, g, FMA(G00, a, G01 * b))));
-        y[9 + c] = FMA(1.5, b, -(0.5 * FMA(G12, g, FMA(G01, a, G11 * b))));
-        y[12 + c] = FMA(1.5, g, -(0.5 * FMA(G22, g, FMA(G02, a, G12 * b))));
+    /* FRAME_ITERATIONS steps at most, until a step starts within FRAME_ONE_STEP */
+    for (int it = 0; it < 6; it++) {
+        double G00 = FMA(y[8], y[8], FMA(y[6], y[6], y[7] * y[7]));
+        double G11 = FMA(y[11], y[11], FMA(y[9], y[9], y[10] * y[10]));
+        double G22 = FMA(y[14], y[14], FMA(y[12], y[12], y[13] * y[13]));
+        double G01 = FMA(y[8], y[11], FMA(y[6], y[9], y[7] * y[10]));
+        double G02 = FMA(y[8], y[14], FMA(y[6], y[12], y[7] * y[13]));
+        double G12 = FMA(y[11], y[14], FMA(y[9], y[12], y[10] * y[13]));
+        for (int c = 0; c < 3; c++) {
+            double a = y[6 + c], b = y[9 + c], g = y[12 + c];
+            y[6 + c] = FMA(1.5, a, -(0.5 * FMA(G02, g, FMA(G00, a, G01 * b))));
+            y[9 + c] = FMA(1.5, b, -(0.5 * FMA(G12, g, FMA(G01, a, G11 * b))));
+            y[12 + c] = FMA(1.5, g, -(0.5 * FMA(G22, g, FMA(G02, a, G12 * b))));
+        }
+        double error = fmax(fmax(fmax(fabs(G00 - 1.0), fabs(G11 - 1.0)), fmax(fabs(G22 - 1.0),
+                       fabs(G01))), fmax(fabs(G02), fabs(G12)));
+        if (error <= 1e-8)
+            break;
     }
     /* sync_direction (geometric): psi_nu follows the axis azimuth modulo 2 pi */
     if (sqrt(FMA(y[8], y[8], y[11] * y[11])) > 1e-12) {

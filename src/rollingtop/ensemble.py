@@ -362,12 +362,14 @@ def _ensemble_integrals(
 
 def ensemble_from_scenario(scenario: Scenario, columns: Columns, **kwargs: Any) -> EnsembleResult:
     """Run the scenario's body and model over the initial states of ``columns``; ``kwargs`` go to
-    :func:`simulate_ensemble` (the scenario's ``t_end``, ``rtol`` and ``atol`` by default)."""
+    :func:`simulate_ensemble` (the scenario's ``t_end``, ``rtol``, ``atol`` and ``max_steps`` by
+    default)."""
     opts = scenario.integration
     check_ensemble_memory(len(next(iter(columns.values()), ())), kwargs.get("samples"))
     kwargs.setdefault("t_end", opts.t_end)
     kwargs.setdefault("rtol", opts.rtol)
     kwargs.setdefault("atol", opts.resolved_atol if kwargs["rtol"] == opts.rtol else None)
+    kwargs.setdefault("max_steps", opts.max_steps)
     states = states_from_table(scenario, columns)
     result = simulate_ensemble(scenario.body, scenario.model, states, **kwargs)
     return replace(result, columns=dict(columns))

@@ -11,3 +11,6 @@ POLISH_ITERATIONS = 2
 #: Time step of the central difference of the event function along the flow (exact for the
 #: quadratic ``W_TAU``).
 POLISH_DT = 1e-6
+#: Status of a section trajectory stopped because it went ``max_gap_steps`` accepted steps
+#: without a new crossing (a motion that settled, or one that never turns in ``gamma3``).
+NO_CROSSING = 3

@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from rollingtop._checks import short_repr
 from rollingtop._compiled import by_package, compiling
 from rollingtop._compiled._dop853 import FINISHED, STATUS_NAMES
-from rollingtop._compiled._section import SECTION_STATS
+from rollingtop._compiled._section import NO_CROSSING, SECTION_STATS
 from rollingtop._errors import InitialStateError, ScenarioError
 from rollingtop._layout import GAMMA, N_STATE, W, state_components
 from rollingtop._types import FloatArray
@@ -58,6 +58,12 @@ __all__ = ["STATE_COMPONENTS", "poincare_section", "section_summary", "stopped_e
 
 #: Names of the state components (the ``state`` coordinate of the datasets).
 STATE_COMPONENTS = state_components()
+#: Accepted steps a section trajectory may take without crossing before it stops: at the
+#: default tolerance a turn of gamma3 takes tens to hundreds of steps, so this is hundreds of
+#: its periods.
+MAX_GAP_STEPS = 100_000
+#: The stepper's status names and the section's own.
+SECTION_STATUS = {**STATUS_NAMES, NO_CROSSING: "no crossing within max_gap_steps steps"}
 #: Largest number of crossings stored (trajectories times crossings).
 MAX_POINTS = 20_000_000
 #: Default number of trajectories when a single state is given.
@@ -106,6 +112,7 @@ def poincare_section(
     atol: float | None = None,
     t_max: float = math.inf,
     max_steps: int = 10**7,
+    max_gap_steps: int = MAX_GAP_STEPS,
     threads: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> xr.Dataset:
@@ -133,6 +140,11 @@ def poincare_section(
         A trajectory stops at this time even with fewer crossings.
     max_steps : int
         ... or after this many accepted steps.
+    max_gap_steps : int
+        ... or after this many accepted steps without a new crossing (default
+        :data:`MAX_GAP_STEPS`: a motion that settled onto a steady one, or that never turns in
+        ``gamma3``, stops instead of running to ``max_steps``; its status says
+        ``"no crossing within max_gap_steps steps"``).
     threads : int, optional
         Threads (default: numba's, all cores).
     progress : callable, optional
@@ -157,6 +169,7 @@ def poincare_section(
     model = get_model(model)
     crossings = _check_count("crossings", crossings, 1)
     _check_count("max_steps", max_steps, 1)
+    _check_count("max_gap_steps", max_gap_steps, 1)
     if trajectories is not None:
         trajectories = _check_count("trajectories", trajectories, 1)
     if not 1e-15 <= rtol <= 0.1:
@@ -195,8 +208,8 @@ def poincare_section(
         with compiling(kernels, "chaos"):
             seconds, used = run_rows(kernels.chaos.section_batch,
                                      (codes[idx], body.params, Y0[idx], float(t_max), float(rtol),
-                                      float(atol), int(max_steps), *part),
-                                     (0, 2, 7, 8, 9), idx.size, threads=threads,
+                                      float(atol), int(max_steps), int(max_gap_steps), *part),
+                                     (0, 2, 8, 9, 10), idx.size, threads=threads,
                                      poll=poll)  # fmt: skip
         wall += seconds
         ev_t[idx], ev_y[idx], stats[idx] = part
@@ -230,7 +243,7 @@ def poincare_section(
         model=model.name, held=",".join(names), crossings=crossings, rtol=float(rtol),
         atol=float(atol), wall_time_s=wall, threads=used, source="rollingtop section",
         section="w_tau = 0, w_tau increasing (minima of gamma3)", plane="gamma3, w_n",
-        status_names=json.dumps({str(k): v for k, v in STATUS_NAMES.items()}),
+        status_names=json.dumps({str(k): v for k, v in SECTION_STATUS.items()}),
     )  # fmt: skip
     coords = {"trajectory": np.arange(K), "crossing": np.arange(crossings),
               "state": state_components(model.slot_name)}  # fmt: skip

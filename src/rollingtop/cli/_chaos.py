@@ -80,6 +80,13 @@ def _stopped_lines(stopped: list[dict[str, Any]], crossings: int) -> list[str]:
 @click.option("--t-max", type=click.FloatRange(min=0.0, min_open=True), default=None,
               help="Stop each trajectory at this time even with fewer crossings (motions that "
                    "settle, e.g. onto a steady spin, cross no more).")  # fmt: skip
+@click.option(
+    "--max-gap-steps",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Stop a trajectory after this many accepted steps without a new crossing "
+    "(default 100000: hundreds of turns of gamma3 at the default tolerance).",
+)
 @rtol_option
 @atol_option
 @json_option
@@ -92,6 +99,7 @@ def section(
     seed: int,
     netcdf: str | None,
     t_max: float | None,
+    max_gap_steps: int | None,
     rtol: float | None,
     atol: float | None,
     as_json: bool,
@@ -100,6 +108,7 @@ def section(
     trajectories sampled on the level set of the scenario's initial state (same energy and
     other integrals of its model)."""
     from rollingtop.chaos import poincare_section, section_summary
+    from rollingtop.chaos.section import MAX_GAP_STEPS
     from rollingtop.io import check_output_path, netcdf_bytes, write_together
     from rollingtop.plot import FIGURE_SUFFIXES
     from rollingtop.scenario import load_scenario
@@ -113,6 +122,7 @@ def section(
         ds = poincare_section(sc.body, sc.model, y0, crossings=crossings,
                               trajectories=trajectories, hold=_hold(hold), seed=seed,
                               t_max=math.inf if t_max is None else t_max,
+                              max_gap_steps=max_gap_steps or MAX_GAP_STEPS,
                               rtol=sc.integration.rtol, atol=sc.integration.resolved_atol,
                               progress=progress)  # fmt: skip
     from rollingtop.plot.section import section_figure

@@ -12,7 +12,7 @@ from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled._events import W_TAU
 from rollingtop._compiled._flags import STOP_POLL_STEPS, read_flag
 from rollingtop._compiled._kernel import new_workspace
-from rollingtop._compiled._section import POLISH_DT, POLISH_ITERATIONS
+from rollingtop._compiled._section import NO_CROSSING, POLISH_DT, POLISH_ITERATIONS
 from rollingtop._compiled._template.dynamics import project, rhs
 from rollingtop._compiled._template.events import event_value
 from rollingtop._compiled._template.stepper import run, start
@@ -61,13 +61,15 @@ def section_one(
     rtol: float,
     atol: float,
     max_steps: int,
+    max_gap: int,
     ev_t: FloatArray,
     ev_y: FloatArray,
     stats: FloatArray,
     stop: IntArray,
 ) -> None:
     """Upward zeros of the ``W_TAU`` event along one trajectory until ``len(ev_t)`` are found,
-    ``t_max`` is reached or ``max_steps`` steps are taken. ``stats``: :data:`SECTION_STATS`."""
+    ``t_max`` is reached, ``max_steps`` steps are taken or ``max_gap`` steps pass without a
+    crossing (status ``NO_CROSSING``). ``stats``: :data:`SECTION_STATS`."""
     n = N_STATE
     K = np.zeros((16, n))
     ynew = np.zeros(n)
@@ -87,6 +89,7 @@ def section_one(
     ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew,
                                 ws)  # fmt: skip
     wanted = ev_t.shape[0]
+    last_events, last_steps = 0, 0
     while True:
         if read_flag(stop) != 0:
             status = dop.INTERRUPTED
@@ -99,6 +102,11 @@ def section_one(
             status = dop.FINISHED
             break
         if status != dop.BUDGET_EXHAUSTED or counts[dop.STEPS] >= max_steps:
+            break
+        if counts[dop.N_EVENTS] > last_events:
+            last_events, last_steps = counts[dop.N_EVENTS], counts[dop.STEPS]
+        elif counts[dop.STEPS] - last_steps >= max_gap:
+            status = NO_CROSSING
             break
     for m in range(min(counts[dop.N_EVENTS], wanted)):
         ev_t[m] += polish_crossing(code, p, ev_y[m], f, ytmp, ws)
@@ -118,6 +126,7 @@ def section_batch(
     rtol: float,
     atol: float,
     max_steps: int,
+    max_gap: int,
     ev_t: FloatArray,
     ev_y: FloatArray,
     stats: FloatArray,
@@ -129,8 +138,8 @@ def section_batch(
         if read_flag(stop) != 0:
             stats[k, 0] = dop.INTERRUPTED
         else:
-            section_one(codes[k], p, Y0[k], t_max, rtol, atol, max_steps, ev_t[k], ev_y[k],
-                         stats[k], stop)  # fmt: skip
+            section_one(codes[k], p, Y0[k], t_max, rtol, atol, max_steps, max_gap, ev_t[k],
+                        ev_y[k], stats[k], stop)  # fmt: skip
 
 
 @compiled(nogil=True)
