@@ -67,7 +67,8 @@ def test_rough_pole_level_runs_and_writes(tmp_path, suffix):
     code, stdout, err = rollingtop("simulate", path, "--t-end", "1", "--json", *out)
     assert code == 0, err
     summary = json.loads(stdout)
-    assert "level" not in summary  # the reduction refuses a pole level: not shown
+    # no spin: both poles are pole levels of Routh's sphere, reduced since item 5
+    assert summary["level"]["jellett"] == summary["level"]["routh"] == 0.0
     assert summary["integrals"]["jellett"]["max_abs_drift"] < 1e-9
     if suffix is not None:
         assert (tmp_path / f"rw{suffix}").stat().st_size > 0

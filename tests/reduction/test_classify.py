@@ -129,9 +129,10 @@ def test_rotation_of_another_reduced_model_on_the_command_line(capsys, tmp_path)
     )
 
 
-def test_a_model_that_refuses_the_state_leaves_the_others(capsys, tmp_path):
-    """A vertical spin is a pole level of Routh's sphere, not reduced yet: compare-classification
-    classifies the other models and names the refused one (JSON "refused", one stderr line)."""
+def test_a_vertical_spin_is_classified_by_every_model(capsys, tmp_path):
+    """A vertical spin is a pole level of every integrable model: compare-classification
+    classifies each (Routh's sphere's since issue 36: its pole levels are reduced), with no
+    refusal; rubber rolling keeps none of the spin."""
     path = tmp_path / "vertical.toml"
     path.write_text("""
 [body]
@@ -149,11 +150,12 @@ omega = [0.0, 0.0, 3.0]
                              str(tmp_path / "v.png"), "--json", "--points", "5")  # fmt: skip
     assert code == 0, err
     data = json.loads(out)
-    assert [m["model"] for m in data["models"]] == ["meridian", "smooth", "rubber"]
-    assert set(data["refused"]) == {"rough"} and "pole" in data["refused"]["rough"]
+    assert [m["model"] for m in data["models"]] == ["meridian", "smooth", "rough", "rubber"]
+    assert data["refused"] == {}
+    assert data["models"][2]["level"]["pole"] == "south"
     # rubber rolling cannot spin about the vertical: its part of omega is the rest at the pole
-    rubber = data["models"][2]
-    assert rubber["level"]["rubber_spin"] == 0.0 and rubber["orbit"] is None
+    rubber = data["models"][3]
+    assert rubber["level"]["rubber_spin"] == 0.0 and rubber["orbit"] is None  # snapped to 0
     assert "omega projected" in rubber["note"]
 
 

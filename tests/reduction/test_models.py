@@ -356,14 +356,20 @@ def test_every_declared_reduction_is_registered_with_the_same_names():
     assert set(declared) == {"meridian", "smooth", "rough", "rubber", "shell-rotor"}
 
 
-def test_a_rough_pole_level_is_refused_in_one_line(paper_body):
-    """The vertical spin's level (jellett + I3 k w3 = 0 at gamma3 = 1) is not reduced yet."""
+def test_a_rough_pole_level_is_reduced(paper_body):
+    """The vertical spin's level (jellett + I3 k w3 = 0 at gamma3 = 1) is a south pole level
+    (issue 36 item 5; was refused): U is finite and even about the pole, whose steady motion is
+    the sleeping top (tests/reduction/test_rough_pole.py times its orbits against mpmath)."""
     b = paper_body
     k = b.R + b.a3
     routh = 1.0
     w3 = routh / math.sqrt(b.I1 * b.I3 + b.m * b.I3 * k**2)
-    with pytest.raises(Exception, match="south.*pole levels are not reduced yet"):
-        RoughLevel(b, jellett=-b.I3 * k * w3, routh=routh)
+    level = RoughLevel(b, jellett=-b.I3 * k * w3, routh=routh)
+    assert level.pole == "south" and level.theta_domain == (-math.pi, math.pi)
+    theta = np.array([1e-9, 1e-4, 0.3])
+    assert level.U(theta) == pytest.approx(level.U(-theta), rel=1e-15)
+    assert float(level.U(0.0)) == pytest.approx(0.5 * b.I3 * w3**2 + b.m * b.g * b.a3, rel=1e-15)
+    assert 0.0 in [m.theta for m in steady_motions(level)]
 
 
 @pytest.mark.parametrize("model", ["meridian", *MODELS])
@@ -538,7 +544,7 @@ def test_the_rubber_pole_level_rocks_through_the_vertical_as_the_full_system(bod
     y0 = _state("rubber", body, gamma, 0.3 * tau)
     reduction = reduction_of("rubber")
     level = reduction.level_of_state(body, y0)
-    assert level.pole == "both" and level.rubber_spin == 0.0
+    assert level.pole == "both" and level.rubber_spin == 0.0  # snapped to the pole level: exact
     (o,) = orbits(level, reduction.reduced_energy(body, y0))
     assert o.kind == "periodic" and o.pole_passage
     far = o.gamma3_min if pole > 0 else o.gamma3_max

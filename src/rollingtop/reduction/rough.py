@@ -24,9 +24,23 @@ and the energy ``h = E - m g R`` (the spin's energy is not constant here, so it 
 
 from ``T = (I w, w)/2 + m |r x w|^2/2`` with ``|r x w|^2 = |r|^2 |w|^2 - (r, w)^2``.
 
-``w_n`` grows like ``1/s`` at a pole unless ``jellett + I3 k w3`` vanishes there: such a pole
-level (the vertical spin's, or a motion through the vertical) is refused for now; every other
-level has walls at both poles and its motions stay inside ``0 < theta < pi``.
+``w_n`` grows like ``1/s`` at a pole unless ``jellett + I3 k w3`` vanishes there: every other
+level has walls at both poles and its motions stay inside ``0 < theta < pi``. On a **pole
+level** (``pole = "south"``: ``jellett = -I3 k0 w3(0)`` with ``k0 = R + a3``, the level of the
+sleeping top and of every motion through the upright vertical; ``"north"`` likewise at
+``theta = pi``) ``U`` is finite and smooth through the pole and ``theta`` is signed, in
+``(-pi, pi)`` (``(0, 2 pi)`` for the north pole), as for the meridian model's pole cases. There
+``jellett + I3 k w3 = I3 routh (k / sqrt(f) - k0 / sqrt(f0))``, a difference that cancels next
+to the pole; with ``sigma = sin^2(theta/2)`` it is written without cancellation,
+
+    k^2 f0 - k0^2 f = -2 R I1 sigma (I3 (k + k0) + 2 m R (1 - sigma) k0^2),
+
+so ``w_n = -I3 routh tan(theta/2) (I3 (k + k0) + 2 m R (1 - sigma) k0^2)
+/ (sqrt(f f0) (k sqrt(f0) + k0 sqrt(f)))`` (while ``k > 0``; beyond, the two terms of the
+difference have opposite signs and it is taken as it stands). The north pole level is the
+south one of the mirrored body (:meth:`RoughLevel.mirrored`). With no spin at all
+(``jellett = routh = 0``) both poles are pole levels: ``w3 = w_n = 0`` and ``U = m g a3 cos``,
+the planar rocking and rolling over of :mod:`rollingtop.reduction.no_spin`.
 """
 
 from __future__ import annotations
@@ -42,7 +56,6 @@ from rollingtop.body import SphericalTop
 from rollingtop.reduction._services import check_level_size, check_level_values
 from rollingtop.reduction.level import (
     LevelSet,
-    PoleLevelError,
     Real,
     _Analytic,
     _AnalyticResult,
@@ -51,7 +64,7 @@ from rollingtop.reduction.level import (
 __all__ = ["RoughLevel", "rough_integrals"]
 
 FloatArray = NDArray[np.float64]
-#: ``|jellett + I3 k w3|`` at a pole below this times the level's size is a pole level (refused).
+#: ``|jellett + I3 k w3|`` at a pole below this times the level's size is a pole level.
 POLE_LEVEL_TOLERANCE = 1e-9
 
 
@@ -64,9 +77,8 @@ class RoughLevel(LevelSet):
     integrals: ClassVar[tuple[str, ...]] = ("jellett", "routh")
     model: ClassVar[str] = "rough"
     near_pole_limits: ClassVar[bool] = False
-    #: :attr:`LevelSet.pole_advice`: its pole levels are refused.
-    pole_advice: ClassVar[str] = ("its pole levels are not reduced: integrate the full system "
-                                  "(rollingtop simulate)")  # fmt: skip
+    #: :attr:`LevelSet.pole_advice`.
+    pole_advice: ClassVar[str] = "for the pole level set jellett = -I3 (R +- a3) w3 exactly"
 
     #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
     #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
@@ -81,20 +93,16 @@ class RoughLevel(LevelSet):
         check_level_values(self, ("jellett", "routh"))
         for name in ("M3", "C1", "C2"):
             object.__setattr__(self, name, 0.0)
-        object.__setattr__(self, "pole", None)
+        # values read from a state: round-off of |I w| |r| (scale) counts as zero
+        size = max(abs(self.jellett), abs(self.routh) * self.body.R,
+                   abs(float(self.scale)) * (self.body.R + abs(self.body.a3)), 1e-300)  # fmt: skip
+        south, north = (abs(x) <= POLE_LEVEL_TOLERANCE * size for x in self.pole_offsets())
+        pole = "both" if south and north else "south" if south else "north" if north else None
+        if pole == "both":  # no spin: jellett = routh = 0 exactly (module docstring)
+            object.__setattr__(self, "jellett", 0.0)
+            object.__setattr__(self, "routh", 0.0)
+        object.__setattr__(self, "pole", pole)
         check_level_size(self)
-        size = max(abs(self.jellett), abs(self.routh) * self.body.R, 1e-300)
-        for theta, name in ((0.0, "south (gamma3 = 1)"), (math.pi, "north (gamma3 = -1)")):
-            if abs(self._numerator(theta)) <= POLE_LEVEL_TOLERANCE * size:
-                raise PoleLevelError(
-                    f"level {self.describe()} lets the {name} pole touch the plane (jellett + "
-                    "I3 k w3 = 0 there): the rough model's pole levels are not reduced yet"
-                )
-
-    def pole_offsets(self) -> tuple[float, float]:
-        """``jellett + I3 k w3`` at the south and north poles: 0 on a pole level
-        (:func:`~rollingtop.reduction.level.near_north` mirrors a level nearer the north one)."""
-        return self._numerator(0.0), self._numerator(math.pi)
 
     def mirrored(self) -> RoughLevel:
         """The same motions with the body axis reversed: ``theta -> pi - theta``,
@@ -105,6 +113,9 @@ class RoughLevel(LevelSet):
     # ---- the spin, w_n and their derivatives, complex-safe (the complex step of d2U) -------
     def _parts(self, theta: Any) -> tuple[Any, ...]:
         """``(s, c, k, w3, w_n)`` and their theta-derivatives ``(k', w3', w_n')``."""
+        if self.pole == "north":  # the south pole level of the mirrored body, theta -> pi - theta
+            s, c, k, w3, w_n, dk, dw3, dw_n = self.mirrored()._parts(np.pi - theta)
+            return s, -c, -k, -w3, w_n, dk, dw3, -dw_n
         b = self.body
         s, c = np.sin(theta), np.cos(theta)
         k, dk = b.R * c + b.a3, -b.R * s
@@ -112,11 +123,50 @@ class RoughLevel(LevelSet):
         df = 2 * b.m * b.R * s * (b.I1 * b.R * c - b.I3 * k)
         w3 = self.routh / np.sqrt(f)
         dw3 = -0.5 * w3 * df / f
+        if self.pole == "both":  # no spin: w3 = w_n = 0
+            zero = 0.0 * s
+            return s, c, k, w3, zero, dk, dw3, zero
+        if self.pole == "south":
+            w_n = self._pole_w_n(theta, k, f)
+            # d(w_n)/dtheta from N' = I1 R (s w_n)': w_n' = (N' / (I1 R) - c w_n) / s, regular
+            # at the pole by l'Hopital: there w_n' = N''(0) / (2 I1 R)
+            dN = b.I3 * (dw3 * k + w3 * dk)
+            with np.errstate(all="ignore"):
+                dw_n = (dN / (b.I1 * b.R) - c * w_n) / s
+            dw_n = np.where(np.abs(s) < 1e-8, self._pole_dw_n0(), dw_n)
+            if not np.ndim(s):
+                dw_n = dw_n[()]
+            return s, c, k, w3, w_n, dk, dw3, dw_n
         N = self.jellett + b.I3 * k * w3
         dN = b.I3 * (dw3 * k + w3 * dk)
         w_n = N / (b.I1 * b.R * s)
         dw_n = dN / (b.I1 * b.R * s) - w_n * c / s
         return s, c, k, w3, w_n, dk, dw3, dw_n
+
+    def _pole_w_n(self, theta: Any, k: Any, f: Any) -> Any:
+        """``w_n`` on the south pole level, free of cancellation next to the pole (module
+        docstring)."""
+        b = self.body
+        k0 = b.R + b.a3
+        f0 = b.I1 * b.I3 + b.m * b.I3 * k0 * k0
+        half = np.sin(theta / 2)
+        sigma = half * half
+        rf, rf0 = np.sqrt(f), math.sqrt(f0)
+        bracket = b.I3 * (k + k0) + 2 * b.m * b.R * (1 - sigma) * k0 * k0
+        with np.errstate(all="ignore"):
+            denominator = rf * rf0 * (k * rf0 + k0 * rf)
+            near = -b.I3 * self.routh * np.tan(theta / 2) * bracket / denominator
+            far = b.I3 * self.routh * (k / rf - k0 / rf0) / (b.I1 * b.R * np.sin(theta))
+        out = np.where(np.real(k) > 0, near, far)
+        return out if np.ndim(k) else out[()]
+
+    def _pole_dw_n0(self) -> float:
+        """``w_n'(0)`` on the south pole level: ``tan(theta/2) ~ theta/2`` in :meth:`_pole_w_n`."""
+        b = self.body
+        k0 = b.R + b.a3
+        f0 = b.I1 * b.I3 + b.m * b.I3 * k0 * k0
+        bracket = 2 * b.I3 * k0 + 2 * b.m * b.R * k0 * k0
+        return float(-b.I3 * self.routh * 0.5 * bracket / (f0 * 2 * k0 * math.sqrt(f0)))
 
     def _numerator(self, theta: float) -> float:
         """``jellett + I3 k w3`` at ``theta``: ``I1 R s w_n``, 0 at a pole of a pole level."""
@@ -164,9 +214,28 @@ class RoughLevel(LevelSet):
         return out
 
     def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
-        """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model)."""
-        rate: float | FloatArray = -self._parts(theta)[4] / np.sin(theta)
+        """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model); on a pole level
+        finite at the pole (``w_n ~ s``): its limit there."""
+        s, w_n = np.sin(theta), self._parts(theta)[4]
+        if self.pole in ("south", "north"):  # w_n ~ w_n'(pole) s next to the pole
+            pole, mirror = (0.0, self) if self.pole == "south" else (math.pi, self.mirrored())
+            with np.errstate(all="ignore"):
+                away = -w_n / s
+            near = np.abs(np.asarray(theta) - pole) < 1e-8
+            rate: float | FloatArray = np.where(near, -mirror._pole_dw_n0(), away)
+            return rate if np.ndim(theta) else float(rate)
+        rate = -w_n / s
         return rate
+
+    def pole_offsets(self) -> tuple[float, float]:
+        """``jellett + I3 k w3`` at the south and north poles: 0 on a pole level
+        (:func:`~rollingtop.reduction.level.near_north` mirrors a level nearer the north one)."""
+        return self._numerator(0.0), self._numerator(math.pi)
+
+    def pole_label(self) -> str:
+        """The pole level in words, for :meth:`describe`."""
+        return {None: "", "south": " (south pole level)", "north": " (north pole level)",
+                "both": " (no spin: both poles)"}[self.pole]  # fmt: skip
 
     #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here (``M3 = 0``).
     energy_formula: ClassVar[str] = "h + m g R"
@@ -177,7 +246,7 @@ class RoughLevel(LevelSet):
 
     def describe(self) -> str:
         """One line naming the level set."""
-        return f"jellett = {self.jellett:g}, routh = {self.routh:g}"
+        return f"jellett = {self.jellett:g}, routh = {self.routh:g}{self.pole_label()}"
 
 
 def rough_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
