@@ -104,6 +104,8 @@ def test_an_edit_of_a_model_recompiles_that_model_and_no_other(tmp_path):
     first, _ = _run(src, cache, "smooth", "rhs")
     assert _ours(first["compiled"], "rollingtop._compiled.smooth.dynamics.rhs")
     again, _ = _run(src, cache, "smooth", "rhs")
+    # loaded machine code is the compiled code: the same numbers to the last bit (so are the
+    # kinematics the edit leaves alone, and the rough model's entries below)
     assert again["compiled"] == [] and again["dy"] == first["dy"]
     rough, _ = _run(src, cache, "rough", "rhs")
     assert not _ours(rough["compiled"], "rollingtop._compiled.smooth")
@@ -148,7 +150,7 @@ def test_two_models_never_share_an_entry(tmp_path):
     _run(src, shared, "smooth", "rhs")
     after, _ = _run(src, shared, "rough", "rhs")
     assert _ours(after["compiled"], "rollingtop._compiled.rough.dynamics.rhs")
-    assert after["dy"] == alone["dy"]
+    assert after["dy"] == alone["dy"]  # the same kernel on the same state: the same bits
     index = {p.parent.parent.name for p in (shared / "rollingtop").rglob("dynamics.rhs-*.nbi")}
     assert {"rollingtop._compiled.smooth.dynamics", "rollingtop._compiled.rough.dynamics"} <= index
     # data files are named by their key, not numbered from the index a process last read
@@ -187,7 +189,7 @@ def test_a_fresh_process_imports_a_models_kernels_by_name(tmp_path):
         with distributed.Client(cluster) as client:
             file, dy = client.submit(rhs_by_name, name).result(timeout=300)
     assert Path(file) == _instances.TEMPLATE / "dynamics.py"
-    assert rhs_by_name(name)[1] == pytest.approx(dy, rel=0, abs=0)
+    assert rhs_by_name(name)[1] == pytest.approx(dy, rel=0, abs=0)  # the same kernel: exact
 
 
 def test_an_unwritable_cache_folder_runs_with_one_notice(tmp_path):

@@ -54,6 +54,7 @@ def test_performance_page_is_generated_from_results(run_benchmarks, results):
 def test_results_hold_the_numbers_issue_13_asks_for(results):
     """The C ratio with identical steps, the cold and warm starts, the peers, the scaling."""
     c = results["C"]
+    # the C limit computes rollingtop's numbers to the last bit (test_c_limit): a difference of 0
     assert c["identical_steps"] and c["final_state_difference"] == 0.0
     assert len(c["ratios"]) >= 5 and c["ratio_median"] > 0
     assert {"portrait_empty_cache_s", "simulate_empty_cache_s", "rough_after_paper_s",

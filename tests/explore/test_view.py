@@ -88,6 +88,7 @@ def test_the_diagram_marks_the_level_and_its_curves_are_critical_values(fig5):
 
     lo, hi = view.x_range
     inside = [f for f in folds(fig5.body, 1.0, 0.5) if lo <= f.C2 <= hi]
+    # the diagram's folds are folds()'s: one computation, so exact
     assert sorted(view.folds[0]) == sorted(f.C2 for f in inside) and inside
 
 

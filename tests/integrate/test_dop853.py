@@ -151,7 +151,7 @@ def test_progress_callback_does_not_change_the_result(monkeypatch):
     seen = []
     with_progress = simulate(sc, progress=seen.append)
     plain = simulate(sc)
-    np.testing.assert_array_equal(with_progress.y, plain.y)
+    np.testing.assert_array_equal(with_progress.y, plain.y)  # the same steps: the same bits
     assert len(seen) > 5 and seen == sorted(seen) and seen[-1] == 50.0
 
 
@@ -248,6 +248,7 @@ def test_event_capacity_keeps_the_first_events_and_counts_the_rest():
     capped = integrate(MERIDIAN, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12, events="w_tau",
                        event_direction=1, max_events=3)  # fmt: skip
     assert capped.events_dropped == 7
+    # the same steps and roots, only fewer kept: exact equality is the claim
     np.testing.assert_array_equal(capped.event_t, full.event_t[:3])
     np.testing.assert_array_equal(capped.event_y, full.event_y[:3])
     none = integrate(MERIDIAN, p, sc.y0, t_eval, rtol=1e-10, atol=1e-12)
@@ -257,7 +258,8 @@ def test_event_capacity_keeps_the_first_events_and_counts_the_rest():
 
 def test_chunks_of_the_compiled_loop_take_the_same_steps(monkeypatch):
     """The driver always runs the compiled loop in chunks of PROGRESS_CHUNK accepted steps (so
-    that signal handlers run); any chunk size gives the same steps, samples, events, reactions."""
+    that signal handlers run); any chunk size gives the same steps, samples, events, reactions:
+    the same computation, so the same numbers to the last bit."""
     from rollingtop.integrate import driver
 
     sc = scenario(t_end=50.0, samples=11)

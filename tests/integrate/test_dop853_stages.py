@@ -30,7 +30,8 @@ def test_stage_equals_tableau_sum(s):
 
 
 def test_thirteenth_stage_is_the_solution():
-    """The stepper forms the new point with ``stage(K, 12, ...)``: first same as last."""
+    """The stepper forms the new point with ``stage(K, 12, ...)``: first same as last. Both rows
+    are literals of the tableau, so they are the same numbers exactly."""
     assert np.array_equal(A[12, :12], B)
 
 

@@ -58,7 +58,7 @@ def _step_events(body, y, Fd, direction, prev_g):
                  _kernel.new_workspace(), True)  # fmt: skip
     assert ready
     assert ctrl[G_OLD] == pytest.approx(y_end[12] * y_end[4])
-    assert (ctrl[EV_PREV_T], ctrl[EV_PREV_G]) == (t, y[12] * y[4])  # moved on by one step
+    assert (ctrl[EV_PREV_T], ctrl[EV_PREV_G]) == (t, y[12] * y[4])  # moved on by one step: copied
     return ev_t[: min(counts[N_EVENTS], 4)].copy(), counts[N_EVENTS]
 
 

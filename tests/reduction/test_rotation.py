@@ -98,6 +98,7 @@ def test_resonance_points_have_integer_rotation_numbers(small_map):
         level = LevelSet(PAPER, 1.0, 0.5, r["C2"])
         n = rot.rotation_numbers(level, r["h"])[r["orbit"]]
         assert n == pytest.approx(r["p"] / r["q"], abs=1e-9)
+        # N is the fraction p/q itself, correctly rounded either way: exact
         assert r["N"] == r["p"] / r["q"] and r["q"] <= rot.CURVE_DENOMINATOR
 
 
@@ -157,7 +158,7 @@ def test_cli_rotation_empty_window_is_one_line(capsys):
 
 def test_rotation_map_on_a_pole_level():
     """C1 = M3: orbits above the pole's energy pass through the pole; N is defined there too and
-    the map holds what rotation_numbers gives."""
+    the map holds what rotation_numbers gives (the same computation: to the last bit)."""
     rmap = rot.rotation_map(PAPER, 1.0, 1.0, C2_range=(-0.5, 0.5), h_range=(0.2, 1.5),
                             resolution=(5, 5))  # fmt: skip
     n0 = rmap.N[:, :, 0]
