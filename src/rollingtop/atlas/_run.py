@@ -9,6 +9,7 @@ import functools
 import json
 import os
 import shutil
+import signal
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -144,8 +145,17 @@ def _client(
             from rollingtop.atlas._quiet import QuietWorker
 
             local.register_plugin(QuietWorker(), name="rollingtop-quiet-worker")
+            # the workers' processes, asked while they are idle: a worker running a compiled
+            # chunk holds its GIL and answers no one, so a stopped run kills them (its chunks
+            # are saved by this process) instead of waiting seconds for the chunk to end
+            pids = list(local.run(os.getpid).values())
             try:
                 yield local
+            except BaseException:
+                for pid in pids:
+                    with contextlib.suppress(OSError):
+                        os.kill(pid, signal.SIGKILL)
+                raise
             finally:
                 local.close()
         finally:
