@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from rollingtop.absolute import PeriodMap, period_map
 from rollingtop.reduction import LevelSet, LevelSetError, Orbit, orbits, reduce_state
 from rollingtop.reduction.near_pole import NearPole, near_pole
@@ -79,14 +81,20 @@ def survey_orbits(level: LevelSet, h: float) -> list[OrbitSurvey]:
         No motion on the level with this ``h``.
     """
     found = orbits(level, h)
-    return [
-        OrbitSurvey(
-            o,
-            period_map(level, h, o) if o.kind == "periodic" else None,
-            near_pole(level, h, o),
-        )  # fmt: skip
-        for o in found
-    ]
+    return [OrbitSurvey(o, _map_or_none(level, h, o), near_pole(level, h, o)) for o in found]
+
+
+def _map_or_none(level: LevelSet, h: float, orbit: Orbit) -> PeriodMap | None:
+    """The orbit's per-period map, or ``None`` where there is none (not periodic) or where its
+    reconstruction in space fails (a wall within round-off of the far pole: the precession rate
+    there is beyond what the quadrature resolves): the orbit is still listed, without it."""
+    if orbit.kind != "periodic":
+        return None
+    try:
+        with np.errstate(all="ignore"):
+            return period_map(level, h, orbit)
+    except LevelSetError:
+        return None
 
 
 def motion_period_map(scenario: Scenario) -> PeriodMap | None:

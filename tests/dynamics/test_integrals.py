@@ -1,5 +1,7 @@
 """First integrals: conserved where docs/model.md says, and the models differ where physics says."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -120,9 +122,10 @@ def test_energy_by_hand(paper_body):
 
 
 def test_natural_scales_by_hand(paper_body):
-    """The natural size of each integral, written out for two states of the paper's body: the
-    energy's is the kinetic energy plus |m g (r, gamma)|; a linear integral's the sum of its
-    terms' magnitudes (``I1 = I2 = 0.3, I3 = 0.5, a3 = 0.1, R = m = g = 1``)."""
+    """The natural size of each integral, written out for two states of the paper's body
+    (``I1 = I2 = 0.3, I3 = 0.5, a3 = 0.1, R = m = g = 1``): the energy's is the kinetic energy
+    plus |m g (r, gamma)|; a linear integral's is |grad I| |u| in the kinetic-energy metric,
+    ``sqrt(sum_i I_i c_i^2) sqrt(m |v|^2 + sum_i I_i w_i^2)`` for ``I = sum_i I_i w_i c_i``."""
     Y = np.zeros((2, 18))
     Y[0, 0:6] = (0.1, -0.2, 0.3, 0.5, 0.0, -1.0)
     Y[0, 12:15] = (0.0, 0.6, 0.8)
@@ -134,19 +137,16 @@ def test_natural_scales_by_hand(paper_body):
     assert sizes["energy"] == pytest.approx(
         max(map(sum, zip(kinetic, potential, strict=True))), rel=1e-15
     )
-    assert sizes["lagrange"] == pytest.approx(0.5 * 2.0, rel=1e-15)
-    # jellett = (I w, r), r = -R gamma - a3 e3: terms I_i w_i r_i
-    r = [(0.0, -0.6, -0.9), (-0.6, 0.0, 0.7)]
-    w = [(0.5, 0.0, -1.0), (0.2, 0.1, 2.0)]
     inertia = (0.3, 0.3, 0.5)
-    jellett = [
-        sum(abs(i * a * b) for i, a, b in zip(inertia, wk, rk, strict=True))
-        for wk, rk in zip(w, r, strict=True)
-    ]
-    assert sizes["jellett"] == pytest.approx(max(jellett), rel=1e-15)
-    gammas = [(0.0, 0.6, 0.8), (0.6, 0.0, -0.8)]
-    area = [
-        sum(abs(i * a * b) for i, a, b in zip(inertia, wk, gk, strict=True))
-        for wk, gk in zip(w, gammas, strict=True)
-    ]
-    assert sizes["area"] == pytest.approx(max(area), rel=1e-15)
+    speed = [math.sqrt(2 * k) for k in kinetic]  # |u|_M^2 = 2 T
+
+    def size(coefficients):
+        return max(
+            math.sqrt(sum(i * c * c for i, c in zip(inertia, cs, strict=True))) * u
+            for cs, u in zip(coefficients, speed, strict=True)
+        )
+
+    assert sizes["lagrange"] == pytest.approx(size([(0, 0, 1), (0, 0, 1)]), rel=1e-15)
+    # jellett = (I w, r), r = -R gamma - a3 e3; area = (I w, gamma)
+    assert sizes["jellett"] == pytest.approx(size([(0, -0.6, -0.9), (-0.6, 0, 0.7)]), rel=1e-15)
+    assert sizes["area"] == pytest.approx(size([(0, 0.6, 0.8), (0.6, 0, -0.8)]), rel=1e-15)

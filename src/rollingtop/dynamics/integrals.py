@@ -297,30 +297,36 @@ def natural_scales(
     slot_is_velocity: bool = False,
 ) -> dict[str, float]:
     """The natural size of each integral ``names`` along the states ``Y`` (shape ``(n, 18)``):
-    the largest, over the states, of the sum of the magnitudes of its terms, so that a drift
-    divided by it is a drift relative to round-off of the integral's evaluation, whatever the
-    integral's own value (which may be zero).
+    the largest, over the states, of the size the integral can take at the state's speed, so
+    that a drift divided by it is a drift relative to the round-off of the motion, whatever the
+    integral's own value (which may be zero, with every term of it: the spin of a body that
+    rolls over).
 
     Every integral but the energy is homogeneous of degree one in the velocity ``u`` (``v``,
-    ``w`` and, with ``slot_is_velocity``, the state's last slot: the shell's spin): its terms
-    are its values at each velocity component alone, ``sum_j |I(u_j e_j)|`` (at least ``|I|``
-    by the triangle inequality). The energy's are the kinetic energy and the magnitude of the
-    potential, ``(E - E|u=0) + |E|u=0|``.
+    ``w`` and, with ``slot_is_velocity``, the state's last slot: the shell's spin): by
+    Cauchy-Schwarz ``|I| <= |grad I|_(M^-1) |u|_M`` in the kinetic-energy metric ``M =
+    diag(m, m, m, I1, I2, I3[, shell_inertia])``, with ``grad I`` read off the integral at each
+    unit velocity component (for ``slip_nu``, a norm, a bound of it). The energy's size is the
+    kinetic energy plus the magnitude of the potential, ``(E - E|u=0) + |E|u=0|``.
     """
     Y = np.atleast_2d(np.asarray(Y, dtype=float))
     velocity = [*range(6), *([PSI_NU] if slot_is_velocity else [])]
     still = Y.copy()
     still[:, velocity] = 0.0
+    metric = [body.m] * 3 + [float(x) for x in body.inertia]
+    metric += [body.shell_inertia] * slot_is_velocity
+    speed = np.sqrt(np.sum(np.asarray(metric) * Y[:, velocity] ** 2, axis=-1))  # |u|_M
     out = {}
     for name in names:
         if name == "energy":
             e0 = energy(body, still)
             size = energy(body, Y) - e0 + np.abs(e0)
         else:
-            size = np.zeros(Y.shape[0])
-            for j in velocity:
-                one = still.copy()
-                one[:, j] = Y[:, j]
-                size += np.abs(evaluate(body, one, (name,), pole)[name])
+            dual = np.zeros(Y.shape[0])  # |grad I|^2 in the metric M^-1
+            for j, mass in zip(velocity, metric, strict=True):
+                unit = still.copy()
+                unit[:, j] = 1.0
+                dual += evaluate(body, unit, (name,), pole)[name] ** 2 / mass
+            size = np.sqrt(dual) * speed
         out[name] = float(np.max(size)) if size.size else 0.0
     return out
