@@ -199,8 +199,8 @@ class Trajectory(NetCDFOutput):
         """Summary as a JSON-ready dict (the output of ``rollingtop simulate --json``).
 
         Keys: ``model, t_end, final, integrals, constraints, reactions, stats`` (see README).
-        Each integral's ``max_rel_drift`` is its largest drift over its natural size (the sum of
-        its terms' magnitudes: :func:`~rollingtop.dynamics.integrals.natural_scales`). A run that
+        Each integral's ``max_rel_drift`` is its largest drift over its natural size (the size
+        it can take at the run's speed: :func:`~rollingtop.dynamics.integrals.natural_scales`). A run that
         held its integrals by projection adds ``projection``: ``held`` (every drift within
         ``tolerance``, :data:`~rollingtop.dynamics.integrals.HELD_TOLERANCE`), ``worst`` (the
         integral of largest relative drift) and its ``max_rel_drift``.
@@ -227,7 +227,7 @@ class Trajectory(NetCDFOutput):
                 "initial": float(values[0]),
                 "final": float(values[-1]),
                 "max_abs_drift": drift,
-                # on the integral's natural size: the sum of its terms' magnitudes
+                # on the integral's natural size: the size it can take at the run's speed
                 "max_rel_drift": drift / scales[name] if scales[name] > 0 else None,
             }
         min_normal = min(
