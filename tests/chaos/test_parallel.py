@@ -64,8 +64,8 @@ def test_the_parallel_exponent_by_two_nearby_trajectories():
 
 
 def test_the_readme_states_what_the_chaos_command_measures():
-    """README: 'the finite-time maximal Lyapunov exponent ... is 0.02 at t = 3000 and the mean
-    MEGNO 31' (a finite-time exponent of a chaotic motion: its digits move with the last bits
+    """README: 'the finite-time maximal Lyapunov exponent ... is 0.018 at t = 3000 and the mean
+    MEGNO 24' (a finite-time exponent of a chaotic motion: its digits move with the last bits
     of the compiled code), for examples/parallel_chaotic.toml."""
     from pathlib import Path
 
