@@ -200,10 +200,10 @@ class Trajectory(NetCDFOutput):
 
         Keys: ``model, t_end, final, integrals, constraints, reactions, stats`` (see README).
         Each integral's ``max_rel_drift`` is its largest drift over its natural size (the size
-        it can take at the run's speed: :func:`~rollingtop.dynamics.integrals.natural_scales`). A run that
-        held its integrals by projection adds ``projection``: ``held`` (every drift within
-        ``tolerance``, :data:`~rollingtop.dynamics.integrals.HELD_TOLERANCE`), ``worst`` (the
-        integral of largest relative drift) and its ``max_rel_drift``.
+        it can take at the run's speed: :func:`~rollingtop.dynamics.integrals.natural_scales`).
+        A run that held its integrals by projection adds ``projection``: ``held`` (every drift
+        within ``tolerance``, :data:`~rollingtop.dynamics.integrals.HELD_TOLERANCE`), ``worst``
+        (the integral of largest relative drift) and its ``max_rel_drift``.
         """
         last = self.y[-1]
         final = {

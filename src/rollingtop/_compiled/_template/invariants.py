@@ -35,11 +35,14 @@ the step was. Only where neither exists (a steady motion whose level is one poin
 itself for the tilt) is the energy left for the next steps (``counts[PROJ_DEFERRED]`` of the
 stepper).
 
-**Round-off is not corrected.** A row's residual (after the earlier rows are taken out) below
-the round-off of its integral's value, ``ROUNDOFF * sqrt(q_k) |u|_M`` (the integral's natural
-size at this velocity), is set to zero: the row still keeps the correction off its direction,
-but a nearly dependent row (the integrals near the vertical, where Jellett's and the area
-integral tend to Lagrange's) no longer turns round-off into a velocity change.
+**Round-off is not amplified.** A nearly dependent row (the integrals near the vertical,
+where Jellett's and the area integral tend to Lagrange's) would turn the round-off of its
+residual into a velocity change ``1 / sqrt(left)`` times larger. Where its part orthogonal to
+the earlier rows is below :data:`ILL_CONDITIONED` of its size and its residual below the
+round-off of its integral's value, ``ROUNDOFF * sqrt(q_k) |u|_M`` (the integral's natural size
+at this velocity), the residual is set to zero: the row still keeps the correction off its
+direction. A well-conditioned row's round-off is corrected (else it would be left to wander
+up to that bound).
 
 ``F6`` carries ``-M3 a3 theta``, with the signed ``theta`` of the carried direction: its value
 jumps by ``2 pi M3 a3`` where ``atan2`` wraps (a passage of the north pole in a pole case), so
@@ -61,8 +64,11 @@ __all__ = ["project_integrals"]
 #: dual metric) is dependent on them: dropped.
 DEPENDENT = 1e-4
 #: A residual below this many units of round-off of its integral's natural size is round-off:
-#: not corrected (module docstring).
+#: not corrected where its row is ill-conditioned (module docstring).
 ROUNDOFF = 16.0 * 2.220446049250313e-16
+#: A row whose part orthogonal to the earlier ones is below this fraction of its size is
+#: ill-conditioned: a correction along it is its residual amplified.
+ILL_CONDITIONED = 0.1
 #: A velocity correction beyond this fraction of the velocity's size is refused (the attitude is
 #: used, or the integral left for later).
 MAX_CHANGE = 0.5
@@ -168,9 +174,11 @@ def _linear(
             natural += pw[n_rows, k] * pw[n_rows, k] * minv[k]
         natural = math.sqrt(natural) * usize
         pw[n_rows, 6] = -res
-        if _orthogonalise(pw, n_rows, n_rows, minv) > DEPENDENT * DEPENDENT:
-            if abs(pw[n_rows, 6]) <= ROUNDOFF * natural:
-                pw[n_rows, 6] = 0.0  # round-off: kept as a row, not corrected
+        left = _orthogonalise(pw, n_rows, n_rows, minv)
+        if left > DEPENDENT * DEPENDENT:
+            noise = abs(pw[n_rows, 6]) <= ROUNDOFF * natural
+            if noise and left < ILL_CONDITIONED * ILL_CONDITIONED:
+                pw[n_rows, 6] = 0.0  # round-off that 1 / sqrt(left) would amplify: not corrected
             size = 0.0
             for k in range(6):
                 size += pw[n_rows, k] * pw[n_rows, k] * minv[k]
