@@ -154,7 +154,7 @@ def _client(
             except BaseException:
                 for pid in pids:
                     with contextlib.suppress(OSError):
-                        os.kill(pid, signal.SIGKILL)
+                        os.kill(pid, getattr(signal, "SIGKILL", signal.SIGTERM))
                 raise
             finally:
                 local.close()

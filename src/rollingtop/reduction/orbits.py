@@ -189,7 +189,7 @@ def _make_orbit(
     w_tau_max = float(np.max(level.w_tau(thetas, h)))
     note = "passes through the pole" if passage else ""
     # steady motion: a centre with h at (or within round-off of) its potential
-    if t2 - t1 < 1e-7 or any(
+    if t2 - t1 < 1e-7 * max(abs(t1), abs(t2)) or any(
         steadies[c].type == "center"
         and t1 <= c <= t2
         and h - steadies[c].U <= STEADY_TOLERANCE * scale

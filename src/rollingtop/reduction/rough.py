@@ -101,6 +101,11 @@ class RoughLevel(LevelSet):
         if pole == "both":  # no spin: jellett = routh = 0 exactly (module docstring)
             object.__setattr__(self, "jellett", 0.0)
             object.__setattr__(self, "routh", 0.0)
+        elif pole is not None:  # snapped to the pole level exactly, so that its mirror image
+            b = self.body  # (the north one's computation) is the same pole level
+            k = b.R * (1.0 if pole == "south" else -1.0) + b.a3
+            exact = -b.I3 * k * self.routh / math.sqrt(b.I1 * b.I3 + b.m * b.I3 * k * k)
+            object.__setattr__(self, "jellett", exact)
         object.__setattr__(self, "pole", pole)
         check_level_size(self)
 
@@ -216,7 +221,8 @@ class RoughLevel(LevelSet):
     def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
         """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model); on a pole level
         finite at the pole (``w_n ~ s``): its limit there."""
-        s, w_n = np.sin(theta), self._parts(theta)[4]
+        parts = self._parts(theta)  # s of the mirror image (pi - theta) for the north pole
+        s, w_n = parts[0], parts[4]
         if self.pole in ("south", "north"):  # w_n ~ w_n'(pole) s next to the pole
             pole, mirror = (0.0, self) if self.pole == "south" else (math.pi, self.mirrored())
             with np.errstate(all="ignore"):

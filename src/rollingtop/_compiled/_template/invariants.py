@@ -309,7 +309,12 @@ def project_integrals(
                     slope = (up - down) / (2.0 * TILT_STEP)
                     if slope != 0.0 and math.isfinite(slope):
                         phi = -res / slope
-                        tilt = abs(phi)
+                        # taken only if it brings the energy nearer (a small slope near a
+                        # centre of U would jump the attitude the wrong way)
+                        after = _tilted_energy(code, p, trial, src, phi, ic, icodes, targets, pw,
+                                               ws, minv)  # fmt: skip
+                        if abs(after - targets[i]) < abs(res):
+                            tilt = abs(phi)
                 # pw's rows were used by the trials: the rows of y again
                 n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
                 if tilt < change and tilt <= MAX_CHANGE:
@@ -317,6 +322,9 @@ def project_integrals(
                     for k in range(18):
                         y[k] = trial[k]
                     moved = True
+                    # back on the constraints, with the rows of the new attitude for the next
+                    # integral of this pass
+                    n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
                     continue
                 velocity_gradient(ic, p, y, grad)
                 for k in range(6):
