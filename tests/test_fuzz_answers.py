@@ -35,15 +35,13 @@ def invoke(args):
     return code, out, "".join(kept)
 
 
-MODELS = ("meridian", "smooth", "rough", "rubber", "parallel")
+MODELS = ("meridian", "smooth", "rough", "rubber", "parallel", "shell-rotor")
 BODY = "[body]\nR = 1.0\nm = 1.0\ng = 1.0\na3 = 0.1\nI1 = 0.3\nI3 = 0.5\n"
+SHELL = "[shell]\nmass = 0.2\ninertia = 0.13333333333333333\n"
 
 component = st.one_of(
     st.just(0.0),
-    # ordinary magnitudes; the tiny ones are the sampled values below (a drawn 7.6e-213 along x
-    # with gamma tilted by 1e-9 met rubber rolling's (omega, gamma) = 0 check at its tolerance:
-    # left open, see the note)
-    st.floats(-3.0, 3.0, allow_nan=False).filter(lambda x: x == 0.0 or abs(x) > 1e-100),
+    st.floats(-3.0, 3.0, allow_nan=False),
     st.sampled_from([1e-300, -1e-300, 1e-12, 2.0, -2.0]),
 )
 
@@ -68,15 +66,17 @@ def admissible_states(draw):
             [math.sin(tilt) * math.cos(az), math.sin(tilt) * math.sin(az), math.cos(tilt)]
         )
     omega = np.array([draw(component) for _ in range(3)])
-    if model == "rubber":
-        omega = omega - float(omega @ gamma) * gamma
+    if model == "rubber":  # projected twice: once leaves a relative residual ~ the tilt when
+        for _ in range(2):  # omega is nearly vertical (7.6e-204 e3 at a tilt of 1e-9 became
+            omega = omega - float(omega @ gamma) * gamma  # -7.6e-213 e1: 1e-9 off, refused)
     return model, gamma, omega
 
 
 def scenario_text(model, gamma, omega, extra=""):
     vec = lambda x: "[" + ", ".join(repr(float(v)) for v in x) + "]"  # noqa: E731
+    shell = SHELL if model == "shell-rotor" else ""
     return (
-        f'{BODY}[contact]\nmodel = "{model}"\n[initial]\ngamma = {vec(gamma)}\n'
+        f'{BODY}{shell}[contact]\nmodel = "{model}"\n[initial]\ngamma = {vec(gamma)}\n'
         f"omega = {vec(omega)}\n[integration]\nt_end = 0.05\n{extra}"
     )
 
@@ -104,7 +104,7 @@ def test_fuzz_a_valid_state_is_run_and_classified(tmp_path_factory, state):
 @pytest.mark.slow
 @fuzz(20)
 @given(
-    state=admissible_states(),
+    state=admissible_states().filter(lambda state: state[0] != "shell-rotor"),  # refused at once
     tol=st.sampled_from(["1e-2", "1e-3", "1e-5", "1e-7", "1e-10"]),
     output=st.booleans(),
 )

@@ -79,19 +79,24 @@ def test_rough_pole_level_runs_and_writes(tmp_path, suffix):
     [
         ("rough", "gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\n"),
         ("meridian", "gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\nv_tau = 0.0\n"),
+        ("shell-rotor", "gamma = [0.0, 0.0, 1.0]\nomega = [0.0, 0.0, 2.0]\nv_tau = 0.0\n"),
     ],
 )
 def test_sleeping_top_simulates(tmp_path, model, initial):
-    """The sleeping top stays asleep: exit 0 and omega3 exact."""
+    """The sleeping top stays asleep: exit 0 and omega3 exact; its level is shown (every
+    integrable model's pole levels are reduced since item 5)."""
+    shell = "[shell]\nmass = 0.2\ninertia = 0.13333333333333333\n" if model == "shell-rotor" else ""
     path = scenario(
         tmp_path,
         "s.toml",
-        f'{BODY}[contact]\nmodel = "{model}"\n[initial]\n{initial}[integration]\nt_end = 3.0\n',
+        f'{BODY}{shell}[contact]\nmodel = "{model}"\n[initial]\n{initial}'
+        "[integration]\nt_end = 3.0\n",
     )
     code, stdout, err = rollingtop("simulate", path, "--json")
     assert code == 0, err
-    final = json.loads(stdout)["final"]
-    assert abs(final["omega"][2] - 2.0) < 1e-12
+    summary = json.loads(stdout)
+    assert abs(summary["final"]["omega"][2] - 2.0) < 1e-12
+    assert "level" in summary
 
 
 def test_refusal_after_writing_leaves_no_file(tmp_path, capsys):
@@ -483,3 +488,31 @@ def test_ctrl_c_ends_an_atlas_before_its_running_chunk(tmp_path):
 #: Ctrl-C to the end of the process: measured 0.42 s, against 4.46 s when the cluster's close
 #: waited for the worker's running chunk (2 cores, the suite running beside it).
 STOP_S = 2.0
+
+
+@pytest.mark.parametrize(
+    ("gamma", "omega", "accepted"),
+    [
+        # row 14: horizontal and tiny (|omega| squared underflows): was refused, tolerance 0
+        ("[0.0, 0.6, 0.8]", "[0.0, -4.8e-301, 3.6e-301]", True),
+        # vertical and tiny: was accepted (the norm 0 made every residual pass) and projected
+        ("[0.0, 0.6, 0.8]", "[0.0, 0.0, 1e-300]", False),
+        # a nearly vertical spin projected twice off a tilt of 1e-9 (the fuzz's draw)
+        ("[1e-09, 0.0, 1.0]", "[-7.6e-213, 0.0, 7.6e-222]", True),
+    ],
+)
+def test_a_tiny_rubber_spin_is_judged_by_its_direction(tmp_path, gamma, omega, accepted):
+    """Issue 36 row 14: rubber rolling's ``(omega, gamma) = 0`` is checked on omega's direction,
+    whatever its size: ``UNIT_TOLERANCE |omega|`` underflowed (and ``|omega|`` with it)."""
+    path = scenario(
+        tmp_path,
+        "r.toml",
+        f'{BODY}[contact]\nmodel = "rubber"\n[initial]\ngamma = {gamma}\nomega = {omega}\n'
+        "[integration]\nt_end = 0.1\n",
+    )
+    code, out, err = rollingtop("simulate", path, "--json")
+    if accepted:
+        assert code == 0, err
+        assert abs(json.loads(out)["integrals"]["rubber_spin"]["max_abs_drift"]) < 1e-12
+    else:
+        assert code == 2 and err.count("\n") == 1 and "violates the constraint" in err

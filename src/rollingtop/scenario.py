@@ -218,7 +218,8 @@ class Scenario:
         -------
         dict or None
             ``None`` also where the model's reduction refuses the level (the shell-rotor pair's
-            pole levels): the run needs no reduction. Otherwise ``M3, C1, C2, h``
+            levels through both poles with spin): the run needs no reduction. Otherwise ``M3,
+            C1, C2, h``
             (:meth:`level_integrals`, :meth:`level_h`), ``energy = h +
             spin_energy + mgR`` (:func:`~rollingtop.reduction.start.level_energy`), ``source``
             (``"[level]"`` where it gives ``h``, else ``"initial state"``).
@@ -227,7 +228,7 @@ class Scenario:
             return None
         from rollingtop.reduction.level import LevelSetError
 
-        try:  # a level the reduction refuses (a shell-rotor pole level): not shown; the run stands
+        try:  # a level the reduction refuses (spin through both poles): not shown; the run stands
             level = self.level_set()
             values = level.values()
             h = self.level_h()

@@ -96,10 +96,15 @@ def _check_spin(model: ContactModel, gamma: FloatArray, omega: FloatArray) -> No
     beyond it the given ``omega`` is not the model's, and it is not silently changed."""
     if model.spin_directions is None:
         return
-    size = float(np.linalg.norm(omega))
+    largest = float(np.max(np.abs(omega)))
+    if largest == 0.0:
+        return
+    # relative: np.linalg.norm squares (1e-300 has norm 0) and UNIT_TOLERANCE |omega| underflows
+    unit = omega / largest
+    unit = unit / float(np.linalg.norm(unit))
     for name, d in model.spin_directions(gamma).items():
         res = float(omega @ np.asarray(d, dtype=float))
-        if abs(res) > UNIT_TOLERANCE * size:
+        if abs(float(unit @ np.asarray(d, dtype=float))) > UNIT_TOLERANCE:
             raise InitialStateError(
                 f"omega = {omega.tolist()} violates the constraint {name} of model "
                 f"{model.name!r} (residual {res:.3g}, tolerance {UNIT_TOLERANCE:g} |omega|)"

@@ -25,8 +25,24 @@ and its integrals (proved by :mod:`rollingtop.symbolic.shell_rotor`) are Lagrang
 
 With ``ms = Js = 0`` this is the meridian model's reduction. The rotor's velocity along ``tau``
 is ``v_tau = (R cos + a3) w_n + R s Omega3``; along ``n`` and ``e3`` it is the meridian model's.
-``w_n`` grows like ``1/s`` at a pole unless ``(m + ms) jellett + k_p (M3 + Js Omega3)``
-vanishes there: such pole levels are refused (not reduced yet), as the rough model's.
+``w_n`` grows like ``1/s`` at a pole unless ``num = (m + ms) jellett + k_p (M3 + Js Omega3)``
+vanishes there. On such a **pole level** (``pole = "south"``: ``(m + ms) jellett = -k_p0 (M3 +
+Js Omega3(0))``, ``k_p0 = (m + ms) R + m a3``: the sleeping top's level and that of every motion
+through the upright vertical; ``"north"`` likewise at ``theta = pi``, computed as the south one of
+the mirrored pair) ``U`` is finite and smooth through the pole and ``theta`` is signed, as for
+the other models' pole levels. Next to the pole ``num`` is the difference of two nearly equal
+terms; with ``sigma = sin^2(theta/2)`` (``1 - cos = 2 sigma``) it is written without cancellation,
+
+    num = -2 sigma (m + ms) R (M3 + Js Omega3) + k_p0 Js (Omega3 - Omega3(0)),
+    sqrt(N) (Omega3 - Omega3(0)) = Omega3(0) (sqrt N(0) - sqrt N) - R M3 (Phi - Phi(0)),
+    sqrt N(0) - sqrt N = 2 sigma (beta - kappa (1 + cos)) / (sqrt N(0) + sqrt N),
+
+and ``Phi``'s arccos term through the half angles, ``arccos x = 2 arctan t`` with
+``t = (1 - x) / sqrt(1 - x^2)`` and ``arctan t - arctan t0 = arctan((t - t0) / (1 + t t0))``,
+each difference a multiple of ``sigma`` computed as such; ``w_n = num / (R s D0)`` then carries
+``2 sigma / s = tan(theta/2)``, so ``w_n / s`` (the precession) is finite at the pole. A level
+that is a pole level at both poles is the pair at rest in spin (``M3 = jellett = C2 = 0``: the
+planar rocking and rolling over); one with spin at both poles is refused in one line.
 """
 
 from __future__ import annotations
@@ -65,9 +81,9 @@ class ShellRotorLevel(LevelSet):
     integrals: ClassVar[tuple[str, ...]] = ("M3", "jellett", "C2")
     model: ClassVar[str] = "shell-rotor"
     near_pole_limits: ClassVar[bool] = False
-    #: :attr:`LevelSet.pole_advice`: its pole levels are refused.
-    pole_advice: ClassVar[str] = ("its pole levels are not reduced: integrate the full system "
-                                  "(rollingtop simulate)")  # fmt: skip
+    #: :attr:`LevelSet.pole_advice`.
+    pole_advice: ClassVar[str] = ("for the pole level set (m + ms) jellett = -k_p (M3 + Js Omega3) "
+                                  "at the pole exactly")  # fmt: skip
 
     #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
     #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
@@ -85,20 +101,34 @@ class ShellRotorLevel(LevelSet):
             raise LevelSetError("the shell-rotor reduction needs a shell (shell_mass, "
                                 "shell_inertia > 0)")  # fmt: skip
         object.__setattr__(self, "pole", None)
-        check_level_size(self)
         size = max(abs(self.jellett) * (b.m + b.shell_mass), abs(self.M3) * b.R,
-                   abs(self.C2), 1e-300)  # fmt: skip
-        for value, name in zip(self.pole_offsets(), ("south (gamma3 = 1)", "north (gamma3 = -1)"),
-                               strict=True):  # fmt: skip
-            if abs(value) <= POLE_LEVEL_TOLERANCE * size:
+                   abs(self.C2), abs(float(self.scale)) * (b.R + abs(b.a3)), 1e-300)  # fmt: skip
+        south, north = (abs(x) <= POLE_LEVEL_TOLERANCE * size for x in self.pole_offsets())
+        pole = "both" if south and north else "south" if south else "north" if north else None
+        if pole == "both":
+            if max(abs(self.M3) * b.R, abs(self.C2)) > POLE_LEVEL_TOLERANCE * size:
                 raise PoleLevelError(
-                    f"level {self.describe()} lets the {name} pole touch the plane: the "
-                    "shell-rotor pair's pole levels are not reduced yet"
+                    f"level {self.describe()} touches both poles with spin: the shell-rotor "
+                    "pair's levels through both poles are reduced only without spin"
                 )
+            for name in ("M3", "C2", "jellett"):  # no spin (module docstring)
+                object.__setattr__(self, name, 0.0)
+        elif pole is not None:  # snapped to the pole level exactly, so that its mirror image
+            c = 1.0 if pole == "south" else -1.0  # (the north one's computation) is one too
+            N, phi = pair_weight(b, c)
+            omega3 = (self.C2 - b.R * self.M3 * float(phi)) / math.sqrt(float(N))
+            kp = (b.m + b.shell_mass) * b.R * c + b.m * b.a3
+            exact = -kp * (self.M3 + b.shell_inertia * omega3) / (b.m + b.shell_mass)
+            object.__setattr__(self, "jellett", exact)
+        object.__setattr__(self, "pole", pole)
+        check_level_size(self)
 
     # ---- the pair's coefficients and the level's Omega3, w_n (complex-safe) -----------------
     def _parts(self, theta: Any) -> tuple[Any, ...]:
         """``(s, c, k_p, Omega3, w_n)`` and the theta-derivatives ``(k_p', Omega3', w_n')``."""
+        if self.pole == "north":  # the south pole level of the mirrored pair, theta -> pi - theta
+            s, c, kp, om, w_n, dkp, dom, dw_n = self.mirrored()._parts(np.pi - theta)
+            return s, -c, -kp, -om, w_n, dkp, dom, -dw_n
         b = self.body
         M, ms, Js = b.m + b.shell_mass, b.shell_mass, b.shell_inertia
         s, c = np.sin(theta), np.cos(theta)
@@ -112,11 +142,61 @@ class ShellRotorLevel(LevelSet):
         # N dOmega3/dc = -(N'/2 Omega3 + R M3 k_p) (the pair's F6, proved), dc/dtheta = -s
         domega3 = s * (0.5 * dN_dc * omega3 + b.R * self.M3 * kp) / N
         D0 = K + M * Js
+        if self.pole is not None:  # south or both: w_n / s regular at the pole
+            over_s = self._w_n_over_s(theta, c, kp, omega3, sqrtN)
+            w_n = over_s * s
+            # w_n' = num' / (R s D0) - c w_n / s with num' = s G (G below): regular at the pole
+            G = -M * b.R * (self.M3 + Js * omega3) + kp * Js * (
+                0.5 * dN_dc * omega3 + b.R * self.M3 * kp) / N  # fmt: skip
+            dw_n = G / (b.R * D0) - c * over_s
+            return s, c, kp, omega3, w_n, dkp, domega3, dw_n
         num = M * self.jellett + kp * (self.M3 + Js * omega3)
         dnum = dkp * (self.M3 + Js * omega3) + kp * Js * domega3
         w_n = num / (b.R * s * D0)
         dw_n = dnum / (b.R * s * D0) - w_n * c / s
         return s, c, kp, omega3, w_n, dkp, domega3, dw_n
+
+    def _w_n_over_s(self, theta: Any, c: Any, kp: Any, omega3: Any, sqrtN: Any) -> Any:
+        """``w_n / s`` on the south pole level (or with no spin), free of cancellation next to
+        the pole (module docstring); complex-safe."""
+        b = self.body
+        M, ms, Js = b.m + b.shell_mass, b.shell_mass, b.shell_inertia
+        if self.pole == "both":
+            return 0.0 * c
+        K = M * b.I1 + b.m * ms * b.a3**2
+        alpha = Js * (b.I1 + Js + ms * b.R**2 + b.m * b.R**2 + b.m * b.a3**2) + b.R**2 * K
+        beta = 2.0 * Js * b.m * b.R * b.a3
+        kappa = b.R**2 * K
+        D = math.sqrt(beta**2 + 4 * alpha * kappa)
+        p = M * b.R
+        B = b.m * b.a3 + p * beta / (2 * kappa)
+        N0 = alpha + beta - kappa
+        sqrtN0 = math.sqrt(N0)
+        omega30 = (self.C2 - b.R * self.M3 * float(pair_weight(b, 1.0)[1])) / sqrtN0
+        kp0 = M * b.R + b.m * b.a3
+        half = np.sin(theta / 2)
+        sigma = half * half
+        # (sqrt N0 - sqrt N) / (2 sigma)
+        dsqrt = (beta - kappa * (1 + c)) / (sqrtN0 + sqrtN)
+        # arccos x = 2 arctan t, t = sqrt(1 - x^2) / (1 + x), sqrt(1 - x^2) = 2 sqrt(kappa N) / D
+        x, x0 = (2 * kappa * c - beta) / D, (2 * kappa - beta) / D
+        t = 2 * math.sqrt(kappa) * sqrtN / (D * (1 + x))
+        t0 = 2 * math.sqrt(kappa) * sqrtN0 / (D * (1 + x0))
+        # (t - t0) / sigma: sqrt N (1 + x0) - sqrt N0 (1 + x) = -(sqrtN0 - sqrtN)(1 + x0)
+        # + sqrtN0 (x0 - x), x0 - x = 4 kappa sigma / D
+        dt = (2 * math.sqrt(kappa) / D) * (-2 * dsqrt * (1 + x0) + sqrtN0 * 4 * kappa / D) / (
+            (1 + x) * (1 + x0))  # fmt: skip
+        z = dt / (1 + t * t0)  # arctan(sigma z) = arctan t - arctan t0
+        with np.errstate(all="ignore"):
+            ratio = np.arctan(sigma * z) / sigma
+        ratio = np.where(sigma == 0, z, ratio)
+        darc = ratio  # (arccos x - arccos x0) / (2 sigma) = 2 arctan(sigma z) / (2 sigma)
+        dphi = p / kappa * dsqrt - B / math.sqrt(kappa) * darc  # (Phi - Phi(0)) / (2 sigma)
+        domega3 = (omega30 * dsqrt - b.R * self.M3 * dphi) / sqrtN  # (Omega3 - Omega3(0))/(2 sigma)
+        bracket = -M * b.R * (self.M3 + Js * omega3) + kp0 * Js * domega3  # num / (2 sigma)
+        # w_n / s = num / (R s^2 D0), 2 sigma / s^2 = 1 / (2 cos^2(theta/2))
+        out = bracket / (2 * np.cos(theta / 2) ** 2 * b.R * (K + M * Js))
+        return out if np.ndim(out) else out[()]
 
     def pole_offsets(self) -> tuple[float, float]:
         """``(m + ms) jellett + k_p (M3 + Js Omega3)`` at the south and north poles: 0 on a pole
@@ -196,8 +276,19 @@ class ShellRotorLevel(LevelSet):
         return out
 
     def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
-        """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model)."""
-        rate: float | FloatArray = -self._parts(theta)[4] / np.sin(theta)
+        """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model); on a pole level
+        finite at the pole (:meth:`_w_n_over_s`)."""
+        if self.pole == "north":  # w_n kept, s the mirror's
+            mirror = self.mirrored()
+            return mirror.psi_dot(np.pi - np.asarray(theta)) if np.ndim(theta) else float(
+                mirror.psi_dot(math.pi - theta))  # fmt: skip
+        if self.pole is not None:
+            parts = self._parts(theta)
+            over = self._w_n_over_s(theta, parts[1], parts[2], parts[3],
+                                    np.sqrt(pair_weight(self.body, parts[1])[0]))  # fmt: skip
+            rate: float | FloatArray = -over
+            return rate if np.ndim(theta) else float(rate)
+        rate = -self._parts(theta)[4] / np.sin(theta)
         return rate
 
     def normal_force(self, theta: Real, w_tau: Real) -> Real:
@@ -215,7 +306,12 @@ class ShellRotorLevel(LevelSet):
 
     def describe(self) -> str:
         """One line naming the level set."""
-        return f"M3 = {self.M3:g}, jellett = {self.jellett:g}, C2 = {self.C2:g}"
+        return f"M3 = {self.M3:g}, jellett = {self.jellett:g}, C2 = {self.C2:g}{self.pole_label()}"
+
+    def pole_label(self) -> str:
+        """The pole level in words, for :meth:`describe`."""
+        return {None: "", "south": " (south pole level)", "north": " (north pole level)",
+                "both": " (no spin: both poles)"}[self.pole]  # fmt: skip
 
 
 def shell_rotor_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
