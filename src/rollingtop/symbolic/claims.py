@@ -7,11 +7,24 @@ between the full and the reduced equations. It is decided by
 1. **exact simplification** when the expression is small enough to simplify quickly: the
    manifold is parametrised *rationally* (``gamma`` by two rational parameters with
    ``s = sqrt(1 - gamma3^2)`` itself rational, the velocity by the constraints' free components)
-   and the result cancelled to a normal form -- zero is a proof;
+   and the result cancelled to a normal form -- zero is a proof. The normal form is computed
+   first in sympy's field of rational functions (:func:`_field_value`: each distinct
+   subexpression once, reduced by the gcd as it is formed), and where an intermediate result
+   grows beyond :data:`FIELD_TERMS_LIMIT` terms by ``cancel(together(...))`` on the substituted
+   expression, the faster of the two on the claims where each was measured;
 2. otherwise **exact evaluation at random rational points** (all parameters and variables drawn
    as rationals, arithmetic in exact rationals): nonzero anywhere disproves the claim, zero at
    every one of several independent points establishes it with the certainty of polynomial
    identity testing (a nonzero rational function vanishes on a set of measure zero).
+
+   The evaluation walks the expression as the graph it is (:func:`_rational_value`): a
+   derived rate has a few hundred distinct subexpressions but, once the manifold's rational
+   functions are substituted, a tree of up to 10^6 nodes, which sympy's substitution and
+   arithmetic visit one by one (seconds per claim). Each distinct subexpression is evaluated
+   once, in Python's exact :class:`fractions.Fraction`, with the manifold's substitutions
+   evaluated first at the point. sympy has no such evaluator (``lambdify`` prints rationals as
+   floats; ``xreplace`` walks the tree); an expression with a non-rational part (a square root
+   of a non-square) is evaluated by sympy as before.
 
 Each result says which method decided it.
 """
@@ -19,7 +32,9 @@ Each result says which method decided it.
 from __future__ import annotations
 
 import importlib
+import math
 import random
+import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
@@ -35,6 +50,15 @@ __all__ = ["Claim", "ClaimResult", "claims_for", "decide", "verify"]
 
 #: Above this many operations the exact route is skipped for the random rational points.
 EXACT_OPS_LIMIT = 4000
+#: The field route of the exact simplification gives up above this many terms in a numerator
+#: or denominator (the smooth model's momentum rates reach 610-667 and take 12-15 s there, 5-7 s
+#: by ``cancel``; every other claim stays below 130 and takes at most 0.8 s there, up to 9 s by
+#: ``cancel``: measured on the claims of every model).
+FIELD_TERMS_LIMIT = 160
+#: An expression (before the manifold's substitution) with a tree larger than this goes straight
+#: to the random rational points: its operation count (4000 at most for the exact route) would
+#: cost more than the evaluation itself (every claim's tree above it counts > 20000 operations).
+EXACT_TREE_LIMIT = 20000
 #: Random rational points of the fallback.
 N_POINTS = 4
 #: The classical integrals of a rolling top: each one a model does not claim is shown to vary.
@@ -129,6 +153,207 @@ def _random_rational(rng: random.Random, lo: int = -3, hi: int = 3) -> Any:
     return sp.Rational(Fraction(rng.randint(lo * 97, hi * 97), rng.randint(1, 97)))
 
 
+class _NotRational(Exception):
+    """A subexpression whose value at a rational point need not be rational."""
+
+
+def _tree_size(expr: Any, limit: int) -> int:
+    """Nodes of ``expr``'s tree, counted up to ``limit + 1``."""
+    n = 0
+    for _ in sp.preorder_traversal(expr):
+        n += 1
+        if n > limit:
+            break
+    return n
+
+
+def _symbols(expr: Any) -> set[Any]:
+    """``expr.free_symbols``, each distinct subexpression visited once (sympy's property walks
+    the tree: seconds for the shell-rotor pair's rates, whose few hundred subexpressions repeat
+    10^6 times)."""
+    seen: set[int] = set()
+    out: set[Any] = set()
+    stack = [expr]
+    while stack:
+        e = stack.pop()
+        if id(e) in seen:
+            continue
+        seen.add(id(e))
+        if e.is_Symbol:
+            out.add(e)
+        else:
+            stack.extend(e.args)
+    return out
+
+
+class _TooLarge(Exception):
+    """An intermediate rational function beyond :data:`FIELD_TERMS_LIMIT` terms."""
+
+
+def _field_value(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...],
+                 subs: dict[Any, Any]) -> Any:  # fmt: skip
+    """``expr`` on the manifold as an element of sympy's sparse field of rational functions
+    (:func:`sympy.polys.fields.field` over QQ): the substitutions of :func:`_on_manifold` made
+    on the field's values, each distinct subexpression once. Zero is the zero element, so the
+    claim is decided exactly. Raises :class:`_NotRational` for a node outside the field and
+    :class:`_TooLarge` (module docstring)."""
+    from sympy.polys.fields import field
+
+    expr = sp.sympify(expr)
+    present = _symbols(expr)
+    subs = {x: image for x, image in subs.items() if x in present}
+    replaced = set(subs) | {a for a, _ in params} | ({S.I2} if symmetric else set())
+    base = set(present)
+    for image in (*subs.values(), *(sp.sympify(b) for _, b in params)):
+        base |= _symbols(image)
+    symbols = sorted(base - replaced, key=lambda x: x.name)
+    if not symbols:
+        return sp.cancel(expr)
+    K, *gens = field(symbols, sp.QQ)
+    values: dict[Any, Any] = dict(zip(symbols, gens, strict=True))
+
+    def value_of(e: Any) -> Any:
+        memo: dict[Any, Any] = {}
+
+        def value(e: Any) -> Any:
+            found = memo.get(e)
+            if found is not None:
+                return found
+            if e.is_Symbol:
+                out = values[e]
+            elif e.is_Rational:
+                out = K(sp.QQ(int(e.p), int(e.q)))
+            elif e.is_Add or e.is_Mul:
+                out = value(e.args[0])
+                for a in e.args[1:]:
+                    out = out + value(a) if e.is_Add else out * value(a)
+            elif e.is_Pow and e.exp.is_Integer:
+                out = value(e.base) ** int(e.exp)
+            else:
+                raise _NotRational(str(e))
+            if len(out.numer) > FIELD_TERMS_LIMIT or len(out.denom) > FIELD_TERMS_LIMIT:
+                raise _TooLarge
+            memo[e] = out
+            return out
+
+        return value(sp.sympify(e))
+
+    if symmetric and S.I1 in values:
+        values[S.I2] = values[S.I1]
+    for a, b in params:
+        values[a] = value_of(b)
+    values.update({x: value_of(image) for x, image in subs.items()})
+    depth = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(depth, 20000))
+    try:
+        return value_of(expr)
+    finally:
+        sys.setrecursionlimit(depth)
+
+
+def _rational_value(expr: Any, values: dict[Any, Fraction]) -> Fraction:
+    """``expr`` at the point ``values`` (symbol -> Fraction), exactly, each distinct subexpression
+    once (module docstring). Raises :class:`_NotRational` for a node other than a symbol, a
+    rational number, a sum, a product or an integer power (a root that is not exact), and
+    ``ZeroDivisionError`` at a pole of the rational function."""
+    memo: dict[Any, Fraction] = {}
+
+    def value(e: Any) -> Fraction:
+        found = memo.get(e)
+        if found is not None:
+            return found
+        if e.is_Symbol:
+            out = values[e]
+        elif e.is_Rational:
+            out = Fraction(int(e.p), int(e.q))
+        elif e.is_Add:
+            out = sum((value(a) for a in e.args), Fraction(0))
+        elif e.is_Mul:
+            out = Fraction(1)
+            for a in e.args:
+                out *= value(a)
+        elif e.is_Pow and e.exp.is_Integer:
+            out = value(e.base) ** int(e.exp)
+        elif e.is_Pow and e.exp == sp.S.Half:  # exact only for squares of rationals
+            base = value(e.base)
+            if base < 0:
+                raise _NotRational(str(e))
+            num, den = math.isqrt(base.numerator), math.isqrt(base.denominator)
+            if num * num != base.numerator or den * den != base.denominator:
+                raise _NotRational(str(e))
+            out = Fraction(num, den)
+        else:
+            raise _NotRational(str(e))
+        memo[e] = out
+        return out
+
+    depth = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(depth, 20000))  # a deep sum of products recurses once per level
+    try:
+        return value(expr)
+    finally:
+        sys.setrecursionlimit(depth)
+
+
+def _draw(rng: random.Random, x: Any) -> Any:
+    """A random rational for the symbol ``x``: ``q, k`` in (0, 1), masses and inertias
+    positive, anything else in [-3, 3]."""
+    if x in (q, k):
+        return sp.Rational(rng.randint(1, 50), rng.randint(51, 120))  # in (0, 1)
+    if x in (S.m, S.I1, S.I2, S.I3, S.R) or x.is_positive:  # masses, inertias
+        return sp.Rational(rng.randint(20, 200), rng.randint(20, 100))
+    return _random_rational(rng)
+
+
+def _on_manifold(expr: Any, model: str, symmetric: bool, params: tuple[tuple[Any, Any], ...],
+                 subs: dict[Any, Any]) -> Any:  # fmt: skip
+    """``expr`` with the manifold's substitutions, then the parameters', then ``I2 = I1``."""
+    on = sp.sympify(expr).xreplace(subs)
+    if params:  # after the manifold, whose velocities involve the parameters
+        on = on.xreplace(dict(params))
+    if symmetric:
+        on = on.xreplace({S.I2: S.I1})
+    return on
+
+
+def _evaluate_fast(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...],
+                   subs: dict[Any, Any], rng: random.Random) -> tuple[bool, str]:  # fmt: skip
+    """The random rational points by :func:`_rational_value`: the same substitutions as
+    :func:`_on_manifold`, in the same order, made on the point's values instead of the
+    expression (raises :class:`_NotRational` where a value need not be rational)."""
+    expr = sp.sympify(expr)
+    present = _symbols(expr)
+    subs = {x: image for x, image in subs.items() if x in present}
+    replaced = set(subs) | {a for a, _ in params} | ({S.I2} if symmetric else set())
+    base = set(present)
+    for image in (*subs.values(), *(sp.sympify(b) for _, b in params)):
+        base |= _symbols(image)
+    symbols = sorted(base - replaced, key=lambda x: x.name)
+    done = 0
+    for _ in range(50 * N_POINTS):  # a point at a pole of the rational function is drawn again
+        point = {x: _draw(rng, x) for x in symbols}
+        if S.I2 in point and not symmetric:  # keep the triangle inequality and I1 != I2
+            point[S.I3] = min(point[S.I3], point[S.I1] + point[S.I2])
+        values = {x: Fraction(int(v.p), int(v.q)) for x, v in point.items()}
+        try:
+            if symmetric:
+                values[S.I2] = values[S.I1]
+            for a, b in params:
+                values[a] = _rational_value(sp.sympify(b), values)
+            images = {x: _rational_value(image, values) for x, image in subs.items()}
+            values.update(images)
+            val = _rational_value(expr, values)
+        except ZeroDivisionError:
+            continue
+        if val != 0:
+            return False, (f"exact evaluation: nonzero ({float(val):.6g}) at a random rational "
+                           "point")  # fmt: skip
+        done += 1
+        if done == N_POINTS:
+            return True, f"exact evaluation at {N_POINTS} random rational points"
+    raise _NotRational("every point drawn is a pole")
+
+
 def decide(
     expr: Any, model: str, symmetric: bool = True, seed: int = 1,
     params: tuple[tuple[Any, Any], ...] = (),
@@ -137,25 +362,26 @@ def decide(
     the manifold of ``model`` (with the parameter values ``params``, if any)? Returns
     ``(holds, method)``."""
     subs = _manifold(model)
-    on = sp.sympify(expr).xreplace(subs)
-    if params:  # after the manifold, whose velocities involve the parameters
-        on = on.xreplace(dict(params))
-    if symmetric:
-        on = on.xreplace({S.I2: S.I1})
-    if sp.count_ops(on, visual=False) <= EXACT_OPS_LIMIT:
-        normal = sp.cancel(sp.together(on))
-        return normal == 0, "exact simplification"
+    on = None
+    if _tree_size(sp.sympify(expr), EXACT_TREE_LIMIT) <= EXACT_TREE_LIMIT:
+        on = _on_manifold(expr, model, symmetric, params, subs)
+        if sp.count_ops(on, visual=False) <= EXACT_OPS_LIMIT:
+            try:
+                return _field_value(expr, symmetric, params, subs) == 0, "exact simplification"
+            except (_NotRational, _TooLarge):
+                normal = sp.cancel(sp.together(on))
+                return normal == 0, "exact simplification"
+    rng = random.Random(seed)
+    try:
+        return _evaluate_fast(expr, symmetric, params, subs, rng)
+    except _NotRational:
+        pass
+    if on is None:
+        on = _on_manifold(expr, model, symmetric, params, subs)
     rng = random.Random(seed)
     symbols = sorted(on.free_symbols, key=lambda x: x.name)
     for _ in range(N_POINTS):
-        values: dict[Any, Any] = {}
-        for x in symbols:
-            if x in (q, k):
-                values[x] = sp.Rational(rng.randint(1, 50), rng.randint(51, 120))  # in (0, 1)
-            elif x in (S.m, S.I1, S.I2, S.I3, S.R) or x.is_positive:  # masses, inertias
-                values[x] = sp.Rational(rng.randint(20, 200), rng.randint(20, 100))
-            else:
-                values[x] = _random_rational(rng)
+        values: dict[Any, Any] = {x: _draw(rng, x) for x in symbols}
         if not symmetric:  # keep the triangle inequality and I1 != I2
             values[S.I3] = min(values[S.I3], values[S.I1] + values.get(S.I2, values[S.I1]))
         val = on.xreplace(values)
