@@ -110,21 +110,28 @@ def admissible_omega(model, gamma, omega):
     return omega
 
 
-@pytest.fixture(scope="session", autouse=True)
-def kernels_compiled_in_parallel(request):
+def pytest_sessionstart(session: pytest.Session) -> None:
     """Compile (or load) every model's integrator and ensemble kernels before the first test,
     one process per model on every core (:func:`rollingtop.warmup`): on a cold numba cache the
     tests would otherwise compile them one after the other, on one core. A warm cache loads in
     seconds. Says so on the terminal, and each model as it is done: a cold start is a minute
     or more of otherwise silent work on 2 cores (the start-up table's ``rollingtop warmup``,
-    measured by ``benchmarks/run_benchmarks.py``)."""
+    measured by ``benchmarks/run_benchmarks.py``).
+
+    With pytest-xdist (``-n``) the controller does it once, before it starts its workers (this
+    hook runs before xdist's own, which is ``trylast``); the workers load the cache."""
     import json
     import time
 
+    config = session.config
+    if hasattr(config, "workerinput"):  # an xdist worker: the controller has compiled them
+        return
+    if config.getoption("collectonly", False):
+        return
     from rollingtop import warmup
 
-    reporter = request.config.pluginmanager.get_plugin("terminalreporter")
-    capture = request.config.pluginmanager.get_plugin("capturemanager")
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    capture = config.pluginmanager.get_plugin("capturemanager")
 
     def say(text):
         if reporter is None:

@@ -516,3 +516,22 @@ def test_a_tiny_rubber_spin_is_judged_by_its_direction(tmp_path, gamma, omega, a
         assert abs(json.loads(out)["integrals"]["rubber_spin"]["max_abs_drift"]) < 1e-12
     else:
         assert code == 2 and err.count("\n") == 1 and "violates the constraint" in err
+
+
+@pytest.mark.parametrize("length", [76, 78, 79, 80, 81, 200])
+def test_a_long_path_keeps_the_reason_in_the_message(tmp_path, length):
+    """A path whose quoted form just exceeds the quote limit lost its closing quote, and the
+    command line's one-line pass then cut from there to the next quote: the reason ("unknown
+    output format") vanished for paths of 79-80 characters (seen under pytest-xdist's longer
+    temporary folders)."""
+    from rollingtop._errors import QUOTE_CHARS, short_repr
+    from rollingtop.cli._errors import one_line
+    from rollingtop.io import OutputError, check_output_path
+
+    path = "/" + "p" * (length - len("/o.xlsx")) + "/o.xlsx"
+    quoted = short_repr(path)
+    assert len(quoted) <= QUOTE_CHARS and quoted[0] == quoted[-1] == "'"
+    with pytest.raises(OutputError) as info:
+        check_output_path(path, (".nc", ".csv"))
+    assert "unknown output format '.xlsx' (use .nc or .csv)" in one_line(str(info.value))
+    assert short_repr("a'b\n" * 40)[-1] in "'\""  # escapes still inside the quotes

@@ -61,8 +61,11 @@ def short_repr(value: object, limit: int = QUOTE_CHARS) -> str:
             return f"<integer of {len(str(abs(value)))} digits>"
         except ValueError:  # longer than Python converts to text
             return f"<integer of about {int(value.bit_length() * 0.30103)} digits>"
-    if isinstance(value, str) and len(value) > limit:
-        return repr(value[: limit - 3] + "…")
+    if isinstance(value, str) and len(repr(value)) > limit:  # cut inside its quotes
+        cut = limit - 3
+        while cut > 0 and len(repr(value[:cut] + "…")) > limit:  # escapes take more room
+            cut -= 1
+        return repr(value[:cut] + "…")
     if isinstance(value, list | tuple | dict) and len(value) > limit:
         return f"<{type(value).__name__} of {len(value)} items>"
     try:

@@ -1,5 +1,5 @@
 """The shell-rotor pair's pole levels (issue 36 item 5): the pair's sleeping top and its motions
-through the vertical are reduced and timed, against mpmath (``Phi`` by quadrature of its
+through the vertical are reduced and timed, against mpmath (``Phi`` by integrating its
 derivative, not its closed form) and the full equations."""
 
 import json
@@ -64,9 +64,13 @@ def mp_pair(body, M3, omega30, pole=1):
     c0 = mp.mpf(pole)
     jellett = -kp(c0) * (M3 + Js * omega30) / M
 
+    # Phi - Phi(pole) as the solution of Phi' = k_p / sqrt(N) (mpmath's Taylor-series ODE
+    # solver, with u = |c - c0| >= 0 as its forward variable; cached between evaluations)
+    phi_u = mp.odefun(lambda u, y: c0 * -kp(c0 - c0 * u) / mp.sqrt(N(c0 - c0 * u)), 0, 0)
+
     def omega3(theta):
         c = mp.cos(theta)
-        dphi = mp.quad(lambda u: kp(u) / mp.sqrt(N(u)), [c0, c])
+        dphi = phi_u(abs(c - c0))
         return (omega30 * mp.sqrt(N(c0)) - R * M3 * dphi) / mp.sqrt(N(c))
 
     def w_n(theta):
