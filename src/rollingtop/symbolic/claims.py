@@ -186,6 +186,20 @@ def _symbols(expr: Any) -> set[Any]:
     return out
 
 
+def _free_parts(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...],
+                subs: dict[Any, Any]) -> tuple[Any, dict[Any, Any], list[Any]]:  # fmt: skip
+    """``expr`` sympified, the manifold's substitutions it needs, and the symbols left free once
+    they, the parameters' and ``I2 = I1`` (if ``symmetric``) are made, sorted by name."""
+    expr = sp.sympify(expr)
+    present = _symbols(expr)
+    subs = {x: image for x, image in subs.items() if x in present}
+    replaced = set(subs) | {a for a, _ in params} | ({S.I2} if symmetric else set())
+    base = set(present)
+    for image in (*subs.values(), *(sp.sympify(b) for _, b in params)):
+        base |= _symbols(image)
+    return expr, subs, sorted(base - replaced, key=lambda x: x.name)
+
+
 class _TooLarge(Exception):
     """An intermediate rational function beyond :data:`FIELD_TERMS_LIMIT` terms."""
 
@@ -199,14 +213,7 @@ def _field_value(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...]
     :class:`_TooLarge` (module docstring)."""
     from sympy.polys.fields import field
 
-    expr = sp.sympify(expr)
-    present = _symbols(expr)
-    subs = {x: image for x, image in subs.items() if x in present}
-    replaced = set(subs) | {a for a, _ in params} | ({S.I2} if symmetric else set())
-    base = set(present)
-    for image in (*subs.values(), *(sp.sympify(b) for _, b in params)):
-        base |= _symbols(image)
-    symbols = sorted(base - replaced, key=lambda x: x.name)
+    expr, subs, symbols = _free_parts(expr, symmetric, params, subs)
     if not symbols:
         return sp.cancel(expr)
     K, *gens = field(symbols, sp.QQ)
@@ -321,14 +328,7 @@ def _evaluate_fast(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ..
     """The random rational points by :func:`_rational_value`: the same substitutions as
     :func:`_on_manifold`, in the same order, made on the point's values instead of the
     expression (raises :class:`_NotRational` where a value need not be rational)."""
-    expr = sp.sympify(expr)
-    present = _symbols(expr)
-    subs = {x: image for x, image in subs.items() if x in present}
-    replaced = set(subs) | {a for a, _ in params} | ({S.I2} if symmetric else set())
-    base = set(present)
-    for image in (*subs.values(), *(sp.sympify(b) for _, b in params)):
-        base |= _symbols(image)
-    symbols = sorted(base - replaced, key=lambda x: x.name)
+    expr, subs, symbols = _free_parts(expr, symmetric, params, subs)
     done = 0
     for _ in range(50 * N_POINTS):  # a point at a pole of the rational function is drawn again
         point = {x: _draw(rng, x) for x in symbols}
