@@ -153,7 +153,7 @@ def _sessions_text(s: dict[str, Any]) -> str:
 def write(res: dict[str, Any]) -> None:
     results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     results["explore"] = res
-    results.setdefault("dates", {})["explore"] = res["date"]
+    # its date is its own (results["dates"] dates the performance page's parts)
     tmp = RESULTS.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(results, indent=2))
     os.replace(tmp, RESULTS)
