@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import compiling, for_code, packages_of
-from rollingtop._compiled._events import EVENTS
+from rollingtop._compiled._events import EVENTS, NONE
 from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import IntegrationError
 from rollingtop._jit import call
@@ -186,7 +186,7 @@ def _run_compiled(
     ev_code, ev_direction, capacity = event
     # the copy of the stepper the run needs (rollingtop._compiled._instances)
     stepper = (package.stepper_held if icodes.shape[0] > 0
-               else package.stepper_events if ev_code != 0 else package.stepper)  # fmt: skip
+               else package.stepper_events if ev_code != NONE else package.stepper)  # fmt: skip
     ev_spec = np.array([ev_code, ev_direction, int(dips)], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
     ev_t = np.empty(capacity)
@@ -363,7 +363,7 @@ def integrate(
         raise ValueError(f"unknown event {events!r} (known: {', '.join(EVENTS)})")
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
-    event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
+    event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (NONE, 0, 1)
     from rollingtop._compiled._integrals import CODES
 
     unknown = [n for n in project_integrals if n not in CODES]

@@ -11,6 +11,7 @@ motion in absolute space) asks the level through these, whatever the model.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from typing import Any, ClassVar, TypeAlias, TypeVar
 
 import numpy as np
@@ -80,7 +81,7 @@ def check_level_size(level: Any) -> None:
         )
 
 
-class LevelServices:
+class LevelServices(ABC):
     """The services of a level set (module docstring); a level provides ``body``, ``M3``,
     :attr:`integrals`, ``v_tau(theta)`` and ``flow(theta, w_tau)``."""
 
@@ -90,13 +91,13 @@ class LevelServices:
     #: of a ``[level]`` table and of the level in JSON output (:meth:`values`).
     integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "C2")
 
+    @abstractmethod
     def v_tau(self, theta: Any) -> Any:
         """``v_tau`` at ``theta`` (the level's own)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def flow(self, theta: Any, w_tau: Any) -> tuple[Any, Any]:
         """``(theta', w_tau')`` (the level's own)."""
-        raise NotImplementedError
 
     #: :meth:`full_energy` in words.
     energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
