@@ -81,8 +81,9 @@ class LevelSpec:
 
         reduction = reduction_of(model or get_model(DEFAULT_MODEL))
         if "C2" in reduction.names and self.C2 is None:
-            raise ScenarioError("[level] is missing C2 (only `rollingtop bifurcation` does "
-                                "without it)")  # fmt: skip
+            raise ScenarioError(
+                "[level] is missing C2 (only `rollingtop bifurcation` does without it)"
+            )
         values = {name: getattr(self, name) for name in reduction.names}
         values = {k: _LEVEL_OPTIONAL.get(k) if v is None else v for k, v in values.items()}
         return reduction.level(body, {k: v for k, v in values.items() if v is not None})

@@ -61,8 +61,10 @@ def check_level_values(level: Any, names: tuple[str, ...]) -> None:
         object.__setattr__(level, name, float(x))
     b = level.body
     if not b.symmetric:
-        raise LevelSetError(f"the reduction needs a dynamically symmetric body (I1 = I2), got "
-                            f"I1 = {b.I1:g}, I2 = {b.I2:g}")  # fmt: skip
+        raise LevelSetError(
+            f"the reduction needs a dynamically symmetric body (I1 = I2), got "
+            f"I1 = {b.I1:g}, I2 = {b.I2:g}"
+        )
 
 
 def check_level_size(level: Any) -> None:
@@ -151,6 +153,9 @@ class LevelServices(ABC):
         t = np.asarray(theta, dtype=float)[..., None]
         wt = np.asarray(w_tau, dtype=float)[..., None]
         v_tau = (np.asarray(self.v_tau(theta), dtype=float) + 0.0 * wt[..., 0])[..., None]
-        v: FloatArray = (v_tau * frame["tau"] - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
-                         - b.R * np.sin(t) * wt * frame["e3"])  # fmt: skip
+        v: FloatArray = (
+            v_tau * frame["tau"]
+            - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
+            - b.R * np.sin(t) * wt * frame["e3"]
+        )
         return v

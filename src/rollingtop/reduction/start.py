@@ -55,8 +55,7 @@ def level_of_state(body: SphericalTop, y: ArrayLike, model: str | None = None) -
     y = np.asarray(y, dtype=float)
     ints = reduced_integrals(body, y)
     scale = float(np.linalg.norm(body.inertia * y[W]))
-    return LevelSet(body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]),
-                    scale=scale)  # fmt: skip
+    return LevelSet(body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]), scale=scale)
 
 
 def reduced_energy(body: SphericalTop, y: ArrayLike, model: str | None = None) -> float:
@@ -127,6 +126,7 @@ def start_on_level(
         if first.rolls_over or not 0.0 < theta < math.pi:  # no turning point on that branch
             theta = math.pi / 2
         # theta itself: a turning point beside a pole keeps its distance from it (cos rounds)
-        return state_from_level(level, h, math.cos(theta), branch=branch, phi=phi, psi=psi,
-                                theta=theta)  # fmt: skip
+        return state_from_level(
+            level, h, math.cos(theta), branch=branch, phi=phi, psi=psi, theta=theta
+        )
     return state_from_level(level, h, gamma3, branch=branch, phi=phi, psi=psi)
