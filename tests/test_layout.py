@@ -1,4 +1,5 @@
 """The habits of the codebase that a test can hold: no module over MAX_LINES lines, no
+formatting escapes (``# fmt: skip``) packing lines to stay under it, no
 comparison of a contact model's name outside the contact package (each model has one home:
 rollingtop.contact), and no circle of imports between modules (lint-imports holds the layers and
 the circles between sibling packages; this also sees a module that imports its own package)."""
@@ -19,6 +20,17 @@ def test_no_module_is_over_the_line_limit():
     long = {str(p.relative_to(SRC)): n for p in SRC.rglob("*.py")
             if (n := len(p.read_text().splitlines())) > MAX_LINES}  # fmt: skip
     assert not long, f"modules over {MAX_LINES} lines: {long}"
+
+
+#: Issue 37: ``ruff format`` formats the package; an escape needs its reason on its line.
+MAX_FMT_SKIPS = 20
+
+
+def test_the_formatter_formats_the_package():
+    skips = [f"{p.relative_to(SRC)}:{k}" for p in SRC.rglob("*.py")
+             for k, line in enumerate(p.read_text().splitlines(), 1) if "fmt: skip" in line
+             or "fmt: off" in line]  # fmt: skip
+    assert len(skips) <= MAX_FMT_SKIPS, f"{len(skips)} formatting escapes: {skips}"
 
 
 def test_no_model_name_is_compared_outside_the_contact_package():

@@ -78,11 +78,11 @@ def test_start_on_level_is_the_scenarios_state():
     level = LevelSet(sc.body, 1.0, 0.5, -2.0)
     y = start_on_level(level, 4.0)
     np.testing.assert_array_equal(y, sc.y0)  # the scenario calls start_on_level: the same bits
-    back = level_of_state(sc.body, y)
+    back = level_of_state(sc.body, y, "meridian")
     assert (back.M3, back.C1, back.C2) == pytest.approx((1.0, 0.5, -2.0), abs=1e-12)
-    assert reduced_energy(sc.body, y) == pytest.approx(4.0, abs=1e-12)
+    assert reduced_energy(sc.body, y, "meridian") == pytest.approx(4.0, abs=1e-12)
     # reduced_energy is reduced_integrals' h: one computation, exact
-    assert reduced_energy(sc.body, y) == float(reduced_integrals(sc.body, y)["h"])
+    assert reduced_energy(sc.body, y, "meridian") == float(reduced_integrals(sc.body, y)["h"])
 
 
 def test_initial_conditions_round_trip(paper_body):
@@ -90,3 +90,16 @@ def test_initial_conditions_round_trip(paper_body):
     ic = InitialConditions.from_state(y)
     assert all(type(x) is float for x in ic.gamma + ic.omega)
     np.testing.assert_allclose(ic.state(paper_body, "smooth"), y, rtol=0, atol=1e-15)
+
+
+def test_the_meridian_default_of_the_level_helpers_is_deprecated():
+    """Issue 37, item 6: level_of_state / reduced_energy without a model assume the meridian
+    model and say so; with the model's name they are the model's own (the same numbers)."""
+    sc = load_scenario(EXAMPLES / "fig5.toml")
+    for helper in (level_of_state, reduced_energy):
+        with pytest.warns(DeprecationWarning, match="model='meridian'"):
+            old = helper(sc.body, sc.y0)
+        new = helper(sc.body, sc.y0, "meridian")
+        if helper is level_of_state:
+            old, new = (old.M3, old.C1, old.C2), (new.M3, new.C1, new.C2)
+        assert old == new  # the same computation: exact

@@ -88,9 +88,11 @@ def count(n: int, one: str, many: str | None = None) -> str:
 def block(title: str, subtitle: str, sections: Sequence[tuple[str, str]]) -> str:
     """The whole view: the title (the object's type), a line saying what it is, then each
     ``(name, html)`` section under its name (an empty name: no heading)."""
-    parts = [f'<div class="rollingtop-repr">{STYLE}',
-             f'<div><span class="rt-title">{escape(title)}</span> '
-             f'<span class="rt-sub">{escape(subtitle)}</span></div>']  # fmt: skip
+    parts = [
+        f'<div class="rollingtop-repr">{STYLE}',
+        f'<div><span class="rt-title">{escape(title)}</span> '
+        f'<span class="rt-sub">{escape(subtitle)}</span></div>',
+    ]
     for name, html in sections:
         if name:
             parts.append(f'<div class="rt-section">{escape(name)}</div>')
@@ -106,18 +108,28 @@ def trajectory_html(
     integral's initial value and largest drift (absolute, and relative to ``|initial|``), the
     constraints' residuals, the reactions."""
     stats, react, cons = summary["stats"], summary["reactions"], summary["constraints"]
-    motion = {"t_end": summary["t_end"], "samples": head["samples"], "steps": stats["steps"],
-              "rejected": stats["rejected_steps"], "rtol": head["rtol"], "atol": head["atol"],
-              "wall time (s)": stats["wall_time_s"]}  # fmt: skip
+    motion = {
+        "t_end": summary["t_end"],
+        "samples": head["samples"],
+        "steps": stats["steps"],
+        "rejected": stats["rejected_steps"],
+        "rtol": head["rtol"],
+        "atol": head["atol"],
+        "wall time (s)": stats["wall_time_s"],
+    }
     if "projection_passes" in stats:  # [integration] project_integrals
         motion["projection passes"] = stats["projection_passes"]
-    rows = [[name, v["initial"], v["final"], Num(v["max_abs_drift"], 3),
-             Num(v["max_rel_drift"], 3)] for name, v in summary["integrals"].items()]  # fmt: skip
-    contact = {"min normal force": react["min_normal_force"],
-               "max friction ratio": react["max_friction_ratio"],
-               "contact lost at": react["contact_lost_at"],
-               "max constraint residual": Num(cons["max_abs_residual"], 3),
-               "frame orthonormality error": Num(cons["orthonormality_max_error"], 3)}  # fmt: skip
+    rows = [
+        [name, v["initial"], v["final"], Num(v["max_abs_drift"], 3), Num(v["max_rel_drift"], 3)]
+        for name, v in summary["integrals"].items()
+    ]
+    contact = {
+        "min normal force": react["min_normal_force"],
+        "max friction ratio": react["max_friction_ratio"],
+        "contact lost at": react["contact_lost_at"],
+        "max constraint residual": Num(cons["max_abs_residual"], 3),
+        "frame orthonormality error": Num(cons["orthonormality_max_error"], 3),
+    }
     header = ["integral", "initial", "final", "max |I - I0|", "max |I - I0| / size"]
     return block(
         "rollingtop.Trajectory",

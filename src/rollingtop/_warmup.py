@@ -50,13 +50,6 @@ def warm_package(package: str) -> dict[str, float]:
     return seconds
 
 
-def warm_model(model: str) -> dict[str, float]:
-    """Compile (or load) ``model``'s groups of kernels (:data:`GROUPS`), its variants' too, in
-    this process; the seconds each took."""
-    name = get_model(model).name
-    return _sum([warm_package(g.package) for g in _packages([name])])
-
-
 def _sum(parts: list[dict[str, float]]) -> dict[str, float]:
     return {group: sum(p[group] for p in parts) for group in GROUPS}
 

@@ -121,13 +121,16 @@ def reconstruct(
         ``t, theta, gamma3, w_tau, psi, position (n, 2), contact_point (n, 2)``.
     """
     if level.uniform_drift() is not None:
-        raise LevelSetError(f"the {level.model} model's centre of mass drifts uniformly in a "
-                            "direction its level does not fix: reconstruct its path from a full "
-                            "state (rollingtop simulate)")  # fmt: skip
+        raise LevelSetError(
+            f"the {level.model} model's centre of mass drifts uniformly in a "
+            "direction its level does not fix: reconstruct its path from a full "
+            "state (rollingtop simulate)"
+        )
     t = np.asarray(t, dtype=float)
     z0 = [theta0, w_tau0, psi0, float(position0[0]), float(position0[1])]
-    sol = solve_ivp(_path_rhs(level), (t[0], t[-1]), z0, method="DOP853", rtol=rtol, atol=atol,
-                    t_eval=t)  # fmt: skip
+    sol = solve_ivp(
+        _path_rhs(level), (t[0], t[-1]), z0, method="DOP853", rtol=rtol, atol=atol, t_eval=t
+    )
     if not sol.success:
         raise LevelSetError(f"reconstruction failed: {sol.message}")
     theta, w_tau, psi, X, Y = sol.y
@@ -227,26 +230,68 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
         theta0 = start_theta(orbit)
         dpsi, dpsi_err = 2 * math.pi * turns, 2 * math.pi * turns_err
         if drift == 0:  # at rest: the CoM stays where it is
-            return PeriodMap(T, dpsi, (0.0, 0.0), "bounded", (0.0, 0.0), 0.0, None, False,
-                             theta0, dpsi_err)  # fmt: skip
+            return PeriodMap(
+                T, dpsi, (0.0, 0.0), "bounded", (0.0, 0.0), 0.0, None, False, theta0, dpsi_err
+            )
         # its direction is the horizontal momentum's, not part of the level: only its speed
-        return PeriodMap(T, dpsi, (math.nan, math.nan), "uniform drift", None, None, None,
-                         False, theta0, dpsi_err, drift_speed=drift)  # fmt: skip
+        return PeriodMap(
+            T,
+            dpsi,
+            (math.nan, math.nan),
+            "uniform drift",
+            None,
+            None,
+            None,
+            False,
+            theta0,
+            dpsi_err,
+            drift_speed=drift,
+        )
     try:
         dpsi, dpsi_err, theta0, D = _displacement(level, h, orbit)
     except PathUnresolvedError:  # Delta psi by quadrature all the same; no displacement
         turns, turns_err = rotation_number(level, h, orbit)
-        return PeriodMap(T, 2 * math.pi * turns, (math.nan, math.nan), "unresolved", None, None,
-                         None, False, start_theta(orbit), 2 * math.pi * turns_err)  # fmt: skip
+        return PeriodMap(
+            T,
+            2 * math.pi * turns,
+            (math.nan, math.nan),
+            "unresolved",
+            None,
+            None,
+            None,
+            False,
+            start_theta(orbit),
+            2 * math.pi * turns_err,
+        )
     turns = dpsi / (2 * math.pi)
     if abs(turns - round(turns)) < RESONANCE_TOLERANCE:
         v = D / T
-        return PeriodMap(T, dpsi, (D.real, D.imag), "drifting", None, None, (v.real, v.imag),
-                         False, theta0, dpsi_err)  # fmt: skip
+        return PeriodMap(
+            T,
+            dpsi,
+            (D.real, D.imag),
+            "drifting",
+            None,
+            None,
+            (v.real, v.imag),
+            False,
+            theta0,
+            dpsi_err,
+        )
     c = D / (1 - cmath.exp(1j * dpsi))
     radius = abs(c)
-    return PeriodMap(T, dpsi, (D.real, D.imag), "bounded", (c.real, c.imag), radius, None,
-                     radius > NEAR_RESONANT * level.body.R, theta0, dpsi_err)  # fmt: skip
+    return PeriodMap(
+        T,
+        dpsi,
+        (D.real, D.imag),
+        "bounded",
+        (c.real, c.imag),
+        radius,
+        None,
+        radius > NEAR_RESONANT * level.body.R,
+        theta0,
+        dpsi_err,
+    )
 
 
 def _displacement(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, float, float, complex]:

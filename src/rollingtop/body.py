@@ -150,8 +150,20 @@ class SphericalTop:
     def params(self) -> NDArray[np.float64]:
         """Parameters ``(R, m, g, a3, I1, I2, I3, shell_mass, shell_inertia)`` for the compiled
         kernels, shape (9,)."""
-        return np.array([self.R, self.m, self.g, self.a3, self.I1, self.I2, self.I3,
-                         self.shell_mass, self.shell_inertia], dtype=float)  # fmt: skip
+        return np.array(
+            [
+                self.R,
+                self.m,
+                self.g,
+                self.a3,
+                self.I1,
+                self.I2,
+                self.I3,
+                self.shell_mass,
+                self.shell_inertia,
+            ],
+            dtype=float,
+        )
 
     @overload
     def rho(self, gamma3: float) -> float: ...

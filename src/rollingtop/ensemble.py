@@ -133,7 +133,7 @@ class EnsembleResult(NetCDFOutput):
             "status_counts": {
                 STATUS.get(int(k), str(int(k))): int(v)
                 for k, v in zip(*np.unique(self.status, return_counts=True), strict=True)
-            },  # fmt: skip
+            },
             "wall_time_s": self.wall_time_s,
             "compile_time_s": self.compile_time_s,
             "trajectories_per_second": self.n / self.wall_time_s if self.wall_time_s else None,
@@ -173,9 +173,13 @@ class EnsembleResult(NetCDFOutput):
             coords["t"] = self.t
         b = self.bodies[0]
         attrs: dict[str, str | float] = {f"body_{k}": v for k, v in b.to_dict().items()}
-        attrs.update(model=self.model.name, t_end=self.t_end,
-                     summary_json=json.dumps(self.summary()), source="rollingtop ensemble",
-                     single_body=int(all(x == b for x in self.bodies)))  # fmt: skip
+        attrs.update(
+            model=self.model.name,
+            t_end=self.t_end,
+            summary_json=json.dumps(self.summary()),
+            source="rollingtop ensemble",
+            single_body=int(all(x == b for x in self.bodies)),
+        )
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -258,30 +262,51 @@ def simulate_ensemble(
             raise ScenarioError(f"threads = {short_repr(threads)} must be an integer >= 1")
         threads = thread_count(int(threads))  # what is really used
     # the model picks its kernel variant per state (meridian: the pole cases)
-    codes = np.array([model.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)],
-                     dtype=np.int64)  # fmt: skip
+    codes = np.array(
+        [model.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)], dtype=np.int64
+    )
     params = np.array([b.params for b in bodies])
     t_eval = np.linspace(0.0, t_end, samples) if samples else np.array([0.0, float(t_end)])
     if client is not None:
         compile_s = 0.0
-        out, final, stats, wall, used = _on_client(client, codes, params, states, t_eval, rtol,
-                                                   atol, max_steps, progress)  # fmt: skip
+        out, final, stats, wall, used = _on_client(
+            client, codes, params, states, t_eval, rtol, atol, max_steps, progress
+        )
     else:
         # the packages of the codes it runs (the model's own, its variants'), and no other
         compile_s = sum(compile_ensemble_code(c) for c in _first_codes(codes))
-        out, final, stats, wall = integrate_batch(codes, params, states, t_eval, rtol=rtol,
-                                                  atol=atol, max_steps=max_steps, threads=threads,
-                                                  progress=progress)  # fmt: skip
+        out, final, stats, wall = integrate_batch(
+            codes,
+            params,
+            states,
+            t_eval,
+            rtol=rtol,
+            atol=atol,
+            max_steps=max_steps,
+            threads=threads,
+            progress=progress,
+        )
         used = thread_count(threads)
     integrals = _ensemble_integrals(model, bodies, codes, states, final)
     return EnsembleResult(
-        model=model, bodies=bodies, initial=states, final=final, t_end=float(t_end),
-        status=stats[:, 0].astype(int), steps=stats[:, 1].astype(int),
-        rejected_steps=stats[:, 2].astype(int), rhs_evals=stats[:, 3].astype(int),
-        min_normal_force=stats[:, 4], max_friction_ratio=stats[:, 5], integrals=integrals,
-        wall_time_s=wall, compile_time_s=compile_s, threads=used,
-        t=t_eval if samples else None, samples=out if samples else None,
-    )  # fmt: skip
+        model=model,
+        bodies=bodies,
+        initial=states,
+        final=final,
+        t_end=float(t_end),
+        status=stats[:, 0].astype(int),
+        steps=stats[:, 1].astype(int),
+        rejected_steps=stats[:, 2].astype(int),
+        rhs_evals=stats[:, 3].astype(int),
+        min_normal_force=stats[:, 4],
+        max_friction_ratio=stats[:, 5],
+        integrals=integrals,
+        wall_time_s=wall,
+        compile_time_s=compile_s,
+        threads=used,
+        t=t_eval if samples else None,
+        samples=out if samples else None,
+    )
 
 
 def _first_codes(codes: IntArray) -> list[int]:
@@ -294,28 +319,50 @@ CLIENT_CHUNKS = 4
 
 
 def _integrate_chunk(
-    codes: IntArray, params: FloatArray, states: FloatArray, t_eval: FloatArray, rtol: float,
-    atol: float, max_steps: int,
-) -> tuple[FloatArray, FloatArray, FloatArray, float]:  # fmt: skip
+    codes: IntArray,
+    params: FloatArray,
+    states: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+) -> tuple[FloatArray, FloatArray, FloatArray, float]:
     """One Dask task of :func:`simulate_ensemble`: a chunk on one thread of a worker."""
-    return integrate_batch(codes, params, states, t_eval, rtol=rtol, atol=atol,
-                           max_steps=max_steps, threads=1)  # fmt: skip
+    return integrate_batch(
+        codes, params, states, t_eval, rtol=rtol, atol=atol, max_steps=max_steps, threads=1
+    )
 
 
 def _on_client(
-    client: Client, codes: IntArray, params: FloatArray, states: FloatArray, t_eval: FloatArray,
-    rtol: float, atol: float, max_steps: int, progress: Callable[[int, int], None] | None,
-) -> tuple[FloatArray, FloatArray, FloatArray, float, int]:  # fmt: skip
+    client: Client,
+    codes: IntArray,
+    params: FloatArray,
+    states: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    progress: Callable[[int, int], None] | None,
+) -> tuple[FloatArray, FloatArray, FloatArray, float, int]:
     from distributed import as_completed
 
     slots = max(1, sum(client.nthreads().values()))
     N = len(states)
     bounds = np.linspace(0, N, min(N, CLIENT_CHUNKS * slots) + 1).astype(int)
     futures = {
-        client.submit(_integrate_chunk, codes[a:b], params[a:b], states[a:b], t_eval, rtol, atol,
-                      max_steps, pure=False): k
+        client.submit(
+            _integrate_chunk,
+            codes[a:b],
+            params[a:b],
+            states[a:b],
+            t_eval,
+            rtol,
+            atol,
+            max_steps,
+            pure=False,
+        ): k
         for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True))
-    }  # fmt: skip
+    }
     parts: dict[int, tuple[FloatArray, FloatArray, FloatArray, float]] = {}
     done = 0
     for fut in as_completed(futures):

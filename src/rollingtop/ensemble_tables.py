@@ -96,8 +96,11 @@ def states_from_table(scenario: Scenario, columns: Columns) -> FloatArray:
     states = np.empty((n, N_STATE))
     for row in range(n):
         # the vectors of initial_state, each where given
-        fields: dict[str, list[float]] = {"gamma": list(base.gamma), "omega": list(base.omega),
-                                          "position": list(base.position)}  # fmt: skip
+        fields: dict[str, list[float]] = {
+            "gamma": list(base.gamma),
+            "omega": list(base.omega),
+            "position": list(base.position),
+        }
         if base.alpha is not None:
             fields["alpha"] = list(base.alpha)
         if base.v is not None:
@@ -131,9 +134,15 @@ def states_from_table(scenario: Scenario, columns: Columns) -> FloatArray:
             fields.pop("v", None)
         try:
             states[row] = initial_state(
-                scenario.body, model, free=free, gamma=fields["gamma"], omega=fields["omega"],
-                alpha=fields.get("alpha"), position=fields["position"], v=fields.get("v"),
-            )  # fmt: skip
+                scenario.body,
+                model,
+                free=free,
+                gamma=fields["gamma"],
+                omega=fields["omega"],
+                alpha=fields.get("alpha"),
+                position=fields["position"],
+                v=fields.get("v"),
+            )
         except RollingTopError as exc:  # name the row
             raise type(exc)(f"ensemble row {row + 1}: {exc}") from None
     return states
@@ -179,8 +188,11 @@ def read_table(path: str | os.PathLike[str]) -> dict[str, FloatArray]:
     """Columns of a CSV file with a header row (``#`` comment lines allowed)."""
     path = Path(path)
     text = read_input_text(path, "table", MAX_TABLE_BYTES, ScenarioError)
-    lines = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
-             if ln.strip() and not ln.lstrip().startswith("#")]  # fmt: skip
+    lines = [
+        (k, ln)
+        for k, ln in enumerate(text.splitlines(), start=1)
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if len(lines) < 2:
         raise ScenarioError(f"{path}: expected a header row and at least one data row")
     header = [h.strip() for h in lines[0][1].split(",")]

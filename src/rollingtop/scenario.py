@@ -141,8 +141,14 @@ class Scenario:
             self._require_reduction("an initial state built from [level]")
             from rollingtop.reduction.start import start_on_level
 
-            y0 = start_on_level(spec.level_set(self.body, self.model), spec.h, gamma3=spec.gamma3,
-                                branch=spec.branch, phi=spec.phi, psi=spec.psi)  # fmt: skip
+            y0 = start_on_level(
+                spec.level_set(self.body, self.model),
+                spec.h,
+                gamma3=spec.gamma3,
+                branch=spec.branch,
+                phi=spec.phi,
+                psi=spec.psi,
+            )
         object.__setattr__(self, "y0", y0)
 
     def _require_reduction(self, what: str) -> None:
@@ -237,11 +243,16 @@ class Scenario:
         given = self.level is not None and self.level.h is not None
         body = self.body
         M3 = values.get("M3")
-        return {**values, "C2": values.get("C2"), "h": h, "energy": level.full_energy(h),
-                "energy_formula": level.energy_formula,
-                "spin_energy": None if M3 is None else M3 * M3 / (2.0 * body.I3),
-                "mgR": body.m * body.g * body.R,
-                "source": "[level]" if given else "initial state"}  # fmt: skip
+        return {
+            **values,
+            "C2": values.get("C2"),
+            "h": h,
+            "energy": level.full_energy(h),
+            "energy_formula": level.energy_formula,
+            "spin_energy": None if M3 is None else M3 * M3 / (2.0 * body.I3),
+            "mgR": body.m * body.g * body.R,
+            "source": "[level]" if given else "initial state",
+        }
 
     def with_overrides(self, **overrides: Any) -> Scenario:
         """A copy with integration options (``t_end, rtol, atol, samples, max_steps``) or the
@@ -282,8 +293,7 @@ class Scenario:
         missing = [k for k in _BODY_KEYS[:-1] if k not in body_t]
         if missing:
             raise ScenarioError(f"[body] is missing {', '.join(missing)}")
-        body = SphericalTop(**{k: number("body", k, body_t[k]) for k in _BODY_KEYS
-                               if k in body_t})  # fmt: skip
+        body = SphericalTop(**{k: number("body", k, body_t[k]) for k in _BODY_KEYS if k in body_t})
 
         contact_t = data.get("contact", {})
         _reject_unknown("contact", contact_t, ("model",))
@@ -345,8 +355,11 @@ def _with_shell(body: SphericalTop, model: ContactModel, shell: object) -> Spher
     missing = [k for k in ("mass", "inertia") if k not in shell]
     if missing:
         raise ScenarioError(f"[shell] is missing {', '.join(missing)}")
-    return replace(body, shell_mass=number("shell", "mass", shell["mass"]),
-                   shell_inertia=number("shell", "inertia", shell["inertia"]))  # fmt: skip
+    return replace(
+        body,
+        shell_mass=number("shell", "mass", shell["mass"]),
+        shell_inertia=number("shell", "inertia", shell["inertia"]),
+    )
 
 
 def _reject_unknown(table: str, values: Mapping[str, object], allowed: tuple[str, ...]) -> None:

@@ -19,9 +19,6 @@ __all__ = ["LevelSpec", "level_from_table"]
 
 #: Where a motion starts on a level, after the level's own integrals (ContactModel.reduction).
 _LEVEL_PLACEMENT = ("h", "gamma3", "branch", "phi", "psi")
-_LEVEL_KEYS = (
-    "M3", "C1", "C2", "p_horizontal", "jellett", "routh", "rubber_spin", *_LEVEL_PLACEMENT
-)  # fmt: skip
 #: Integrals a [level] may leave out: C2 (``rollingtop bifurcation`` scans it), p_horizontal
 #: (the smooth model's drift: 0).
 _LEVEL_OPTIONAL = {"C2": None, "p_horizontal": 0.0}
@@ -84,8 +81,9 @@ class LevelSpec:
 
         reduction = reduction_of(model or get_model(DEFAULT_MODEL))
         if "C2" in reduction.names and self.C2 is None:
-            raise ScenarioError("[level] is missing C2 (only `rollingtop bifurcation` does "
-                                "without it)")  # fmt: skip
+            raise ScenarioError(
+                "[level] is missing C2 (only `rollingtop bifurcation` does without it)"
+            )
         values = {name: getattr(self, name) for name in reduction.names}
         values = {k: _LEVEL_OPTIONAL.get(k) if v is None else v for k, v in values.items()}
         return reduction.level(body, {k: v for k, v in values.items() if v is not None})

@@ -214,8 +214,14 @@ def simulate(
         When the normal reaction turns negative: the motion leaves the model's assumption that the
         contact is kept. The trajectory is still returned, with ``contact_lost_at`` recorded.
     """
-    overrides = {"t_end": t_end, "rtol": rtol, "atol": atol, "samples": samples,
-                 "max_steps": max_steps, "project_integrals": project_integrals}  # fmt: skip
+    overrides = {
+        "t_end": t_end,
+        "rtol": rtol,
+        "atol": atol,
+        "samples": samples,
+        "max_steps": max_steps,
+        "project_integrals": project_integrals,
+    }
     given: dict[str, Any] = {k: v for k, v in overrides.items() if v is not None}
     if isinstance(source, SphericalTop):
         if model is None or state is None:
@@ -234,8 +240,15 @@ def simulate(
     if options is not None:
         scenario = replace(scenario, integration=options)
     scenario = scenario.with_overrides(**given)
-    return _run(scenario.body, scenario.model, scenario.require_state(), scenario.integration,
-                progress, events, event_direction)  # fmt: skip
+    return _run(
+        scenario.body,
+        scenario.model,
+        scenario.require_state(),
+        scenario.integration,
+        progress,
+        events,
+        event_direction,
+    )
 
 
 def _run(
@@ -252,8 +265,10 @@ def _run(
     held: tuple[str, ...] = ()
     if opts.project_integrals:
         if model.own_inertia:
-            raise ScenarioError(f"integration.project_integrals: not for the {model.name} model "
-                                "yet (its integrals carry the shell's terms)")  # fmt: skip
+            raise ScenarioError(
+                f"integration.project_integrals: not for the {model.name} model "
+                "yet (its integrals carry the shell's terms)"
+            )
         held = model.integrals_for(body)
     result = integrate(
         code,
@@ -276,8 +291,10 @@ def _run(
         "compile_time_s": result.compile_time_s,
     }
     if held:
-        stats |= {"projection_passes": result.projection_passes,
-                  "projection_deferred": result.projection_deferred}  # fmt: skip
+        stats |= {
+            "projection_passes": result.projection_passes,
+            "projection_deferred": result.projection_deferred,
+        }
     traj = Trajectory(
         body=body,
         model=model,
@@ -309,10 +326,12 @@ def _check_work(body: SphericalTop, y0: NDArray[np.float64], opts: IntegrationOp
     largest of the spin ``|w|``, ``|v| / R``, ``sqrt(g / R)`` and ``sqrt(m g (R + |a3|) /
     I_min)`` (the pendulum of the body about its contact point)."""
     with np.errstate(all="ignore"):
-        rate = max(float(np.linalg.norm(y0[3:6])), float(np.linalg.norm(y0[0:3])) / body.R,
-                   math.sqrt(body.g / body.R),
-                   math.sqrt(body.m * body.g * (body.R + abs(body.a3))
-                             / float(np.min(body.inertia))))  # fmt: skip
+        rate = max(
+            float(np.linalg.norm(y0[3:6])),
+            float(np.linalg.norm(y0[0:3])) / body.R,
+            math.sqrt(body.g / body.R),
+            math.sqrt(body.m * body.g * (body.R + abs(body.a3)) / float(np.min(body.inertia))),
+        )
     periods = opts.t_end * rate / (2 * math.pi)
     # a hundredfold: a run near its budget reaches max_steps and says so itself; an overflowing
     # state (periods not finite) is the stepper's to report
@@ -367,9 +386,15 @@ def simulate_models(
     runs = {}
     for model in chosen:
         report = None if progress is None else _tagged(progress, model.name)
-        runs[model.name] = simulate(_projected(scenario, model), t_end=t_end, rtol=rtol,
-                                    atol=atol, samples=samples, max_steps=max_steps,
-                                    progress=report)  # fmt: skip
+        runs[model.name] = simulate(
+            _projected(scenario, model),
+            t_end=t_end,
+            rtol=rtol,
+            atol=atol,
+            samples=samples,
+            max_steps=max_steps,
+            progress=report,
+        )
     return runs
 
 

@@ -166,8 +166,11 @@ def vertical_spin_eigenvalues(
         raise StabilityError(f"omega3 = {omega3!r} must be finite")
     if omega3 != 0.0:
         _require_vertical_spin(model)
-    own = (partial(_reduced_eigenvalues, model) if model.vertical_through_reduction
-           else model.vertical_eigenvalues)  # fmt: skip
+    own = (
+        partial(_reduced_eigenvalues, model)
+        if model.vertical_through_reduction
+        else model.vertical_eigenvalues
+    )
     if own is not None:
         try:
             return own(body, float(omega3), POLES[pole])
@@ -183,8 +186,10 @@ def _reduced_eigenvalues(
     (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`): those of the reduced
     motion at the pole of the pole level. A ValueError for a body the reduction cannot take."""
     if not body.symmetric:
-        raise ValueError(f"the {model.name} model's vertical spin is analysed through the "
-                         "reduction: it needs a dynamically symmetric body (I1 = I2)")  # fmt: skip
+        raise ValueError(
+            f"the {model.name} model's vertical spin is analysed through the "
+            "reduction: it needs a dynamically symmetric body (I1 = I2)"
+        )
     return pole_eigenvalues(body, omega3, pole)
 
 
@@ -217,9 +222,12 @@ class VerticalSpin:
     omega3_closed_form: float | None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"pole": self.pole, "com_above_centre": self.com_above_centre,
-                "omega3_critical": self.omega3_critical,
-                "omega3_closed_form": self.omega3_closed_form}  # fmt: skip
+        return {
+            "pole": self.pole,
+            "com_above_centre": self.com_above_centre,
+            "omega3_critical": self.omega3_critical,
+            "omega3_closed_form": self.omega3_closed_form,
+        }
 
 
 def _critical(body: SphericalTop, model: ContactModel, pole: str) -> float:
@@ -235,8 +243,9 @@ def _critical(body: SphericalTop, model: ContactModel, pole: str) -> float:
             break
         hi *= 2.0
     else:
-        raise StabilityError(f"the vertical spin on the {pole} pole is unstable up to "
-                             f"omega3 = {hi:g}")  # fmt: skip
+        raise StabilityError(
+            f"the vertical spin on the {pole} pole is unstable up to omega3 = {hi:g}"
+        )
     lo = 0.0
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)

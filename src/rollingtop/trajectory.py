@@ -219,8 +219,13 @@ class Trajectory(NetCDFOutput):
         for name, values in self.model_outputs.items():
             final[name] = values[-1].tolist()
         integrals = {}
-        scales = natural_scales(self.body, self.y, self.integrals, self.pole_case,
-                                slot_is_velocity=self.model.slot_name != "psi_nu")  # fmt: skip
+        scales = natural_scales(
+            self.body,
+            self.y,
+            self.integrals,
+            self.pole_case,
+            slot_is_velocity=self.model.slot_name != "psi_nu",
+        )
         for name, values in self.integrals.items():
             drift = float(np.max(np.abs(values - values[0])))
             integrals[name] = {
@@ -242,8 +247,12 @@ class Trajectory(NetCDFOutput):
         if "projection_passes" in self.stats:  # a run that claims its integrals held
             worst = max(integrals, key=lambda k: integrals[k]["max_rel_drift"] or 0.0)
             drift = integrals[worst]["max_rel_drift"] or 0.0
-            verdict = {"held": bool(drift <= HELD_TOLERANCE), "worst": worst,
-                       "max_rel_drift": drift, "tolerance": HELD_TOLERANCE}  # fmt: skip
+            verdict = {
+                "held": bool(drift <= HELD_TOLERANCE),
+                "worst": worst,
+                "max_rel_drift": drift,
+                "tolerance": HELD_TOLERANCE,
+            }
             held = {"projection": verdict}
         return {
             "model": self.model.name,
@@ -276,13 +285,20 @@ class Trajectory(NetCDFOutput):
 
     # ---- notebooks ---------------------------------------------------------------------------
     def __repr__(self) -> str:
-        return (f"<Trajectory: {self.model.name} model, t = {self.t[0]:g} .. {self.t[-1]:g}, "
-                f"{len(self.t)} samples>")  # fmt: skip
+        return (
+            f"<Trajectory: {self.model.name} model, t = {self.t[0]:g} .. {self.t[-1]:g}, "
+            f"{len(self.t)} samples>"
+        )
 
     def _repr_html_(self) -> str:
         """The notebook's view of :meth:`summary`: body, motion, each first integral's drift."""
-        head = {"model": self.model.name, "description": self.model.description,
-                "samples": len(self.t), "rtol": self.rtol, "atol": self.atol}  # fmt: skip
+        head = {
+            "model": self.model.name,
+            "description": self.model.description,
+            "samples": len(self.t),
+            "rtol": self.rtol,
+            "atol": self.atol,
+        }
         return trajectory_html(self.summary(), self.body.to_dict(), head)
 
     def plot(self, ax: Axes | None = None, *, kind: str = "path", **kw: Any) -> Axes:

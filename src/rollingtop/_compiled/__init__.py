@@ -113,8 +113,10 @@ def by_package(codes: ArrayLike) -> list[tuple[ModuleType, IntArray]]:
     order the packages first appear (``ValueError`` for an unknown code)."""
     codes = np.asarray(codes, dtype=np.int64)
     names = np.array([group_of(int(c)).package for c in codes])
-    return [(for_code(int(codes[names == n][0])), np.flatnonzero(names == n))
-            for n in dict.fromkeys(names)]  # fmt: skip
+    return [
+        (for_code(int(codes[names == n][0])), np.flatnonzero(names == n))
+        for n in dict.fromkeys(names)
+    ]
 
 
 class Notifier(Protocol):
@@ -168,8 +170,10 @@ def message(label: str, what: str) -> str:
     estimate = ESTIMATES.get(what)
     about = f", about {estimate:.0f} s" if estimate else ""
     if _jit.caching_disabled():
-        return (f"compiling {label} {what} kernels (numba cannot save its cache: every run "
-                f"compiles them{about})")  # fmt: skip
+        return (
+            f"compiling {label} {what} kernels (numba cannot save its cache: every run "
+            f"compiles them{about})"
+        )
     return f"compiling {label} {what} kernels (first run only{about})"
 
 

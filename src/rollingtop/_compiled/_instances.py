@@ -57,8 +57,16 @@ TEMPLATE = Path(__file__).resolve().parent / "_template"
 #: The template's package, replaced by each group's in its instances.
 TEMPLATE_PACKAGE = f"{PARENT}._template"
 #: The template's modules instantiated in every group's package, under their own names.
-MODULES_COPIED = ("dynamics", "events", "dense", "invariants", "stepper", "ensemble", "tangent",
-                  "chaos")  # fmt: skip
+MODULES_COPIED = (
+    "dynamics",
+    "events",
+    "dense",
+    "invariants",
+    "stepper",
+    "ensemble",
+    "tangent",
+    "chaos",
+)
 #: The stepper instantiated twice more: with its projection onto the integrals and its event
 #: location compiled in (``HELD = True``, ``EVENTS = True``), and with its event location alone.
 COPIES = {"stepper_held": "stepper", "stepper_events": "stepper"}

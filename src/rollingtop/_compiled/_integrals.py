@@ -25,10 +25,17 @@ __all__ = ["CODES", "LINEAR", "integral_value", "velocity_gradient"]
 ENERGY, LAGRANGE, JELLETT, AREA, F6, MOMENTUM_X, MOMENTUM_Y, ROUTH, RUBBER_SPIN, SLIP_NU = range(10)
 #: The code of each integral by its name in :data:`rollingtop.dynamics.integrals.INTEGRALS`.
 CODES = {
-    "energy": ENERGY, "lagrange": LAGRANGE, "jellett": JELLETT, "area": AREA, "F6": F6,
-    "momentum_x": MOMENTUM_X, "momentum_y": MOMENTUM_Y, "routh": ROUTH,
-    "rubber_spin": RUBBER_SPIN, "slip_nu": SLIP_NU,
-}  # fmt: skip
+    "energy": ENERGY,
+    "lagrange": LAGRANGE,
+    "jellett": JELLETT,
+    "area": AREA,
+    "F6": F6,
+    "momentum_x": MOMENTUM_X,
+    "momentum_y": MOMENTUM_Y,
+    "routh": ROUTH,
+    "rubber_spin": RUBBER_SPIN,
+    "slip_nu": SLIP_NU,
+}
 #: Whether each integral (by code) is linear and homogeneous in the velocity ``u = (v, w)``.
 LINEAR = (False, True, True, True, True, True, True, True, True, False)
 

@@ -153,8 +153,9 @@ def _classify_state(
             out["n_centres"][n] = sum(m.type == "center" for m in motions)
             out["n_saddles"][n] = sum(m.type == "saddle" for m in motions)
             if get_model(name).has_reduction:  # the paper's whole reduction: its fold curves
-                out["n_folds"][n] = _fold_count(*(float(getattr(body, key)) for key in BODY_KEYS),
-                                                level.M3, level.C1)  # fmt: skip
+                out["n_folds"][n] = _fold_count(
+                    *(float(getattr(body, key)) for key in BODY_KEYS), level.M3, level.C1
+                )
             centres = [m for m in motions if m.type == "center"][:MAX_CENTRES]
             for c, m in enumerate(centres):
                 out["centre_gamma3"][n, c] = m.gamma3

@@ -29,8 +29,10 @@ class AtlasAccessor:
 
     def __init__(self, ds: xr.Dataset) -> None:
         if "status" not in ds.data_vars or "fixed_json" not in ds.attrs:
-            raise AtlasError("ds.rollingtop: the Dataset is not an atlas of rollingtop.atlas "
-                             "(no status variable or fixed_json attribute)")  # fmt: skip
+            raise AtlasError(
+                "ds.rollingtop: the Dataset is not an atlas of rollingtop.atlas "
+                "(no status variable or fixed_json attribute)"
+            )
         self._ds = ds
 
     @property
@@ -66,8 +68,11 @@ class AtlasAccessor:
         for d in self.axes:
             values = ds[d].values
             numeric = values.dtype.kind in "iuf"
-            first, last = (float(values[0]), float(values[-1])) if numeric else (
-                str(values[0]), str(values[-1]))  # fmt: skip
+            first, last = (
+                (float(values[0]), float(values[-1]))
+                if numeric
+                else (str(values[0]), str(values[-1]))
+            )
             axes.append([d, len(values), first, last])
         cells = [[name, n] for name, n in self.status_counts().items()]
         counted = [[name, value, n] for name, c in self.counts().items() for value, n in c.items()]
@@ -78,9 +83,11 @@ class AtlasAccessor:
             ("cells", table(["status", "cells"], cells)),
             ("classified cells", table(["variable", "value", "cells"], counted)),
         ]
-        return block("rollingtop atlas (ds.rollingtop)",
-                     f"{int(ds['status'].size)} cells ({size}), models: {ds.attrs.get('models')}",
-                     sections)  # fmt: skip
+        return block(
+            "rollingtop atlas (ds.rollingtop)",
+            f"{int(ds['status'].size)} cells ({size}), models: {ds.attrs.get('models')}",
+            sections,
+        )
 
     def plot(
         self,

@@ -70,8 +70,9 @@ def _probe(address: str, timeout: float) -> None:
     try:
         answer = pool.submit(asyncio.run, identity()).result(timeout + 5.0)
     except (TimeoutError, concurrent.futures.TimeoutError):
-        raise AtlasError(f"{where} did not answer within {timeout:g} s "
-                         "(--scheduler-timeout)") from None  # fmt: skip
+        raise AtlasError(
+            f"{where} did not answer within {timeout:g} s (--scheduler-timeout)"
+        ) from None
     except Exception as exc:  # refused, unresolvable, a garbled answer: distributed's own types
         why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise AtlasError(f"cannot reach {where}: {why}") from None
@@ -116,8 +117,9 @@ def _client(
             remote = Client(scheduler, timeout=f"{timeout}s")
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise AtlasError(f"cannot reach the Dask scheduler at {short_repr(scheduler)}: "
-                             f"{why}") from None  # fmt: skip
+            raise AtlasError(
+                f"cannot reach the Dask scheduler at {short_repr(scheduler)}: {why}"
+            ) from None
         try:
             yield remote
         finally:
@@ -203,18 +205,26 @@ def atlas(
     """
     if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
         raise AtlasError(f"chunk = {short_repr(chunk)} must be an integer >= 1")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):  # fmt: skip
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+    ):
         raise AtlasError(f"workers = {short_repr(workers)} must be an integer >= 1")
     cores = os.cpu_count() or 1
     if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
-        raise AtlasError(f"workers = {workers} is more than {MAX_WORKERS_PER_CORE} per core "
-                         f"({cores} cores) for the local cluster; use a scheduler to go "
-                         "wide")  # fmt: skip
-    if not (isinstance(scheduler_timeout, (int, float)) and not isinstance(scheduler_timeout, bool)
-            and 0.0 < scheduler_timeout <= MAX_SCHEDULER_TIMEOUT):  # fmt: skip
-        raise AtlasError(f"scheduler_timeout = {short_repr(scheduler_timeout)} must be a number "
-                         f"of seconds in (0, {MAX_SCHEDULER_TIMEOUT:g}]")  # fmt: skip
+        raise AtlasError(
+            f"workers = {workers} is more than {MAX_WORKERS_PER_CORE} per core "
+            f"({cores} cores) for the local cluster; use a scheduler to go "
+            "wide"
+        )
+    if not (
+        isinstance(scheduler_timeout, (int, float))
+        and not isinstance(scheduler_timeout, bool)
+        and 0.0 < scheduler_timeout <= MAX_SCHEDULER_TIMEOUT
+    ):
+        raise AtlasError(
+            f"scheduler_timeout = {short_repr(scheduler_timeout)} must be a number "
+            f"of seconds in (0, {MAX_SCHEDULER_TIMEOUT:g}]"
+        )
     out_path = None if output is None else check_atlas_output(output)
     cells = spec.cells()
     names = tuple(spec.axes)
@@ -264,12 +274,22 @@ def _compute(
     todo = [k for k in range(len(starts)) if k not in done]
     if todo:
         with connect() as c:
-            futures = {c.submit(classify_cells, spec.fixed, names,
-                                cells[starts[k] : starts[k] + chunk], pure=False): k
-                       for k in todo}  # fmt: skip
+            futures = {
+                c.submit(
+                    classify_cells,
+                    spec.fixed,
+                    names,
+                    cells[starts[k] : starts[k] + chunk],
+                    pure=False,
+                ): k
+                for k in todo
+            }
             try:
-                save = None if folder is None else functools.partial(_save, folder, spec, starts,
-                                                                     chunk)  # fmt: skip
+                save = (
+                    None
+                    if folder is None
+                    else functools.partial(_save, folder, spec, starts, chunk)
+                )
                 _collect(futures, done, save, spec.size, finished, progress)
             except BaseException:
                 c.cancel(list(futures))  # stop what is still queued before the cluster goes
@@ -308,9 +328,11 @@ def _collect(
         except RollingTopError:
             raise
         except Exception as exc:
-            raise AtlasError(f"a Dask task failed ({type(exc).__name__}: "
-                             f"{str(exc).splitlines()[0] if str(exc) else ''}); the chunks "
-                             "finished so far are kept: run again to resume") from None  # fmt: skip
+            raise AtlasError(
+                f"a Dask task failed ({type(exc).__name__}: "
+                f"{str(exc).splitlines()[0] if str(exc) else ''}); the chunks "
+                "finished so far are kept: run again to resume"
+            ) from None
         done[k] = result
         if save is not None:
             save(k, result)

@@ -84,8 +84,10 @@ class AtlasSpec:
     def digest(self, chunk: int) -> str:
         """What a partial result must match to be reused."""
         axes = {k: v.tolist() for k, v in self.axes.items()}
-        text = json.dumps({"version": ATLAS_VERSION, "fixed": self.fixed, "chunk": chunk,
-                           "axes": axes}, sort_keys=True)  # fmt: skip
+        text = json.dumps(
+            {"version": ATLAS_VERSION, "fixed": self.fixed, "chunk": chunk, "axes": axes},
+            sort_keys=True,
+        )
         return hashlib.sha256(text.encode()).hexdigest()
 
     def cells(self) -> FloatArray:
@@ -112,8 +114,9 @@ def _axis_values(key: str, value: object) -> FloatArray:
     elif isinstance(value, dict):
         unknown = set(value) - {"start", "stop", "num"}
         if unknown or {"start", "stop", "num"} - set(value):
-            raise AtlasError(f"{where} must be a list or {{start, stop, num}}, got "
-                             f"{short_repr(value)}")  # fmt: skip
+            raise AtlasError(
+                f"{where} must be a list or {{start, stop, num}}, got {short_repr(value)}"
+            )
         num = int(number("axes", f"{key}.num", value["num"], integer=True))
         if num < 1:
             raise AtlasError(f"{where}.num = {num} must be >= 1")
@@ -123,8 +126,9 @@ def _axis_values(key: str, value: object) -> FloatArray:
         stop = number("axes", f"{key}.stop", value["stop"])
         out = np.linspace(start, stop, num)
     else:
-        raise AtlasError(f"{where} must be a list of numbers or {{start, stop, num}}, got "
-                         f"{short_repr(value)}")  # fmt: skip
+        raise AtlasError(
+            f"{where} must be a list of numbers or {{start, stop, num}}, got {short_repr(value)}"
+        )
     if not np.all(np.isfinite(out)):
         raise AtlasError(f"{where} has non-finite values")
     return out
@@ -141,8 +145,10 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
     for key in axes_t:
         if key not in AXIS_KEYS:
             raise AtlasError(f"unknown axis {short_repr(key)} (allowed: {', '.join(AXIS_KEYS)})")
-    axes = {key: _model_axis(value) if key == "model" else _axis(key, value)
-            for key, value in axes_t.items()}  # fmt: skip
+    axes = {
+        key: _model_axis(value) if key == "model" else _axis(key, value)
+        for key, value in axes_t.items()
+    }
     size = int(np.prod([len(v) for v in axes.values()], dtype=float))
     if size > MAX_CELLS:
         raise AtlasError(f"the atlas has {size} cells, more than {MAX_CELLS}")
@@ -177,11 +183,14 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
             raise
         sc = Scenario.from_dict({**data, "body": given})
     if not sc.model.has_reduction:
-        raise AtlasError(f"the atlas classifies the reduction of the meridian model, not model "
-                         f"{sc.model.name!r}")  # fmt: skip
+        raise AtlasError(
+            f"the atlas classifies the reduction of the meridian model, not model {sc.model.name!r}"
+        )
     if not sc.body.symmetric:
-        raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
-                         f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
+        raise AtlasError(
+            f"the atlas needs a dynamically symmetric body (I1 = I2), got "
+            f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}"
+        )
     fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
     fixed.update({k: float(body_t[k]) for k in BODY_KEYS if k in axes})
     fixed.update({k: float(level_t[k]) for k in LEVEL_KEYS})
@@ -192,14 +201,17 @@ def _model_axis(value: object) -> FloatArray:
     """A ``model`` axis: a list of model names with a reduction, as indices into
     :data:`~rollingtop.atlas._cells.ATLAS_MODELS`."""
     if not isinstance(value, list) or not value:
-        raise AtlasError(f"axes.model must be a non-empty list of model names, got "
-                         f"{short_repr(value)}")  # fmt: skip
+        raise AtlasError(
+            f"axes.model must be a non-empty list of model names, got {short_repr(value)}"
+        )
     out = []
     for name in value:
         if name not in ATLAS_MODELS:
-            raise AtlasError(f"axes.model: {short_repr(name)} is not a model the atlas "
-                             f"classifies ({', '.join(ATLAS_MODELS)}: those with a reduction, "
-                             "for a body without a shell)")  # fmt: skip
+            raise AtlasError(
+                f"axes.model: {short_repr(name)} is not a model the atlas "
+                f"classifies ({', '.join(ATLAS_MODELS)}: those with a reduction, "
+                "for a body without a shell)"
+            )
         if ATLAS_MODELS.index(name) in out:
             raise AtlasError(f"axes.model names {name!r} twice")
         out.append(ATLAS_MODELS.index(name))
@@ -222,13 +234,17 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
 
     on_level = [key for key in axes if key in LEVEL_KEYS]
     if on_level:
-        raise AtlasError(f"axes {', '.join(on_level)}: with a model axis or a model other than "
-                         "the meridian one, each cell's level is the [initial] state's under "
-                         "its model; [axes] takes body keys and model")  # fmt: skip
+        raise AtlasError(
+            f"axes {', '.join(on_level)}: with a model axis or a model other than "
+            "the meridian one, each cell's level is the [initial] state's under "
+            "its model; [axes] takes body keys and model"
+        )
     if not isinstance(data.get("initial"), dict):
-        raise AtlasError("an atlas with a model axis or a model other than the meridian one "
-                         "needs an [initial] table (gamma, omega): each model's level is that "
-                         "state's")  # fmt: skip
+        raise AtlasError(
+            "an atlas with a model axis or a model other than the meridian one "
+            "needs an [initial] table (gamma, omega): each model's level is that "
+            "state's"
+        )
     body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
     data.pop("level", None)
     # The state is checked against the first cell's body that is admissible; a cell whose
@@ -250,14 +266,20 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
         except ScenarioError as exc:
             raise AtlasError(f"the atlas classifies a reduction: {exc}") from None
         if sc.model.name not in ATLAS_MODELS:  # the shell-rotor pair: no shell keys on the axes
-            raise AtlasError(f"the atlas classifies {', '.join(ATLAS_MODELS)} (a body without a "
-                             f"shell), not the {sc.model.name} model")  # fmt: skip
+            raise AtlasError(
+                f"the atlas classifies {', '.join(ATLAS_MODELS)} (a body without a "
+                f"shell), not the {sc.model.name} model"
+            )
     if not sc.body.symmetric:
-        raise AtlasError(f"the atlas needs a dynamically symmetric body (I1 = I2), got "
-                         f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}")  # fmt: skip
+        raise AtlasError(
+            f"the atlas needs a dynamically symmetric body (I1 = I2), got "
+            f"I1 = {sc.body.I1:g}, I2 = {sc.body.I2:g}"
+        )
     if sc.body.has_shell:
-        raise AtlasError("the atlas classifies bodies without a shell: the shell's mass and "
-                         "inertia are not among its axes")  # fmt: skip
+        raise AtlasError(
+            "the atlas classifies bodies without a shell: the shell's mass and "
+            "inertia are not among its axes"
+        )
     y0 = sc.require_state()
     fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
     fixed.update({k: float(body_t[k]) for k in BODY_KEYS if k in axes})

@@ -45,8 +45,10 @@ class CellsKept(WriteFailed):
         self.kept = str(kept)
 
     def __str__(self) -> str:
-        return (f"cannot write {self.filename!r}: {self.strerror}; the finished cells are kept "
-                f"in {self.kept!r}: run again to write them")  # fmt: skip
+        return (
+            f"cannot write {self.filename!r}: {self.strerror}; the finished cells are kept "
+            f"in {self.kept!r}: run again to write them"
+        )
 
 
 class AtlasResumeWarning(UserWarning):
@@ -59,8 +61,9 @@ def _chunk_fits(part: Mapping[str, np.ndarray], n: int) -> bool:
     if set(part) != {*FIELDS, *CENTRE_FIELDS}:
         return False
     flat = all(part[k].shape == (n,) and part[k].dtype.kind == "i" for k in FIELDS)
-    return flat and all(part[k].shape == (n, MAX_CENTRES) and part[k].dtype.kind == "f"
-                        for k in CENTRE_FIELDS)  # fmt: skip
+    return flat and all(
+        part[k].shape == (n, MAX_CENTRES) and part[k].dtype.kind == "f" for k in CENTRE_FIELDS
+    )
 
 
 #: The variables of a saved chunk that say which chunk it is: ``[index, first cell, end]``
@@ -92,8 +95,10 @@ def _load_partial(
     except (OSError, ValueError):
         saved = {}
     if not isinstance(saved, dict) or saved.get("digest") != digest:
-        raise AtlasError(f"{folder} holds an interrupted atlas of another spec (or chunk size); "
-                         "remove it to start over")  # fmt: skip
+        raise AtlasError(
+            f"{folder} holds an interrupted atlas of another spec (or chunk size); "
+            "remove it to start over"
+        )
     done = {}
     bad = []
     for f in sorted(folder.glob("chunk-*.npz")):
@@ -104,17 +109,25 @@ def _load_partial(
             k = int(f.stem.split("-")[1])
             with np.load(f, allow_pickle=False) as z:
                 part = {key: z[key] for key in z.files}
-        if (part is None or k not in ranges or not _chunk_is(part, k, ranges[k], digest)
-                or not _chunk_fits(part, ranges[k][1] - ranges[k][0])):  # fmt: skip
+        if (
+            part is None
+            or k not in ranges
+            or not _chunk_is(part, k, ranges[k], digest)
+            or not _chunk_fits(part, ranges[k][1] - ranges[k][0])
+        ):
             bad.append(f.name)
             with contextlib.suppress(OSError):
                 f.unlink()
             continue
         done[k] = part
     if bad:
-        warnings.warn(AtlasResumeWarning(
-            f"{len(bad)} damaged or foreign chunk file(s) in {folder} (first {bad[0]}): "
-            "computed again"), stacklevel=3)  # fmt: skip
+        warnings.warn(
+            AtlasResumeWarning(
+                f"{len(bad)} damaged or foreign chunk file(s) in {folder} (first {bad[0]}): "
+                "computed again"
+            ),
+            stacklevel=3,
+        )
     return done
 
 
@@ -133,8 +146,9 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
     import xarray as xr
 
     dims = tuple(spec.axes)
-    merged = {key: np.concatenate([parts[k][key] for k in sorted(parts)])
-              for key in parts[min(parts)]}  # fmt: skip
+    merged = {
+        key: np.concatenate([parts[k][key] for k in sorted(parts)]) for key in parts[min(parts)]
+    }
     data_vars = {}
     docs = {
         "status": "0 classified, 1 inadmissible body, 2 pole level, 3 level too large or not "
@@ -152,12 +166,18 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
         if values.ndim == 1:
             data_vars[key] = (dims, values.reshape(spec.shape), {"description": docs[key]})
         else:
-            data_vars[key] = ((*dims, "centre"), values.reshape((*spec.shape, values.shape[1])),
-                              {"description": docs[key]})  # fmt: skip
-    attrs = {"fixed_json": json.dumps(spec.fixed), "axes": " ".join(dims),
-             "models": " ".join(spec.models),
-             "description": "rollingtop atlas: classification of the reduced motions over body "
-                            "parameters and integrals or models (issues 14, 24)"}  # fmt: skip
+            data_vars[key] = (
+                (*dims, "centre"),
+                values.reshape((*spec.shape, values.shape[1])),
+                {"description": docs[key]},
+            )
+    attrs = {
+        "fixed_json": json.dumps(spec.fixed),
+        "axes": " ".join(dims),
+        "models": " ".join(spec.models),
+        "description": "rollingtop atlas: classification of the reduced motions over body "
+        "parameters and integrals or models (issues 14, 24)",
+    }
     coords: dict[str, Any] = dict(spec.axes)
     if "model" in coords:  # indices into ATLAS_MODELS: the names
         coords["model"] = np.array([ATLAS_MODELS[int(i)] for i in coords["model"]], dtype=str)
@@ -201,8 +221,9 @@ def check_atlas_output(output: str | os.PathLike[str]) -> Path:
     path = Path(output)
     if path.suffix.lower() == ".zarr" and path.is_dir():
         if not any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs")):
-            raise AtlasError(f"cannot write {str(path)!r}: a folder that is not a Zarr store "
-                             "is in the way")  # fmt: skip
+            raise AtlasError(
+                f"cannot write {str(path)!r}: a folder that is not a Zarr store is in the way"
+            )
         return path
     try:
         return check_output_path(path, SUFFIXES)

@@ -164,9 +164,12 @@ class PhaseVolume:
 
     def summary(self) -> dict[str, float | int]:
         """The final running mean and the extremes of the divergence."""
-        return {"mean_divergence": float(self.mean[-1]), "dimension": self.dimension,
-                "min_divergence": float(np.min(self.divergence)),
-                "max_divergence": float(np.max(self.divergence))}  # fmt: skip
+        return {
+            "mean_divergence": float(self.mean[-1]),
+            "dimension": self.dimension,
+            "min_divergence": float(np.min(self.divergence)),
+            "max_divergence": float(np.max(self.divergence)),
+        }
 
 
 def phase_volume(

@@ -124,9 +124,12 @@ def _velocity_basis(body: SphericalTop, model: ContactModel, y: FloatArray) -> F
 
 
 def _sample(
-    body: SphericalTop, model: ContactModel, names: Sequence[str], target: FloatArray,
+    body: SphericalTop,
+    model: ContactModel,
+    names: Sequence[str],
+    target: FloatArray,
     rng: np.random.Generator,
-) -> FloatArray | None:  # fmt: skip
+) -> FloatArray | None:
     """One state on the level, or ``None`` where this orientation cannot carry it."""
     gamma, alpha = _orientation(rng, model, body)
     y = initial_state(body, model, gamma=gamma, omega=np.zeros(3), alpha=alpha)

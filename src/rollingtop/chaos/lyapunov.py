@@ -84,8 +84,12 @@ def check_state(body: SphericalTop, model: ContactModel, state: ArrayLike) -> Fl
 
 def check_options(t_end: object, samples: object, rtol: float, atol: float | None) -> float:
     """Validate the shared options; returns ``atol`` (default ``rtol / 100``)."""
-    if not (isinstance(t_end, int | float) and not isinstance(t_end, bool)
-            and math.isfinite(t_end) and t_end > 0):  # fmt: skip
+    if not (
+        isinstance(t_end, int | float)
+        and not isinstance(t_end, bool)
+        and math.isfinite(t_end)
+        and t_end > 0
+    ):
         raise ScenarioError(f"t_end = {t_end!r} must be a positive number")
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 1:
         raise ScenarioError(f"samples = {samples!r} must be an integer >= 1")
@@ -175,8 +179,11 @@ class ChaosIndicators(NetCDFOutput):
             "initial_state": ("state", self.initial),
         }
         attrs: dict[str, Any] = {f"body_{k}": v for k, v in self.body.to_dict().items()}
-        attrs.update(model=self.model.name, source="rollingtop chaos",
-                     summary_json=json.dumps(self.summary()))  # fmt: skip
+        attrs.update(
+            model=self.model.name,
+            source="rollingtop chaos",
+            summary_json=json.dumps(self.summary()),
+        )
         return xr.Dataset(
             data, coords={"t": self.t, "state": state_components(self.model.slot_name)}, attrs=attrs
         )
@@ -191,10 +198,19 @@ CHUNK_STEPS = 4000
 
 
 def _run_chunks(
-    code: int, p: FloatArray, y0: FloatArray, d0: FloatArray, t: FloatArray, rtol: float,
-    atol: float, max_steps: int, out: FloatArray, states: FloatArray, stats: FloatArray,
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    d0: FloatArray,
+    t: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    out: FloatArray,
+    states: FloatArray,
+    stats: FloatArray,
     stop: float,
-) -> None:  # fmt: skip
+) -> None:
     """The compiled ``run_indicators`` of kernel ``code``, in calls of at most
     :data:`CHUNK_STEPS` accepted steps (the same steps as one call)."""
     kernels = for_code(code).tangent
@@ -205,16 +221,35 @@ def _run_chunks(
     k = 0
     while True:
         limit = min(max_steps, int(counts[STEPS]) + CHUNK_STEPS)
-        k = call(kernels.indicators_chunk, code, p, z, fz, ctrl, counts, t, k, limit, out,
-                 states, stats, stop)  # fmt: skip
+        k = call(
+            kernels.indicators_chunk,
+            code,
+            p,
+            z,
+            fz,
+            ctrl,
+            counts,
+            t,
+            k,
+            limit,
+            out,
+            states,
+            stats,
+            stop,
+        )
         if stats[0] != BUDGET_EXHAUSTED or counts[STEPS] >= max_steps:
             return
 
 
 def _compile_indicators(
-    code: int, p: FloatArray, y0: FloatArray, d0: FloatArray, rtol: float, atol: float,
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    d0: FloatArray,
+    rtol: float,
+    atol: float,
     stop: float,
-) -> float:  # fmt: skip
+) -> float:
     """Compile (or load) the tangent kernel apart from a timed run, by a run of one tiny step;
     seconds spent, 0 after the first call in a process (its types never change)."""
     kernels = for_code(code)
@@ -305,8 +340,9 @@ def chaos_indicators(
         )
     compiled = _compile_indicators(code, body.params, y0, d0, rtol, atol, stop)
     start = time.perf_counter()
-    _run_chunks(code, body.params, y0, d0, t, float(rtol), atol, int(max_steps), out, states,
-                stats, stop)  # fmt: skip
+    _run_chunks(
+        code, body.params, y0, d0, t, float(rtol), atol, int(max_steps), out, states, stats, stop
+    )
     wall = time.perf_counter() - start
     status = int(stats[0])
     if status != FINISHED:
@@ -321,12 +357,24 @@ def chaos_indicators(
                 "dynamics (Lyapunov exponent, MEGNO) is undefined beyond it; choose a shorter "
                 "t_end or a motion that stays away from the vertical"
             )
-        _raise_for_status(status, np.array([t_stop, 0.0, t_end, rtol, atol, 0.0]),
-                          np.array([0, 1, 0, 0, 0], dtype=np.int64))  # fmt: skip
+        _raise_for_status(
+            status,
+            np.array([t_stop, 0.0, t_end, rtol, atol, 0.0]),
+            np.array([0, 1, 0, 0, 0], dtype=np.int64),
+        )
         raise IntegrationError(f"{STATUS_NAMES.get(status, status)} near t = {t_stop:.6g}")
     return ChaosIndicators(
-        body=body, model=model, initial=y0, t=t, lyapunov=out[:, 0], megno=out[:, 1],
-        megno_mean=out[:, 2], states=states, steps=int(stats[1]),
-        rejected_steps=int(stats[2]), rhs_evals=int(stats[3]), wall_time_s=wall,
+        body=body,
+        model=model,
+        initial=y0,
+        t=t,
+        lyapunov=out[:, 0],
+        megno=out[:, 1],
+        megno_mean=out[:, 2],
+        states=states,
+        steps=int(stats[1]),
+        rejected_steps=int(stats[2]),
+        rhs_evals=int(stats[3]),
+        wall_time_s=wall,
         compile_time_s=compiled,
-    )  # fmt: skip
+    )

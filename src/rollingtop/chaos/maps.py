@@ -29,9 +29,17 @@ CLIENT_CHUNKS = 4
 
 
 def _chunk(
-    codes: IntArray, params: FloatArray, states: FloatArray, tangents: FloatArray,
-    t: FloatArray, rtol: float, atol: float, max_steps: int, s_stop: float, threads: int | None,
-) -> tuple[FloatArray, FloatArray]:  # fmt: skip
+    codes: IntArray,
+    params: FloatArray,
+    states: FloatArray,
+    tangents: FloatArray,
+    t: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int,
+    s_stop: float,
+    threads: int | None,
+) -> tuple[FloatArray, FloatArray]:
     """One batch (a Dask task, or the whole map in-process): outputs ``(out, stats)``."""
     out = np.full((len(states), t.size, 3), np.nan)
     stats = np.zeros((len(states), 4))
@@ -39,10 +47,24 @@ def _chunk(
     for kernels, idx in by_package(codes):
         part = out[idx], stats[idx]  # copies the kernel fills
         with compiling(kernels, "chaos"):
-            run_rows(kernels.chaos.indicator_batch,
-                     (codes[idx], params, states[idx], tangents[idx], t, rtol, atol, max_steps,
-                      *part, s_stop),
-                     (0, 2, 3, 8, 9), idx.size, threads=threads)  # fmt: skip
+            run_rows(
+                kernels.chaos.indicator_batch,
+                (
+                    codes[idx],
+                    params,
+                    states[idx],
+                    tangents[idx],
+                    t,
+                    rtol,
+                    atol,
+                    max_steps,
+                    *part,
+                    s_stop,
+                ),
+                (0, 2, 3, 8, 9),
+                idx.size,
+                threads=threads,
+            )
         out[idx], stats[idx] = part
     return out, stats
 
@@ -52,9 +74,10 @@ def _on_client(client: Client, args: tuple[Any, ...]) -> tuple[FloatArray, Float
     slots = max(1, sum(client.nthreads().values()))
     N = len(states)
     bounds = np.linspace(0, N, min(N, CLIENT_CHUNKS * slots) + 1).astype(int)
-    futures = [client.submit(_chunk, codes[a:b], params, states[a:b], tangents[a:b], *rest, 1,
-                             pure=False)
-               for a, b in zip(bounds[:-1], bounds[1:], strict=True)]  # fmt: skip
+    futures = [
+        client.submit(_chunk, codes[a:b], params, states[a:b], tangents[a:b], *rest, 1, pure=False)
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+    ]
     parts = client.gather(futures)
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
@@ -134,6 +157,10 @@ def indicator_map(
         "initial_state": (("point", "state"), Y),
     }
     attrs: dict[str, Any] = {f"body_{k}": v for k, v in body.to_dict().items()}
-    attrs.update(model=model.name, rtol=float(rtol), atol=atol,
-                 status_names=str({int(k): v for k, v in STATUS_NAMES.items()}))  # fmt: skip
+    attrs.update(
+        model=model.name,
+        rtol=float(rtol),
+        atol=atol,
+        status_names=str({int(k): v for k, v in STATUS_NAMES.items()}),
+    )
     return xr.Dataset(data, coords={"point": np.arange(len(Y)), "t": t}, attrs=attrs)

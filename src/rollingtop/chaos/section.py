@@ -77,14 +77,19 @@ def _check_count(name: str, value: object, lo: int) -> int:
 
 
 def _initial_states(
-    body: SphericalTop, model: ContactModel, states: ArrayLike, trajectories: int | None,
-    hold: Sequence[str] | None, seed: int | None,
-) -> FloatArray:  # fmt: skip
+    body: SphericalTop,
+    model: ContactModel,
+    states: ArrayLike,
+    trajectories: int | None,
+    hold: Sequence[str] | None,
+    seed: int | None,
+) -> FloatArray:
     Y = np.array(states, dtype=float)
     if Y.shape == (N_STATE,):
         n = DEFAULT_TRAJECTORIES if trajectories is None else trajectories
-        return level_states(body, model, Y, _check_count("trajectories", n, 1), hold=hold,
-                            seed=seed)  # fmt: skip
+        return level_states(
+            body, model, Y, _check_count("trajectories", n, 1), hold=hold, seed=seed
+        )
     if Y.ndim != 2 or Y.shape[1] != N_STATE or Y.shape[0] == 0:
         raise InitialStateError(f"states must have shape (18,) or (K, 18), got {Y.shape}")
     if trajectories is not None and trajectories != Y.shape[0]:
@@ -179,12 +184,14 @@ def poincare_section(
         raise ScenarioError(f"atol = {atol!r} must be > 0")
     if not (isinstance(t_max, int | float) and t_max > 0):
         raise ScenarioError(f"t_max = {t_max!r} must be > 0")
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int | np.integer)
-                             or seed < 0):  # fmt: skip
+    if seed is not None and (
+        isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0
+    ):
         raise ScenarioError(f"seed = {short_repr(seed)} must be an integer >= 0")
     if trajectories is not None and trajectories * crossings > MAX_POINTS:  # before sampling
-        raise ScenarioError(f"{trajectories} trajectories x {crossings} crossings exceeds "
-                            f"{MAX_POINTS}")  # fmt: skip
+        raise ScenarioError(
+            f"{trajectories} trajectories x {crossings} crossings exceeds {MAX_POINTS}"
+        )
     names = held_integrals(body, model, hold)
     Y0 = _initial_states(body, model, states, trajectories, hold, seed)
     K = Y0.shape[0]
@@ -206,11 +213,24 @@ def poincare_section(
                 progress(before + int(np.count_nonzero(~np.isnan(found))), ev_t.size)
 
         with compiling(kernels, "chaos"):
-            seconds, used = run_rows(kernels.chaos.section_batch,
-                                     (codes[idx], body.params, Y0[idx], float(t_max), float(rtol),
-                                      float(atol), int(max_steps), int(max_gap_steps), *part),
-                                     (0, 2, 8, 9, 10), idx.size, threads=threads,
-                                     poll=poll)  # fmt: skip
+            seconds, used = run_rows(
+                kernels.chaos.section_batch,
+                (
+                    codes[idx],
+                    body.params,
+                    Y0[idx],
+                    float(t_max),
+                    float(rtol),
+                    float(atol),
+                    int(max_steps),
+                    int(max_gap_steps),
+                    *part,
+                ),
+                (0, 2, 8, 9, 10),
+                idx.size,
+                threads=threads,
+                poll=poll,
+            )
         wall += seconds
         ev_t[idx], ev_y[idx], stats[idx] = part
     found = stats[:, 1].astype(int)
@@ -240,13 +260,23 @@ def poincare_section(
         data[f"level_{name}"] = ("trajectory", levels[:, k])
     attrs: dict[str, Any] = {f"body_{k}": v for k, v in body.to_dict().items()}
     attrs.update(
-        model=model.name, held=",".join(names), crossings=crossings, rtol=float(rtol),
-        atol=float(atol), wall_time_s=wall, threads=used, source="rollingtop section",
-        section="w_tau = 0, w_tau increasing (minima of gamma3)", plane="gamma3, w_n",
+        model=model.name,
+        held=",".join(names),
+        crossings=crossings,
+        rtol=float(rtol),
+        atol=float(atol),
+        wall_time_s=wall,
+        threads=used,
+        source="rollingtop section",
+        section="w_tau = 0, w_tau increasing (minima of gamma3)",
+        plane="gamma3, w_n",
         status_names=json.dumps({str(k): v for k, v in SECTION_STATUS.items()}),
-    )  # fmt: skip
-    coords = {"trajectory": np.arange(K), "crossing": np.arange(crossings),
-              "state": state_components(model.slot_name)}  # fmt: skip
+    )
+    coords = {
+        "trajectory": np.arange(K),
+        "crossing": np.arange(crossings),
+        "state": state_components(model.slot_name),
+    }
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -273,10 +303,17 @@ def stopped_early(ds: xr.Dataset) -> list[dict[str, Any]]:
         status = int(ds["status"].values[k])
         y0 = ds["initial_state"].values[k]
         reason = "t_max reached" if status == FINISHED else names.get(str(status), str(status))
-        out.append({"trajectory": int(k), "crossings": int(found[k]),
-                    "t_last": float(ds["t_last"].values[k]), "status": status, "reason": reason,
-                    "gamma": [float(x) for x in y0[GAMMA]],
-                    "omega": [float(x) for x in y0[W]]})  # fmt: skip
+        out.append(
+            {
+                "trajectory": int(k),
+                "crossings": int(found[k]),
+                "t_last": float(ds["t_last"].values[k]),
+                "status": status,
+                "reason": reason,
+                "gamma": [float(x) for x in y0[GAMMA]],
+                "omega": [float(x) for x in y0[W]],
+            }
+        )
     return out
 
 
@@ -285,8 +322,11 @@ def section_summary(ds: xr.Dataset) -> dict[str, Any]:
     the trajectories that stopped early, ``stopped_early`` names them (:func:`stopped_early`)."""
     w_tau = np.abs(ds["w_tau"].values)
     ok = np.isfinite(w_tau)
-    levels = {str(name)[6:]: [float(ds[name].min()), float(ds[name].max())]
-              for name in ds.data_vars if str(name).startswith("level_")}  # fmt: skip
+    levels = {
+        str(name)[6:]: [float(ds[name].min()), float(ds[name].max())]
+        for name in ds.data_vars
+        if str(name).startswith("level_")
+    }
     return {
         "model": ds.attrs["model"],
         "trajectories": int(ds.sizes["trajectory"]),
@@ -300,6 +340,7 @@ def section_summary(ds: xr.Dataset) -> dict[str, Any]:
         "held": ds.attrs["held"].split(","),
         "level_range": levels,
         "gamma3_range": [float(np.nanmin(ds["gamma3"])), float(np.nanmax(ds["gamma3"]))]
-        if ok.any() else None,
+        if ok.any()
+        else None,
         "wall_time_s": float(ds.attrs["wall_time_s"]),
-    }  # fmt: skip
+    }

@@ -36,9 +36,27 @@ from rollingtop.cli._warmup import warmup
 
 __all__ = ["cli", "main"]
 
-for _command in (simulate, equilibria, orbits, portrait, bifurcation, compare_classification,
-                 rotation, stability, atlas, path, plot, compare, animate, ensemble, section,
-                 chaos, explore, verify, warmup):  # fmt: skip
+for _command in (
+    simulate,
+    equilibria,
+    orbits,
+    portrait,
+    bifurcation,
+    compare_classification,
+    rotation,
+    stability,
+    atlas,
+    path,
+    plot,
+    compare,
+    animate,
+    ensemble,
+    section,
+    chaos,
+    explore,
+    verify,
+    warmup,
+):
     cli.add_command(_command)
 
 

@@ -18,15 +18,33 @@ __all__ = ["atlas"]
 
 @click.command()
 @click.argument("spec", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", type=click.Path(), required=True,
-              help="ATLAS.nc or ATLAS.zarr (written when complete; resumable).")  # fmt: skip
-@click.option("--workers", type=int, default=None,
-              help="Worker processes of the embedded local cluster (default: cores).")  # fmt: skip
-@click.option("--scheduler", default=None, metavar="ADDRESS",
-              help="Run on an existing Dask cluster (tcp://host:port).")  # fmt: skip
-@click.option("--scheduler-timeout", type=float, default=10.0, show_default=True,
-              metavar="SECONDS",
-              help="Seconds the --scheduler has to answer as a Dask scheduler.")  # fmt: skip
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(),
+    required=True,
+    help="ATLAS.nc or ATLAS.zarr (written when complete; resumable).",
+)
+@click.option(
+    "--workers",
+    type=int,
+    default=None,
+    help="Worker processes of the embedded local cluster (default: cores).",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Run on an existing Dask cluster (tcp://host:port).",
+)
+@click.option(
+    "--scheduler-timeout",
+    type=float,
+    default=10.0,
+    show_default=True,
+    metavar="SECONDS",
+    help="Seconds the --scheduler has to answer as a Dask scheduler.",
+)
 @click.option("--chunk", type=int, default=None, help="Cells per task (default 200).")
 @json_option
 def atlas(
@@ -54,15 +72,25 @@ def atlas(
     if chunk is not None and chunk < 1:
         raise BadInput(f"--chunk {chunk}: must be >= 1")
     if not 0.0 < scheduler_timeout <= MAX_SCHEDULER_TIMEOUT:  # also NaN
-        raise BadInput(f"--scheduler-timeout {scheduler_timeout:g}: must be in "
-                       f"(0, {MAX_SCHEDULER_TIMEOUT:g}] seconds")  # fmt: skip
+        raise BadInput(
+            f"--scheduler-timeout {scheduler_timeout:g}: must be in "
+            f"(0, {MAX_SCHEDULER_TIMEOUT:g}] seconds"
+        )
     check_atlas_output(output)
     atlas_spec = load_atlas_spec(spec)
     start = time.perf_counter()
     with _output.counting("cells", atlas_spec.size) as progress:
-        ds = _output.with_warnings_reported(lambda: atlas(
-            atlas_spec, output, workers=workers, scheduler=scheduler, chunk=chunk or DEFAULT_CHUNK,
-            progress=progress, scheduler_timeout=scheduler_timeout))  # fmt: skip
+        ds = _output.with_warnings_reported(
+            lambda: atlas(
+                atlas_spec,
+                output,
+                workers=workers,
+                scheduler=scheduler,
+                chunk=chunk or DEFAULT_CHUNK,
+                progress=progress,
+                scheduler_timeout=scheduler_timeout,
+            )
+        )
     wall = time.perf_counter() - start
     classified = ds["status"].values == 0
     counts: dict[str, dict[str, int]] = {}
@@ -70,15 +98,22 @@ def atlas(
         uniq, cnt = np.unique(ds[name].values[classified], return_counts=True)
         counts[name] = {str(int(u)): int(c) for u, c in zip(uniq, cnt, strict=True)}
     dims = {str(k): int(v) for k, v in ds.sizes.items() if k != "centre"}
-    summary = {"output": output, "dims": dims, "cells": atlas_spec.size,
-               "classified": int(classified.sum()), "counts": counts, "wall_s": wall}  # fmt: skip
+    summary = {
+        "output": output,
+        "dims": dims,
+        "cells": atlas_spec.size,
+        "classified": int(classified.sum()),
+        "counts": counts,
+        "wall_s": wall,
+    }
     if as_json:
         click.echo(json.dumps(summary))
         return
     console = _output.console()
     shape = " x ".join(f"{k} {v}" for k, v in dims.items())
-    console.print(f"{atlas_spec.size} cells ({shape}), {summary['classified']} classified, "
-                  f"in {wall:.1f} s")  # fmt: skip
+    console.print(
+        f"{atlas_spec.size} cells ({shape}), {summary['classified']} classified, in {wall:.1f} s"
+    )
     for name, c in counts.items():
         console.print(f"  {name}: " + ", ".join(f"{k}: {v} cells" for k, v in c.items()))
     click.echo(f"wrote {output}")

@@ -53,13 +53,17 @@ def _stopped_lines(stopped: list[dict[str, Any]], crossings: int) -> list[str]:
     def vec(x: list[float]) -> str:
         return "[" + ", ".join(f"{v:.6g}" for v in x) + "]"
 
-    lines = [f"{_count(len(stopped), 'trajectory', 'trajectories')} stopped before "
-             f"{_count(crossings, 'crossing', 'crossings')}:"]  # fmt: skip
+    lines = [
+        f"{_count(len(stopped), 'trajectory', 'trajectories')} stopped before "
+        f"{_count(crossings, 'crossing', 'crossings')}:"
+    ]
     for s in stopped[:MAX_NAMED]:
         found = _count(s["crossings"], "crossing", "crossings")
-        lines.append(f"  trajectory {s['trajectory']} (gamma = {vec(s['gamma'])}, omega = "
-                     f"{vec(s['omega'])}): {found}, stopped at t = {s['t_last']:.6g}: "
-                     f"{s['reason']}")  # fmt: skip
+        lines.append(
+            f"  trajectory {s['trajectory']} (gamma = {vec(s['gamma'])}, omega = "
+            f"{vec(s['omega'])}): {found}, stopped at t = {s['t_last']:.6g}: "
+            f"{s['reason']}"
+        )
     if len(stopped) > MAX_NAMED:
         lines.append(f"  ... and {len(stopped) - MAX_NAMED} more (--json lists every one)")
     return lines
@@ -68,18 +72,36 @@ def _stopped_lines(stopped: list[dict[str, Any]], crossings: int) -> list[str]:
 @click.command()
 @scenario_argument
 @figure_output
-@click.option("--crossings", type=int, default=1000, show_default=True,
-              help="Crossings of the section per trajectory.")  # fmt: skip
-@click.option("--trajectories", type=int, default=16, show_default=True,
-              help="Trajectories on the scenario's level (its own state first).")  # fmt: skip
-@click.option("--hold", default=None, metavar="NAMES",
-              help="Integrals held on the level, comma-separated (default: all of the "
-                   "model's; the energy always).")  # fmt: skip
+@click.option(
+    "--crossings",
+    type=int,
+    default=1000,
+    show_default=True,
+    help="Crossings of the section per trajectory.",
+)
+@click.option(
+    "--trajectories",
+    type=int,
+    default=16,
+    show_default=True,
+    help="Trajectories on the scenario's level (its own state first).",
+)
+@click.option(
+    "--hold",
+    default=None,
+    metavar="NAMES",
+    help="Integrals held on the level, comma-separated (default: all of the "
+    "model's; the energy always).",
+)
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the sampling.")
 @click.option("--netcdf", type=click.Path(), default=None, help="Also write the crossings: OUT.nc.")
-@click.option("--t-max", type=click.FloatRange(min=0.0, min_open=True), default=None,
-              help="Stop each trajectory at this time even with fewer crossings (motions that "
-                   "settle, e.g. onto a steady spin, cross no more).")  # fmt: skip
+@click.option(
+    "--t-max",
+    type=click.FloatRange(min=0.0, min_open=True),
+    default=None,
+    help="Stop each trajectory at this time even with fewer crossings (motions that "
+    "settle, e.g. onto a steady spin, cross no more).",
+)
 @click.option(
     "--max-gap-steps",
     type=click.IntRange(min=1),
@@ -119,12 +141,20 @@ def section(
     sc = load_scenario(scenario).with_overrides(rtol=rtol, atol=atol)
     y0 = sc.require_state()
     with _output.counting("crossings found", trajectories * crossings) as progress:
-        ds = poincare_section(sc.body, sc.model, y0, crossings=crossings,
-                              trajectories=trajectories, hold=_hold(hold), seed=seed,
-                              t_max=math.inf if t_max is None else t_max,
-                              max_gap_steps=max_gap_steps or MAX_GAP_STEPS,
-                              rtol=sc.integration.rtol, atol=sc.integration.resolved_atol,
-                              progress=progress)  # fmt: skip
+        ds = poincare_section(
+            sc.body,
+            sc.model,
+            y0,
+            crossings=crossings,
+            trajectories=trajectories,
+            hold=_hold(hold),
+            seed=seed,
+            t_max=math.inf if t_max is None else t_max,
+            max_gap_steps=max_gap_steps or MAX_GAP_STEPS,
+            rtol=sc.integration.rtol,
+            atol=sc.integration.resolved_atol,
+            progress=progress,
+        )
     from rollingtop.plot.section import section_figure
 
     fig = section_figure(ds)
@@ -142,18 +172,22 @@ def section(
     write_together(writes)  # the figure and the crossings, both or neither
     summary = section_summary(ds)
     if summary["contact_lost"]:
-        click.echo(f"rollingtop: warning: {summary['contact_lost']} of {summary['trajectories']} "
-                   "trajectories need a negative normal force at some time (the body would leave "
-                   "the plane; the model keeps the contact): drawn with open circles",
-                   err=True)  # fmt: skip
+        click.echo(
+            f"rollingtop: warning: {summary['contact_lost']} of {summary['trajectories']} "
+            "trajectories need a negative normal force at some time (the body would leave "
+            "the plane; the model keeps the contact): drawn with open circles",
+            err=True,
+        )
     if as_json:
         click.echo(json.dumps(summary))
         return
     found, K = summary["crossings_found"], summary["trajectories"]
     worst = summary["max_abs_w_tau"]
-    click.echo(f"{found} crossings of {K} trajectories (model {summary['model']}, held: "
-               f"{', '.join(summary['held'])})" + ("" if worst is None else
-               f"; max |w_tau| at the crossings {worst:.2g}"))  # fmt: skip
+    click.echo(
+        f"{found} crossings of {K} trajectories (model {summary['model']}, held: "
+        f"{', '.join(summary['held'])})"
+        + ("" if worst is None else f"; max |w_tau| at the crossings {worst:.2g}")
+    )
     for line in _stopped_lines(summary["stopped_early"], crossings):
         click.echo(line)
     click.echo(f"wrote {output}" + ("" if netcdf is None else f" and {netcdf}"))
@@ -162,12 +196,15 @@ def section(
 @click.command()
 @scenario_argument
 @t_end_option
-@click.option("--samples", type=int, default=1000, show_default=True,
-              help="Sample times of the time series.")  # fmt: skip
-@click.option("-o", "--output", type=click.Path(), default=None,
-              help="Write the time series: OUT.nc.")  # fmt: skip
-@click.option("--figure", type=click.Path(), default=None,
-              help="Draw the time series: FIG.png, .svg or .pdf.")  # fmt: skip
+@click.option(
+    "--samples", type=int, default=1000, show_default=True, help="Sample times of the time series."
+)
+@click.option(
+    "-o", "--output", type=click.Path(), default=None, help="Write the time series: OUT.nc."
+)
+@click.option(
+    "--figure", type=click.Path(), default=None, help="Draw the time series: FIG.png, .svg or .pdf."
+)
 @click.option(
     "--phase-volume",
     "volume_samples",
@@ -208,9 +245,15 @@ def chaos(
     with _output.status("chaos:") as show:
         if show is not None:
             show(f"tangent dynamics to t = {opts.t_end:g}")
-        result = chaos_indicators(sc.body, sc.model, sc.require_state(), t_end=opts.t_end,
-                                  samples=samples, rtol=opts.rtol,
-                                  atol=opts.resolved_atol)  # fmt: skip
+        result = chaos_indicators(
+            sc.body,
+            sc.model,
+            sc.require_state(),
+            t_end=opts.t_end,
+            samples=samples,
+            rtol=opts.rtol,
+            atol=opts.resolved_atol,
+        )
     if output is not None:
         result.to_netcdf(output)
     if figure is not None:
@@ -225,20 +268,30 @@ def chaos(
         with _output.status("phase volume:") as show:
             if show is not None:
                 show(f"divergence at {volume_samples} times")
-            volume = phase_volume(sc.body, sc.model, sc.require_state(), t_end=opts.t_end,
-                                  samples=volume_samples, rtol=opts.rtol,
-                                  atol=opts.resolved_atol)  # fmt: skip
+            volume = phase_volume(
+                sc.body,
+                sc.model,
+                sc.require_state(),
+                t_end=opts.t_end,
+                samples=volume_samples,
+                rtol=opts.rtol,
+                atol=opts.resolved_atol,
+            )
         summary["phase_volume"] = volume.summary()
     if as_json:
         click.echo(json.dumps(summary))
         return
-    click.echo(f"model {summary['model']}, t = {summary['t_end']:g}: maximal Lyapunov exponent "
-               f"{summary['lyapunov']:.6g}, mean MEGNO <Y> = {summary['megno']:.6g} "
-               f"(Y = {summary['megno_instantaneous']:.6g}); {summary['steps']} steps")  # fmt: skip
+    click.echo(
+        f"model {summary['model']}, t = {summary['t_end']:g}: maximal Lyapunov exponent "
+        f"{summary['lyapunov']:.6g}, mean MEGNO <Y> = {summary['megno']:.6g} "
+        f"(Y = {summary['megno_instantaneous']:.6g}); {summary['steps']} steps"
+    )
     if volume_samples is not None:
-        click.echo(f"mean divergence (phase-volume drift) "
-                   f"{summary['phase_volume']['mean_divergence']:.6g} on a manifold of "
-                   f"dimension {summary['phase_volume']['dimension']}")  # fmt: skip
+        click.echo(
+            f"mean divergence (phase-volume drift) "
+            f"{summary['phase_volume']['mean_divergence']:.6g} on a manifold of "
+            f"dimension {summary['phase_volume']['dimension']}"
+        )
     for path in (output, figure):
         if path is not None:
             click.echo(f"wrote {path}")

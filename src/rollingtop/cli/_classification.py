@@ -18,8 +18,13 @@ __all__ = ["compare_classification"]
 @scenario_argument
 @figure_output
 @json_option
-@click.option("--points", type=int, default=121, show_default=True,
-              help="Grid points of each model's critical values.")  # fmt: skip
+@click.option(
+    "--points",
+    type=int,
+    default=121,
+    show_default=True,
+    help="Grid points of each model's critical values.",
+)
 def compare_classification(scenario: str, output: str, as_json: bool, points: int) -> None:
     """Each integrable model's classification of the scenario's motion, side by side.
 
@@ -43,8 +48,9 @@ def compare_classification(scenario: str, output: str, as_json: bool, points: in
     check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
     if sc.initial is None:
-        raise BadInput("compare-classification needs an [initial] table (a state to start "
-                       "every model from)")  # fmt: skip
+        raise BadInput(
+            "compare-classification needs an [initial] table (a state to start every model from)"
+        )
     y0 = sc.require_state()
     own = (sc.model.name, y0) if sc.model.reduction else None
     refused: dict[str, str] = {}
@@ -61,18 +67,34 @@ def compare_classification(scenario: str, output: str, as_json: bool, points: in
     from rich.table import Table
 
     table = Table(title="the same body and state under each reduced model")
-    for col in ("model", "level", "h", "gamma3_min", "gamma3_max", "period", "delta_psi",
-                "steady motions"):  # fmt: skip
+    for col in (
+        "model",
+        "level",
+        "h",
+        "gamma3_min",
+        "gamma3_max",
+        "period",
+        "delta_psi",
+        "steady motions",
+    ):
         table.add_column(col, justify="left" if col in ("model", "level") else "right")
     for c in classes:
         o = c.orbit
         level = ", ".join(f"{k} = {v:.6g}" for k, v in c.level.values().items())
         kinds = ", ".join(f"{m.type} {m.gamma3:.4f}" for m in c.steady)
         dpsi = c.delta_psi
-        table.add_row(c.model, level, f"{c.h:.6g}",
-                      *(("-", "-", "-") if o is None else
-                        (f"{o.gamma3_min:.8g}", f"{o.gamma3_max:.8g}", f"{o.period:.10g}")),
-                      "-" if dpsi is None else f"{dpsi:.8g}", kinds or "none")  # fmt: skip
+        table.add_row(
+            c.model,
+            level,
+            f"{c.h:.6g}",
+            *(
+                ("-", "-", "-")
+                if o is None
+                else (f"{o.gamma3_min:.8g}", f"{o.gamma3_max:.8g}", f"{o.period:.10g}")
+            ),
+            "-" if dpsi is None else f"{dpsi:.8g}",
+            kinds or "none",
+        )
     _output.console().print(table)
     for c in classes:
         if c.note:

@@ -92,8 +92,9 @@ def ensemble(
         columns = grid_table(grid, samples)
     n = len(next(iter(columns.values())))
     with _output.counting("ensemble", n) as progress:
-        result = ensemble_from_scenario(sc, columns, progress=progress, samples=samples,
-                                        threads=threads)  # fmt: skip
+        result = ensemble_from_scenario(
+            sc, columns, progress=progress, samples=samples, threads=threads
+        )
     if threads is not None and result.threads < threads:  # the library used the cores it has
         cores = result.threads
         _output.note(f"--threads {threads} is more than the {cores} cores available; used {cores}")

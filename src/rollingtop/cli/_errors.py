@@ -115,5 +115,6 @@ def reported() -> Iterator[None]:
             "of the inputs beyond 1e308): rescale the scenario's units"
         ) from None
     except MemoryError:
-        raise RunFailed("not enough memory for what was asked (fewer samples, a smaller "
-                        "grid)") from None  # fmt: skip
+        raise RunFailed(
+            "not enough memory for what was asked (fewer samples, a smaller grid)"
+        ) from None

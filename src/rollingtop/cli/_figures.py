@@ -172,6 +172,14 @@ def animate(
         check_device(look, sc.model)  # before anything runs
     traj = run_scenario(sc)
     with _output.counting("rendering", n_frames) as progress:
-        render(traj, output, look=look, fps=fps, duration=duration, speed=speed, camera=camera,
-               progress=progress)  # fmt: skip
+        render(
+            traj,
+            output,
+            look=look,
+            fps=fps,
+            duration=duration,
+            speed=speed,
+            camera=camera,
+            progress=progress,
+        )
     click.echo(f"wrote {output} ({n_frames} frames)")

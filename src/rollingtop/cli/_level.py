@@ -47,8 +47,16 @@ def _steady_table(level: LevelSet, motions: Sequence[SteadyMotion]) -> Table:
     for col in cols:
         table.add_column(col, justify="left" if col == "type" else "right")
     for m in motions:
-        table.add_row(_num(m.gamma3), _num(m.U), m.type, _num(m.frequency), _num(m.period),
-                      _num(m.precession_rate), _num(m.com_speed), _num(m.com_radius))  # fmt: skip
+        table.add_row(
+            _num(m.gamma3),
+            _num(m.U),
+            m.type,
+            _num(m.frequency),
+            _num(m.period),
+            _num(m.precession_rate),
+            _num(m.com_speed),
+            _num(m.com_radius),
+        )
     return table
 
 
@@ -65,8 +73,9 @@ def equilibria(scenario: str, as_json: bool) -> None:
     level = _level_of(scenario)
     motions = steady_motions(level)
     if as_json:
-        click.echo(json.dumps({"level": _level_json(level),
-                               "equilibria": [m.to_dict() for m in motions]}))  # fmt: skip
+        click.echo(
+            json.dumps({"level": _level_json(level), "equilibria": [m.to_dict() for m in motions]})
+        )
     else:
         _output.console().print(_steady_table(level, motions))
 
@@ -76,8 +85,16 @@ def _orbits_table(level: LevelSet, h: float, survey: Sequence[OrbitSurvey]) -> T
 
     energy = level.full_energy(h)
     table = Table(title=f"orbits on {level.describe()}, h = {h:g} (energy {energy:g})")
-    cols = ("gamma3_min", "gamma3_max", "period", "+-", "delta_psi", "motion", "circle / drift",
-            "note")  # fmt: skip
+    cols = (
+        "gamma3_min",
+        "gamma3_max",
+        "period",
+        "+-",
+        "delta_psi",
+        "motion",
+        "circle / drift",
+        "note",
+    )
     for col in cols:
         table.add_column(col, justify="left" if col in ("motion", "note") else "right")
     for row in survey:

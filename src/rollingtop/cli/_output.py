@@ -134,8 +134,9 @@ def counting(label: str, total: int | None) -> Iterator[Callable[[int, int], Non
     if stderr is None:
         yield None
         return
-    with Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), console=stderr,
-                  transient=True) as bar:  # fmt: skip
+    with Progress(
+        TextColumn(label), BarColumn(), MofNCompleteColumn(), console=stderr, transient=True
+    ) as bar:
         task = bar.add_task(label, total=total)
         yield lambda done, n: bar.update(task, completed=done, total=n)
 

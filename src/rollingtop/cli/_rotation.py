@@ -18,17 +18,39 @@ __all__ = ["rotation"]
 @click.command()
 @scenario_argument
 @json_option
-@click.option("-o", "--output", type=click.Path(), default=None,
-              help="Also draw the map and a path of each class: FIG.png, .svg, .pdf.")  # fmt: skip
-@click.option("--c2-range", default=None, metavar="LO,HI",
-              help="C2 window (default: the bifurcation diagram's).")  # fmt: skip
-@click.option("--axis-range", default=None, metavar="LO,HI",
-              help="Another reduced model's axis window (smooth: C1, rough: jellett; default "
-                   "its value +- max(1, |value|)).")  # fmt: skip
-@click.option("--h-range", default=None, metavar="LO,HI",
-              help="h window (default: the bifurcation diagram's).")  # fmt: skip
-@click.option("--resolution", type=int, default=41, show_default=True,
-              help="Grid points along C2 and along h.")  # fmt: skip
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(),
+    default=None,
+    help="Also draw the map and a path of each class: FIG.png, .svg, .pdf.",
+)
+@click.option(
+    "--c2-range",
+    default=None,
+    metavar="LO,HI",
+    help="C2 window (default: the bifurcation diagram's).",
+)
+@click.option(
+    "--axis-range",
+    default=None,
+    metavar="LO,HI",
+    help="Another reduced model's axis window (smooth: C1, rough: jellett; default "
+    "its value +- max(1, |value|)).",
+)
+@click.option(
+    "--h-range",
+    default=None,
+    metavar="LO,HI",
+    help="h window (default: the bifurcation diagram's).",
+)
+@click.option(
+    "--resolution",
+    type=int,
+    default=41,
+    show_default=True,
+    help="Grid points along C2 and along h.",
+)
 def rotation(
     scenario: str,
     as_json: bool,
@@ -61,32 +83,45 @@ def rotation(
     sc = load_scenario(scenario)
     if sc.model.reduction and not sc.model.has_reduction:
         if c2_range is not None:
-            raise BadInput(f"--c2-range: the paper's model's window; the {sc.model.name} "
-                           "model's is --axis-range")  # fmt: skip
-        _other_model(sc, as_json, output, _range("--axis-range", axis_range), h_window,
-                     resolution)  # fmt: skip
+            raise BadInput(
+                f"--c2-range: the paper's model's window; the {sc.model.name} "
+                "model's is --axis-range"
+            )
+        _other_model(sc, as_json, output, _range("--axis-range", axis_range), h_window, resolution)
         return
     if axis_range is not None:
-        raise BadInput("--axis-range: another reduced model's window; the meridian model's is "
-                       "--c2-range")  # fmt: skip
+        raise BadInput(
+            "--axis-range: another reduced model's window; the meridian model's is --c2-range"
+        )
     M3, C1, C2 = sc.level_integrals("`rollingtop rotation`")
     diagram = bifurcation_diagram(sc.body, M3, C1, C2_range=c2_window, h_range=h_window)
     c2w = (float(diagram.C2_grid[0]), float(diagram.C2_grid[-1]))
     hw = (float(diagram.h_grid[0]), float(diagram.h_grid[-1]))
     with _output.counting("rotation numbers", resolution) as progress:
-        rmap = rotation_map(sc.body, M3, C1, C2_range=c2w, h_range=hw,
-                            resolution=(resolution, resolution), progress=progress)  # fmt: skip
+        rmap = rotation_map(
+            sc.body,
+            M3,
+            C1,
+            C2_range=c2w,
+            h_range=hw,
+            resolution=(resolution, resolution),
+            progress=progress,
+        )
     if rmap.to_dict()["N_range"] is None:
-        raise BadInput(f"no periodic orbit in the window C2 in [{c2w[0]:.6g}, {c2w[1]:.6g}], "
-                       f"h in [{hw[0]:.6g}, {hw[1]:.6g}]: widen --h-range or "
-                       "--c2-range")  # fmt: skip
+        raise BadInput(
+            f"no periodic orbit in the window C2 in [{c2w[0]:.6g}, {c2w[1]:.6g}], "
+            f"h in [{hw[0]:.6g}, {hw[1]:.6g}]: widen --h-range or "
+            "--c2-range"
+        )
     examples = class_examples(sc.body, rmap)
     summary: dict[str, Any] = {**rmap.to_dict(), "classes": examples}
     if C2 is not None:
         level = LevelSet(sc.body, M3, C1, C2)
-        summary["centres"] = [{"C2": C2, "gamma3": m.gamma3, "h": m.U,
-                               "N": centre_rotation_number(m)}
-                              for m in steady_motions(level) if m.type == "center"]  # fmt: skip
+        summary["centres"] = [
+            {"C2": C2, "gamma3": m.gamma3, "h": m.U, "N": centre_rotation_number(m)}
+            for m in steady_motions(level)
+            if m.type == "center"
+        ]
     if output is not None:
         from rollingtop.plot import save_figure
         from rollingtop.plot.rotation import rotation_figure
@@ -97,10 +132,12 @@ def rotation(
         return
     console = _output.console()
     lo, hi = summary["N_range"]
-    console.print(f"rotation number N over C2 in [{c2w[0]:.5g}, {c2w[1]:.5g}], h in "
-                  f"[{hw[0]:.5g}, {hw[1]:.5g}]: N from {lo:.6g} to {hi:.6g}; "
-                  f"{sum(r['q'] == 1 for r in rmap.resonances)} points with N an integer, "
-                  f"{sum(r['q'] > 1 for r in rmap.resonances)} with N = p/2 or p/3")  # fmt: skip
+    console.print(
+        f"rotation number N over C2 in [{c2w[0]:.5g}, {c2w[1]:.5g}], h in "
+        f"[{hw[0]:.5g}, {hw[1]:.5g}]: N from {lo:.6g} to {hi:.6g}; "
+        f"{sum(r['q'] == 1 for r in rmap.resonances)} points with N an integer, "
+        f"{sum(r['q'] > 1 for r in rmap.resonances)} with N = p/2 or p/3"
+    )
     for name, ex in examples.items():
         frac = "" if ex["q"] in (None, 1) else f" = {ex['p']}/{ex['q']}"
         console.print(f"{name}: N = {ex['N']:.6g}{frac} at C2 = {ex['C2']:.6g}, h = {ex['h']:.6g}")
@@ -110,8 +147,9 @@ def rotation(
         click.echo(f"wrote {output}")
 
 
-def _other_model(sc: Any, as_json: bool, output: str | None, window: Any, h_window: Any,
-                 resolution: int) -> None:  # fmt: skip
+def _other_model(
+    sc: Any, as_json: bool, output: str | None, window: Any, h_window: Any, resolution: int
+) -> None:
     """``rotation`` for a reduced model other than the paper's: ``N`` over its axis integral and
     ``h`` (:func:`rollingtop.reduction.classify.rotation_grid`)."""
     import numpy as np
@@ -121,12 +159,14 @@ def _other_model(sc: Any, as_json: bool, output: str | None, window: Any, h_wind
 
     level = sc.level_set()
     with _output.counting("rotation numbers", resolution) as progress:
-        grid = rotation_grid(level, window=window, h_range=h_window, resolution=resolution,
-                             progress=progress)  # fmt: skip
+        grid = rotation_grid(
+            level, window=window, h_range=h_window, resolution=resolution, progress=progress
+        )
     summary = grid.to_dict()
     if summary["N_range"] is None:
-        raise BadInput(f"no periodic orbit in the window of {grid.axis} and h: widen "
-                       "--h-range or --c2-range")  # fmt: skip
+        raise BadInput(
+            f"no periodic orbit in the window of {grid.axis} and h: widen --h-range or --c2-range"
+        )
     finite = grid.N[np.isfinite(grid.N)]
     kinds = [classify_rotation(float(n))["class"] for n in finite]
     summary["classes"] = {k: kinds.count(k) for k in sorted(set(kinds))}

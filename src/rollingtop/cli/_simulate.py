@@ -47,8 +47,7 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
         held = sc.integration.project_integrals if held is None else held
         model = get_model(options.get("model") or sc.model)
         if not (held and model.own_inertia):  # else refused by the run, before any compiling
-            compiled = compile_code(code, held=bool(held),
-                                    events=options.get("events") is not None)  # fmt: skip
+            compiled = compile_code(code, held=bool(held), events=options.get("events") is not None)
     with _output.timing(sc.integration.t_end) as progress:
         traj = _output.with_warnings_reported(lambda: run(sc, progress=progress, **options))
     # the compilation belongs to the run's statistics, wherever it happened
@@ -79,8 +78,9 @@ def _level_line(level: dict[str, Any]) -> str:
     (:meth:`rollingtop.scenario.Scenario.level_summary`), in one line."""
     where = "of [level]" if level["source"] == "[level]" else "of the initial state"
     skip = ("h", "energy", "energy_formula", "spin_energy", "mgR", "source")
-    named = ", ".join(f"{k} = {v:.10g}" for k, v in level.items()
-                      if k not in skip and v is not None)  # fmt: skip
+    named = ", ".join(
+        f"{k} = {v:.10g}" for k, v in level.items() if k not in skip and v is not None
+    )
     h, mgR, energy = (f"{level[k]:.10g}" for k in ("h", "mgR", "energy"))
     terms = [h] + ([] if level["spin_energy"] is None else [f"{level['spin_energy']:.10g}"])
     return (
@@ -130,9 +130,13 @@ def _print_report(summary: dict[str, Any]) -> None:
 @click.option(
     "-o", "--output", type=click.Path(), default=None, help="Write samples to OUT.nc or OUT.csv."
 )
-@click.option("--project-integrals", is_flag=True, default=None,
-              help="Hold the model's integrals at their initial values by projection after "
-                   "every step ([integration] project_integrals).")  # fmt: skip
+@click.option(
+    "--project-integrals",
+    is_flag=True,
+    default=None,
+    help="Hold the model's integrals at their initial values by projection after "
+    "every step ([integration] project_integrals).",
+)
 @json_option
 def simulate(
     scenario: str,

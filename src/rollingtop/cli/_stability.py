@@ -41,8 +41,11 @@ class ModelOrAll(ModelChoice):
             return ALL
         if isinstance(value, ContactModel) or (isinstance(value, str) and value in MODELS):
             return super().convert(value, param, ctx)
-        self.fail(f"unknown contact model {short_repr(value)} (known: {', '.join(MODELS)}, or "
-                  f"{ALL})", param, ctx)  # fmt: skip
+        self.fail(
+            f"unknown contact model {short_repr(value)} (known: {', '.join(MODELS)}, or {ALL})",
+            param,
+            ctx,
+        )
 
 
 def _pairs(values: Any) -> list[list[float]]:
@@ -55,12 +58,15 @@ def _model_summary(body: SphericalTop, model: ContactModel, omega3: float | None
     from rollingtop.stability import vertical_spin_eigenvalues, vertical_spins
 
     spins = vertical_spins(body, model)
-    summary: dict[str, Any] = {"model": model.name,
-                               "vertical_spin": [v.to_dict() for v in spins]}  # fmt: skip
+    summary: dict[str, Any] = {"model": model.name, "vertical_spin": [v.to_dict() for v in spins]}
     if omega3 is not None:
-        summary["eigenvalues"] = {"omega3": omega3, **{
-            v.pole: _pairs(vertical_spin_eigenvalues(body, model, omega3, v.pole))
-            for v in spins}}  # fmt: skip
+        summary["eigenvalues"] = {
+            "omega3": omega3,
+            **{
+                v.pole: _pairs(vertical_spin_eigenvalues(body, model, omega3, v.pole))
+                for v in spins
+            },
+        }
     return summary
 
 
@@ -85,28 +91,44 @@ def _table(summaries: list[dict[str, Any]], title: str) -> Table:
 
     several = len(summaries) > 1
     table = Table(title=title)
-    cols = ("model",) * several + ("pole on the plane", "CoM above centre",
-                                   "stable for w3 above", "closed form")  # fmt: skip
+    cols = ("model",) * several + (
+        "pole on the plane",
+        "CoM above centre",
+        "stable for w3 above",
+        "closed form",
+    )
     for col in cols:
         table.add_column(col, justify="left" if col in ("model", "pole on the plane") else "right")
     for s in summaries:
         for v in s.get("vertical_spin", []):
             closed = v["omega3_closed_form"]
-            table.add_row(*(s["model"],) * several, v["pole"],
-                          "yes" if v["com_above_centre"] else "no",
-                          f"{v['omega3_critical']:.10g}",
-                          "-" if closed is None else f"{closed:.10g}")  # fmt: skip
+            table.add_row(
+                *(s["model"],) * several,
+                v["pole"],
+                "yes" if v["com_above_centre"] else "no",
+                f"{v['omega3_critical']:.10g}",
+                "-" if closed is None else f"{closed:.10g}",
+            )
     return table
 
 
 @click.command()
 @scenario_argument
 @json_option
-@click.option("--model", "model", type=ModelOrAll(), default=None,
-              help="Contact model (default: the scenario's), or 'all': every registered model "
-                   "that takes the body.")  # fmt: skip
-@click.option("--omega3", type=float, default=None,
-              help="Also give the eigenvalues of the linearisation at this spin rate.")  # fmt: skip
+@click.option(
+    "--model",
+    "model",
+    type=ModelOrAll(),
+    default=None,
+    help="Contact model (default: the scenario's), or 'all': every registered model "
+    "that takes the body.",
+)
+@click.option(
+    "--omega3",
+    type=float,
+    default=None,
+    help="Also give the eigenvalues of the linearisation at this spin rate.",
+)
 def stability(
     scenario: str, as_json: bool, model: ContactModel | str | None, omega3: float | None
 ) -> None:

@@ -33,9 +33,11 @@ _SHORT_METHODS = (
     (re.compile(r"^exact evaluation: (.*) at a random rational point$"), r"\1 at a point"),
 )
 #: Below the table: what the short methods stand for (``--json`` gives the long names).
-CAPTION = ("every method is exact: simplified = cancelled to zero; N random points = evaluated "
-           "in rational arithmetic at N random rational points; nonzero at a point = a rational "
-           "counterexample")  # fmt: skip
+CAPTION = (
+    "every method is exact: simplified = cancelled to zero; N random points = evaluated "
+    "in rational arithmetic at N random rational points; nonzero at a point = a rational "
+    "counterexample"
+)
 
 
 def _short_method(method: str) -> str:
@@ -58,8 +60,13 @@ def _table(results: list[ClaimResult]) -> Table:
     table.add_column("time (s)", justify="right", no_wrap=True)
     for r in results:
         colour = "green" if r.result == "proved" else "red"
-        table.add_row(r.name, r.model, f"[{colour}]{r.result}[/{colour}]",
-                      _short_method(r.method), f"{r.seconds:.2f}")  # fmt: skip
+        table.add_row(
+            r.name,
+            r.model,
+            f"[{colour}]{r.result}[/{colour}]",
+            _short_method(r.method),
+            f"{r.seconds:.2f}",
+        )
     return table
 
 

@@ -272,8 +272,9 @@ class ContactModel:
         if self.spin_directions is None:
             return True
         e3 = np.array([0.0, 0.0, 1.0])
-        return all(float(np.asarray(d, dtype=float) @ e3) == 0.0
-                   for d in self.spin_directions(e3).values())  # fmt: skip
+        return all(
+            float(np.asarray(d, dtype=float) @ e3) == 0.0 for d in self.spin_directions(e3).values()
+        )
 
     @property
     def kernels(self) -> tuple[Kernel, ...]:

@@ -40,8 +40,7 @@ def rhs_contact(
     a1, a2, a3_ = r2 * g3 - r3 * g2, r3 * g1 - r1 * g3, r1 * g2 - r2 * g1
     bias1 = row_bias(y, r1, r2, r3, rd1, rd2, rd3, g1, g2, g3, gd1, gd2, gd3)
     A11 = (g1 * g1 + g2 * g2 + g3 * g3) * im + a1 * a1 * i1 + a2 * a2 * i2 + a3_ * a3_ * i3
-    c1 = -bias1 - (g1 * f1 + g2 * f2 + g3 * f3) * im - (a1 * f4 * i1 + a2 * f5 * i2
-                                                        + a3_ * f6 * i3)  # fmt: skip
+    c1 = -bias1 - (g1 * f1 + g2 * f2 + g3 * f3) * im - (a1 * f4 * i1 + a2 * f5 * i2 + a3_ * f6 * i3)
     l2 = 0.0
     b1 = b2 = b3 = 0.0
     if two:
@@ -49,8 +48,11 @@ def rhs_contact(
         bias2 = row_bias(y, r1, r2, r3, rd1, rd2, rd3, n1, n2, n3, nd1, nd2, nd3)
         A12 = (g1 * n1 + g2 * n2 + g3 * n3) * im + a1 * b1 * i1 + a2 * b2 * i2 + a3_ * b3 * i3
         A22 = (n1 * n1 + n2 * n2 + n3 * n3) * im + b1 * b1 * i1 + b2 * b2 * i2 + b3 * b3 * i3
-        c2 = -bias2 - (n1 * f1 + n2 * f2 + n3 * f3) * im - (b1 * f4 * i1 + b2 * f5 * i2
-                                                            + b3 * f6 * i3)  # fmt: skip
+        c2 = (
+            -bias2
+            - (n1 * f1 + n2 * f2 + n3 * f3) * im
+            - (b1 * f4 * i1 + b2 * f5 * i2 + b3 * f6 * i3)
+        )
         det = A11 * A22 - A12 * A12
         l1 = (c1 * A22 - c2 * A12) / det
         l2 = (A11 * c2 - A12 * c1) / det

@@ -126,9 +126,15 @@ def tau_rate(y: FloatArray, t1: float, t2: float, t3: float, rate: float) -> Flo
 
 @inline
 def _spin_rate(
-    p: FloatArray, y: FloatArray, t1: float, t2: float, t3: float, td1: float, td2: float,
+    p: FloatArray,
+    y: FloatArray,
+    t1: float,
+    t2: float,
+    t3: float,
+    td1: float,
+    td2: float,
     td3: float,
-) -> Float3:  # fmt: skip
+) -> Float3:
     """``w'`` under the rows ``(vp, gamma) = 0`` and ``(vp, t) = 0`` with ``t' = td``: the
     2x2 multiplier system of :mod:`rollingtop._compiled._kernel`, written out for the pole rate
     (which needs ``w'`` at two trial rates, without a workspace)."""
@@ -217,8 +223,9 @@ def carried_rate(p: FloatArray, y: FloatArray) -> float:
     turn = a3_ * b3d - b3 * a3d  # s^2 psi'
     c2, n2 = math.cos(2.0 * y[17]), math.sin(2.0 * y[17])
     offset = n2 * (a3_ * a3_ - b3 * b3) - c2 * (2.0 * a3_ * b3)  # s^2 sin(2 delta)
-    k = math.sqrt(RELAX * RELAX + PASS_RELAX * PASS_RELAX * (a3d * a3d + b3d * b3d)
-                  / (s2 + S_POLE * S_POLE))  # fmt: skip
+    k = math.sqrt(
+        RELAX * RELAX + PASS_RELAX * PASS_RELAX * (a3d * a3d + b3d * b3d) / (s2 + S_POLE * S_POLE)
+    )
     numerator = turn - 0.5 * k * offset
     if s2 >= S_POLE * S_POLE:
         far: float = numerator / s2

@@ -124,9 +124,19 @@ def _column(
 
 @kernel  # a call of its own: inlined in each of its 14 uses, it took 10 s to compile
 def _dot_mt(
-    p: FloatArray, g1: float, g2: float, g3: float, i: int,
-    x1: float, x2: float, x3: float, x4: float, x5: float, x6: float, x7: float,
-) -> float:  # fmt: skip
+    p: FloatArray,
+    g1: float,
+    g2: float,
+    g3: float,
+    i: int,
+    x1: float,
+    x2: float,
+    x3: float,
+    x4: float,
+    x5: float,
+    x6: float,
+    x7: float,
+) -> float:
     """``(T e_i, x)``: column ``i`` of ``T`` (``q = e_i``) against the 7-vector ``x``."""
     w1 = 1.0 if i == 0 else 0.0
     w2 = 1.0 if i == 1 else 0.0
@@ -150,10 +160,21 @@ def _gram(p: FloatArray, g1: float, g2: float, g3: float, i: int, j: int) -> flo
 
 @inline
 def _solve4(
-    A11: float, A21: float, A22: float, A31: float, A32: float, A33: float,
-    A41: float, A42: float, A43: float, A44: float,
-    b1: float, b2: float, b3: float, b4: float,
-) -> tuple[float, float, float, float]:  # fmt: skip
+    A11: float,
+    A21: float,
+    A22: float,
+    A31: float,
+    A32: float,
+    A33: float,
+    A41: float,
+    A42: float,
+    A43: float,
+    A44: float,
+    b1: float,
+    b2: float,
+    b3: float,
+    b4: float,
+) -> tuple[float, float, float, float]:
     """``A^-1 b`` for a 4x4 SPD ``A`` (lower triangle) by Cholesky, in scalars."""
     L11 = math.sqrt(A11)
     L21 = A21 / L11
@@ -208,12 +229,20 @@ def accelerations(
     b4 = _dot_mt(p, g1, g2, g3, 3, F1 - K1, F2 - K2, F3 - K3, F4 - K4, F5 - K5, F6 - K6, -K7)
     wd1, wd2, wd3, dd = _solve4(
         _gram(p, g1, g2, g3, 0, 0),
-        _gram(p, g1, g2, g3, 1, 0), _gram(p, g1, g2, g3, 1, 1),
-        _gram(p, g1, g2, g3, 2, 0), _gram(p, g1, g2, g3, 2, 1), _gram(p, g1, g2, g3, 2, 2),
-        _gram(p, g1, g2, g3, 3, 0), _gram(p, g1, g2, g3, 3, 1), _gram(p, g1, g2, g3, 3, 2),
+        _gram(p, g1, g2, g3, 1, 0),
+        _gram(p, g1, g2, g3, 1, 1),
+        _gram(p, g1, g2, g3, 2, 0),
+        _gram(p, g1, g2, g3, 2, 1),
+        _gram(p, g1, g2, g3, 2, 2),
+        _gram(p, g1, g2, g3, 3, 0),
+        _gram(p, g1, g2, g3, 3, 1),
+        _gram(p, g1, g2, g3, 3, 2),
         _gram(p, g1, g2, g3, 3, 3),
-        b1, b2, b3, b4,
-    )  # fmt: skip
+        b1,
+        b2,
+        b3,
+        b4,
+    )
     c1, c2, c3 = _column(p, g1, g2, g3, wd1, wd2, wd3, dd)
     vd1, vd2, vd3 = c1 + k1, c2 + k2, c3 + k3
     Q1, Q2, Q3, _, _, _, _ = momenta(p, vd1, vd2, vd3, wd1, wd2, wd3, dd)

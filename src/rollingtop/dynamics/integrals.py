@@ -279,8 +279,7 @@ def evaluate(
     """Evaluate the integrals ``names`` on states ``Y`` (shape ``(..., 18)``); ``pole`` is the
     meridian pole case the states belong to, if any (see :func:`F6`)."""
     Y = np.asarray(Y, dtype=float)
-    return {name: F6(body, Y, pole) if name == "F6" else INTEGRALS[name](body, Y)
-            for name in names}  # fmt: skip
+    return {name: F6(body, Y, pole) if name == "F6" else INTEGRALS[name](body, Y) for name in names}
 
 
 #: Largest drift of a held integral (:func:`rollingtop.simulate`'s ``project_integrals``), as a

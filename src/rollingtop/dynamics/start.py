@@ -59,8 +59,13 @@ class InitialConditions:
     def from_state(cls, y: ArrayLike) -> InitialConditions:
         """The initial conditions that rebuild the state ``y`` (full velocity given)."""
         y = np.asarray(y, dtype=float)
-        return cls(gamma=_floats(y[GAMMA]), omega=_floats(y[W]), alpha=_floats(y[ALPHA]),
-                   position=_floats(y[POSITION]), v=_floats(y[V]))  # fmt: skip
+        return cls(
+            gamma=_floats(y[GAMMA]),
+            omega=_floats(y[W]),
+            alpha=_floats(y[ALPHA]),
+            position=_floats(y[POSITION]),
+            v=_floats(y[V]),
+        )
 
     def state(self, body: SphericalTop, model: ContactModel | str) -> NDArray[np.float64]:
         """The constraint-consistent state vector, shape (18,).

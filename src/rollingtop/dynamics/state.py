@@ -116,8 +116,9 @@ def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: Array
     model = get_model(model)
     state = np.asarray(y, dtype=float)
     J, bias, dirs, _, _ = call(new_workspace)
-    nc = call(for_code(model.code).dynamics.constraint_rows, model.code, body.params, state, J,
-              bias, dirs)  # fmt: skip
+    nc = call(
+        for_code(model.code).dynamics.constraint_rows, model.code, body.params, state, J, bias, dirs
+    )
     residuals: FloatArray = J[:nc] @ state[:6]
     return residuals
 

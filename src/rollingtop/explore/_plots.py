@@ -21,8 +21,14 @@ _CENTRE, _SADDLE, _CURRENT, _PATH = "#1b7837", "#762a83", "#d6604d", "#2166ac"
 
 
 def _figure(title: str, x_label: str, y_label: str, **kw: Any) -> Any:
-    fig = figure(title=title, height=300, width=380, tools="pan,wheel_zoom,reset,tap",
-                 toolbar_location="above", **kw)  # fmt: skip
+    fig = figure(
+        title=title,
+        height=300,
+        width=380,
+        tools="pan,wheel_zoom,reset,tap",
+        toolbar_location="above",
+        **kw,
+    )
     fig.xaxis.axis_label, fig.yaxis.axis_label = x_label, y_label
     return fig
 
@@ -55,24 +61,43 @@ class Plots:
         )
         p.scatter("x", "y", source=self.start, marker="x", color="black", size=12)
         p.legend.location = "top_left"
-        u = self.potential = _figure("effective potential U", "gamma3", "U",
-                                     y_range=Range1d(start=0.0, end=1.0))  # fmt: skip
+        u = self.potential = _figure(
+            "effective potential U", "gamma3", "U", y_range=Range1d(start=0.0, end=1.0)
+        )
         u.line("x", "y", source=self.U, color="black", line_width=1.5)
         u.scatter("x", "U", source=self.steady, color="colour", size=8)
         self.h_line = Span(location=0.0, dimension="width", line_color=_CURRENT, line_dash="dashed")
         u.add_layout(self.h_line)
         self.centres, self.saddles = _source("x", "y"), _source("x", "y")
         self.folds, self.floor, self.mark = _source("x", "y"), _source("x", "y"), _source("x", "y")
-        d = self.diagram = _figure("bifurcation diagram (click: move the level)", "C2", "h",
-                                   x_range=Range1d(start=0.0, end=1.0),
-                                   y_range=Range1d(start=0.0, end=1.0))  # fmt: skip
+        d = self.diagram = _figure(
+            "bifurcation diagram (click: move the level)",
+            "C2",
+            "h",
+            x_range=Range1d(start=0.0, end=1.0),
+            y_range=Range1d(start=0.0, end=1.0),
+        )
         d.line("x", "y", source=self.floor, color="gray", line_dash="dotted")
         d.line("x", "y", source=self.centres, color=_CENTRE, line_width=2, legend_label="centres")
-        d.line("x", "y", source=self.saddles, color=_SADDLE, line_width=2, line_dash="dashed",
-               legend_label="saddles")  # fmt: skip
+        d.line(
+            "x",
+            "y",
+            source=self.saddles,
+            color=_SADDLE,
+            line_width=2,
+            line_dash="dashed",
+            legend_label="saddles",
+        )
         d.scatter("x", "y", source=self.folds, color="black", size=6)
-        d.scatter("x", "y", source=self.mark, marker="star", color=_CURRENT, size=16,
-                  legend_label="current level")  # fmt: skip
+        d.scatter(
+            "x",
+            "y",
+            source=self.mark,
+            marker="star",
+            color=_CURRENT,
+            size=16,
+            legend_label="current level",
+        )
         d.legend.location = "top_left"
         self.path_source = _source("x", "y")
         self.path = _figure("contact point's path on the plane", "X", "Y", match_aspect=True)
@@ -101,9 +126,20 @@ class Plots:
 
     def clear(self) -> None:
         """Every source emptied (the page's session has gone)."""
-        for src in (self.back, self.current, self.section, self.start, self.clicked, self.U,
-                    self.centres, self.saddles, self.folds, self.floor, self.mark,
-                    self.path_source):  # fmt: skip
+        for src in (
+            self.back,
+            self.current,
+            self.section,
+            self.start,
+            self.clicked,
+            self.U,
+            self.centres,
+            self.saddles,
+            self.folds,
+            self.floor,
+            self.mark,
+            self.path_source,
+        ):
             src.data = {"x": [], "y": []}
         self.steady.data = {"x": [], "y": [], "U": [], "colour": []}
         self.frame.object = None
@@ -131,8 +167,12 @@ class Plots:
         self.back.data = {"x": view.background[0], "y": view.background[1]}
         self.current.data = {"x": view.current[0], "y": view.current[1]}
         colours = [_CENTRE if t == "center" else _SADDLE for _, _, t in view.steady]
-        self.steady.data = {"x": [s[0] for s in view.steady], "y": [0.0] * len(view.steady),
-                            "U": [s[1] for s in view.steady], "colour": colours}  # fmt: skip
+        self.steady.data = {
+            "x": [s[0] for s in view.steady],
+            "y": [0.0] * len(view.steady),
+            "U": [s[1] for s in view.steady],
+            "colour": colours,
+        }
         finite = np.isfinite(view.U_y)
         low = float(np.min(view.U_y[finite])) if finite.any() else state.h
         top = max(state.h, low) + max(1.0, abs(state.h - low))

@@ -70,18 +70,21 @@ class ExplorePage:
         The URL's query parameters (default: the session's, from ``pn.state.location``).
     """
 
-    def __init__(self, base: ExploreState, look: str = "plain",
-                 query: dict[str, Any] | None = None) -> None:  # fmt: skip
+    def __init__(
+        self, base: ExploreState, look: str = "plain", query: dict[str, Any] | None = None
+    ) -> None:
         self.doc = pn.state.curdoc
         self.location = pn.state.location
         self.muted = False
         self.state = base
         self.look = look
-        self.message = pn.pane.Alert("", alert_type="danger", visible=False,
-                                     css_classes=["rt-message"])  # fmt: skip
+        self.message = pn.pane.Alert(
+            "", alert_type="danger", visible=False, css_classes=["rt-message"]
+        )
         self.readout = pn.pane.HTML("", css_classes=["rt-readout"])
-        self.path_summary = pn.pane.HTML("click the phase portrait to start a trajectory",
-                                         css_classes=["rt-path"])  # fmt: skip
+        self.path_summary = pn.pane.HTML(
+            "click the phase portrait to start a trajectory", css_classes=["rt-path"]
+        )
         self.drawn: ExploreState | None = None  # the last view whose plots were drawn
         self.last_traj: Any = None  # the last clicked trajectory (for the device's frame)
         self.last_section: tuple[Any, Any] | None = None  # a section's points and states
@@ -132,19 +135,21 @@ class ExplorePage:
 
     # ---- widgets -------------------------------------------------------------------------
     def _slider(self, name: str, value: float, lo: float, hi: float) -> Any:
-        w = pn.widgets.EditableFloatSlider(name=name, value=value, start=lo, end=hi,
-                                           step=(hi - lo) / 400, width=260)  # fmt: skip
+        w = pn.widgets.EditableFloatSlider(
+            name=name, value=value, start=lo, end=hi, step=(hi - lo) / 400, width=260
+        )
         w.param.watch(self._on_widget, "value")
         return w
 
     def _build_widgets(self) -> None:
-        names = [m.name for m in MODELS.values()
-                 if m.own_inertia == self.state.body.has_shell]  # fmt: skip
-        self.model_select = pn.widgets.Select(name="contact model", options=names,
-                                              value=self.state.model, width=260)  # fmt: skip
+        names = [m.name for m in MODELS.values() if m.own_inertia == self.state.body.has_shell]
+        self.model_select = pn.widgets.Select(
+            name="contact model", options=names, value=self.state.model, width=260
+        )
         self.model_select.param.watch(self._on_model, "value")
-        self.look_select = pn.widgets.Select(name="device look", options=list(LOOKS),
-                                             value=self.look, width=260)  # fmt: skip
+        self.look_select = pn.widgets.Select(
+            name="device look", options=list(LOOKS), value=self.look, width=260
+        )
         self.look_select.param.watch(self._on_look, "value")
         b = self.state.body
         self.body_sliders = {}
@@ -185,15 +190,19 @@ class ExplorePage:
 
     def _layout(self) -> Any:
         controls = pn.Column(
-            self.model_select, self.look_select, pn.pane.Markdown("**body**"),
-            *self.body_sliders.values(), pn.pane.Markdown("**level**"), self.level_box,
+            self.model_select,
+            self.look_select,
+            pn.pane.Markdown("**body**"),
+            *self.body_sliders.values(),
+            pn.pane.Markdown("**level**"),
+            self.level_box,
             width=290,
-        )  # fmt: skip
+        )
         plots = pn.Column(
             pn.Row(self.plots.portrait_pane, self.plots.diagram_pane),
             pn.Row(self.plots.potential_pane, self.plots.path_pane, self.plots.frame),
             self.path_summary,
-        )  # fmt: skip
+        )
         title = pn.pane.Markdown("## rollingtop explore: a rolling spherical top, reduced")
         return pn.Column(title, self.message, self.readout, pn.Row(controls, plots))
 
@@ -216,10 +225,13 @@ class ExplorePage:
             return False
         self._clear_error()
         axis = self._axis()
-        diagram = (state.model != self.state.model or state.body != self.state.body
-                   or {k: v for k, v in state.level.items() if k != axis}
-                   != {k: v for k, v in self.state.level.items() if k != axis}
-                   or not self.plots.shows_mark(state.level.get(axis, 0.0), state.h))  # fmt: skip
+        diagram = (
+            state.model != self.state.model
+            or state.body != self.state.body
+            or {k: v for k, v in state.level.items() if k != axis}
+            != {k: v for k, v in self.state.level.items() if k != axis}
+            or not self.plots.shows_mark(state.level.get(axis, 0.0), state.h)
+        )
         self.state = state
         self._refresh(diagram=diagram)
         return True
@@ -341,8 +353,7 @@ class ExplorePage:
 
             with warnings.catch_warnings():  # in the page's summary instead
                 warnings.simplefilter("ignore", ContactLostWarning)
-                traj = simulate(state.body, state.model, x, t_end=PATH_T_END,
-                                samples=PATH_SAMPLES)  # fmt: skip
+                traj = simulate(state.body, state.model, x, t_end=PATH_T_END, samples=PATH_SAMPLES)
             return traj, None
         view = path_view(state, x, w)
         return view.trajectory, view

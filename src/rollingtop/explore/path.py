@@ -79,5 +79,6 @@ def path_view(
         what = "a steady motion" if found[0].kind == "steady" else "its period is infinite"
         summary += f" ({found[0].kind} orbit: {what})"
     curve = joined(orbit_curves(level, h))
-    return PathView(pos[:, 0].copy(), pos[:, 1].copy(), h, gamma3, float(w_tau), summary, traj,
-                    curve)  # fmt: skip
+    return PathView(
+        pos[:, 0].copy(), pos[:, 1].copy(), h, gamma3, float(w_tau), summary, traj, curve
+    )

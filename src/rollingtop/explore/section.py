@@ -35,13 +35,21 @@ def section_view(state: ExploreState) -> SectionView:
     from rollingtop.chaos.section import poincare_section
 
     y = state.reference_state()
-    ds = poincare_section(state.body, state.model, y, crossings=SECTION_CROSSINGS,
-                          trajectories=SECTION_TRAJECTORIES, t_max=200.0)  # fmt: skip
+    ds = poincare_section(
+        state.body,
+        state.model,
+        y,
+        crossings=SECTION_CROSSINGS,
+        trajectories=SECTION_TRAJECTORIES,
+        t_max=200.0,
+    )
     g3 = ds["gamma3"].values.ravel()
     wn = ds["w_n"].values.ravel()
     ys = ds["crossing_state"].values.reshape(-1, ds.sizes["state"])
     ok = np.isfinite(g3) & np.isfinite(wn)
     held = ds.attrs["held"].replace(",", ", ")
-    readout = (f"{state.model} model: no reduction; Poincare section of the level of the "
-               f"scenario's state (held: {held}) | {int(ok.sum())} crossings")  # fmt: skip
+    readout = (
+        f"{state.model} model: no reduction; Poincare section of the level of the "
+        f"scenario's state (held: {held}) | {int(ok.sum())} crossings"
+    )
     return SectionView(readout, np.column_stack([g3[ok], wn[ok]]), ys[ok])

@@ -94,8 +94,9 @@ def _check_address(host: str, port: int) -> None:
             sock.bind(address)
     except OSError as err:
         hint = "choose another --port" if err.errno == errno.EADDRINUSE else "check --host"
-        raise ScenarioError(f"cannot serve at {host}:{port}: {err.strerror or err} "
-                            f"({hint})") from None  # fmt: skip
+        raise ScenarioError(
+            f"cannot serve at {host}:{port}: {err.strerror or err} ({hint})"
+        ) from None
 
 
 #: Digits of an integer a query value may have: more than Tornado's 64 KiB request header.
@@ -137,18 +138,28 @@ def serve(
         pn.state.on_session_destroyed(lambda _: view.close())  # its data go with the session
         return view.layout
 
-    origins = [f"{host}:{port}"] + ([f"localhost:{port}", f"127.0.0.1:{port}"]
-                                    if host in LOOPBACK else [])  # fmt: skip
+    origins = [f"{host}:{port}"] + (
+        [f"localhost:{port}", f"127.0.0.1:{port}"] if host in LOOPBACK else []
+    )
     ours = signal.getsignal(signal.SIGINT)  # Panel installs its own; the command's stays
     try:
-        server = pn.serve(page, port=port, address=host, show=False, start=False,
-                          title="rollingtop explore", websocket_origin=origins,
-                          verbose=False, check_unused_sessions_milliseconds=2000,
-                          unused_session_lifetime_milliseconds=5000)  # fmt: skip
+        server = pn.serve(
+            page,
+            port=port,
+            address=host,
+            show=False,
+            start=False,
+            title="rollingtop explore",
+            websocket_origin=origins,
+            verbose=False,
+            check_unused_sessions_milliseconds=2000,
+            unused_session_lifetime_milliseconds=5000,
+        )
     except OSError as err:
         hint = "choose another --port" if err.errno == errno.EADDRINUSE else "check --host"
-        raise ScenarioError(f"cannot serve at {host}:{port}: {err.strerror or err} "
-                            f"({hint})") from None  # fmt: skip
+        raise ScenarioError(
+            f"cannot serve at {host}:{port}: {err.strerror or err} ({hint})"
+        ) from None
     finally:
         signal.signal(signal.SIGINT, ours)
     url = f"http://{host}:{port}/"
@@ -178,9 +189,12 @@ def serve(
 
 
 def spawn(
-    scenario: str | None = None, *, port: int | None = None, timeout: float = 120.0,
+    scenario: str | None = None,
+    *,
+    port: int | None = None,
+    timeout: float = 120.0,
     args: tuple[str, ...] = (),
-) -> tuple[subprocess.Popen[str], str]:  # fmt: skip
+) -> tuple[subprocess.Popen[str], str]:
     """Start ``rollingtop explore`` in a child process (``--no-browser``; a free port unless
     ``port``) and wait for its ``serving at`` line: ``(process, url)``. For scripts and tests
     that drive the page in a browser; stop the process with SIGINT.
@@ -195,12 +209,23 @@ def spawn(
         with socket.socket() as sock:
             sock.bind(("127.0.0.1", 0))
             port = int(sock.getsockname()[1])
-    cmd = [sys.executable, "-m", "rollingtop", "explore", *([scenario] if scenario else []),
-           "--no-browser", "--port", str(port), *args]  # fmt: skip
+    cmd = [
+        sys.executable,
+        "-m",
+        "rollingtop",
+        "explore",
+        *([scenario] if scenario else []),
+        "--no-browser",
+        "--port",
+        str(port),
+        *args,
+    ]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     lines: list[str] = []
-    reader = threading.Thread(target=lambda: lines.append(proc.stdout.readline()),  # type: ignore[union-attr]
-                              daemon=True)  # fmt: skip
+    reader = threading.Thread(
+        target=lambda: lines.append(proc.stdout.readline()),  # type: ignore[union-attr]
+        daemon=True,
+    )
     reader.start()
     reader.join(timeout)
     line = lines[0].strip() if lines else ""

@@ -113,8 +113,9 @@ class ExploreState:
         reduction = reduction_of(model.name)
         level = reduction.level_of_state(self.body, y)
         values = {k: float(v) for k, v in level.values().items()}
-        return replace(self, model=model.name, level=values,
-                       h=float(reduction.reduced_energy(self.body, y)))  # fmt: skip
+        return replace(
+            self, model=model.name, level=values, h=float(reduction.reduced_energy(self.body, y))
+        )
 
 
 #: The page without a scenario: the paper's body on the level of its Fig. 5 (``M3 = 1, C1 =
@@ -151,8 +152,14 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
         return ExploreState(sc.model.name, body, {}, math.nan, start, own)  # type: ignore[arg-type]
     level = sc.level_set()
     values = {k: float(v) for k, v in level.values().items()}
-    return ExploreState(sc.model.name, body, values, float(sc.level_h()), start,  # type: ignore[arg-type]
-                        own)  # fmt: skip
+    return ExploreState(
+        sc.model.name,
+        body,
+        values,
+        float(sc.level_h()),
+        start,  # type: ignore[arg-type]
+        own,
+    )
 
 
 def parse_query(query: Mapping[str, str | list[str]], base: ExploreState) -> ExploreState:
@@ -178,8 +185,10 @@ def parse_query(query: Mapping[str, str | list[str]], base: ExploreState) -> Exp
         if key == "model":
             continue
         if key not in allowed:
-            raise ScenarioError(f"unknown parameter {key!r} for the {state.model} model "
-                                f"(allowed: {', '.join(allowed)})")  # fmt: skip
+            raise ScenarioError(
+                f"unknown parameter {key!r} for the {state.model} model "
+                f"(allowed: {', '.join(allowed)})"
+            )
         try:
             value = float(text)
         except OverflowError:  # an integer beyond double precision (Panel reads digits as int)
@@ -284,8 +293,17 @@ def level_view(state: ExploreState) -> LevelView:
     values = ", ".join(f"{k} = {v:.6g}" for k, v in state.level.items())
     readout = f"{state.model} model: {values}, h = {state.h:.6g} | steady motions: {len(steady)}"
     motions = [(float(m.theta if pole else m.gamma3), float(m.U), m.type) for m in steady]
-    return LevelView(readout, len(steady), x, U, joined(back), joined(current), motions,
-                     "theta" if pole else "gamma3", note)  # fmt: skip
+    return LevelView(
+        readout,
+        len(steady),
+        x,
+        U,
+        joined(back),
+        joined(current),
+        motions,
+        "theta" if pole else "gamma3",
+        note,
+    )
 
 
 @dataclass(frozen=True)
@@ -322,8 +340,13 @@ def diagram_view(state: ExploreState) -> DiagramView:
         lo, hi = float(d.C2_grid[0]), float(d.C2_grid[-1])
         if not lo <= x0 <= hi:  # widened to take the current C2
             pad = 0.1 * (max(hi, x0) - min(lo, x0))
-            d = bifurcation_diagram(state.body, level.M3, level.C1, resolution=(161, 3),
-                                    C2_range=(min(lo, x0) - pad, max(hi, x0) + pad))  # fmt: skip
+            d = bifurcation_diagram(
+                state.body,
+                level.M3,
+                level.C1,
+                resolution=(161, 3),
+                C2_range=(min(lo, x0) - pad, max(hi, x0) + pad),
+            )
         cx, cy, sx, sy = [], [], [], []
         for br in d.branches:
             cx.append(np.where(br.centre, br.C2, np.nan))
@@ -336,8 +359,9 @@ def diagram_view(state: ExploreState) -> DiagramView:
         floor = (np.asarray(d.C2_grid, dtype=float), np.asarray(d.min_U, dtype=float))
         x_range = (float(d.C2_grid[0]), float(d.C2_grid[-1]))
         y_range = (min(float(d.h_grid[0]), state.h), max(float(d.h_grid[-1]), state.h))
-        return DiagramView(axis, centres, saddles, folds, floor, (x0, state.h), x_range,
-                           _padded(y_range))  # fmt: skip
+        return DiagramView(
+            axis, centres, saddles, folds, floor, (x0, state.h), x_range, _padded(y_range)
+        )
     cv = critical_values(level, window=(x0 - max(1.0, abs(x0)), x0 + max(1.0, abs(x0))), n=161)
     pts = cv.points
     centre = pts[:, 3] > 0
@@ -345,9 +369,16 @@ def diagram_view(state: ExploreState) -> DiagramView:
     empty = (np.array([]), np.array([]))
     hs = np.append(pts[:, 2], state.h)
     y_range = (float(np.min(hs)), float(np.max(hs)))
-    return DiagramView(axis, (pts[centre, 0], pts[centre, 2]), (pts[saddle, 0], pts[saddle, 2]),
-                       empty, empty, (x0, state.h), (float(cv.x[0]), float(cv.x[-1])),
-                       _padded(y_range))  # fmt: skip
+    return DiagramView(
+        axis,
+        (pts[centre, 0], pts[centre, 2]),
+        (pts[saddle, 0], pts[saddle, 2]),
+        empty,
+        empty,
+        (x0, state.h),
+        (float(cv.x[0]), float(cv.x[-1])),
+        _padded(y_range),
+    )
 
 
 def _padded(lim: tuple[float, float]) -> tuple[float, float]:

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import compiling, for_code, packages_of
-from rollingtop._compiled._events import EVENTS
+from rollingtop._compiled._events import EVENTS, NONE
 from rollingtop._compiled._kernel import new_workspace
 from rollingtop._errors import IntegrationError
 from rollingtop._jit import call
@@ -158,9 +158,18 @@ def _compile_package(kernels: ModuleType, held: bool = False, events: bool = Fal
     with compiling(kernels, what):
         call(kernels.dynamics.project, code, p, y, call(new_workspace))
         # with a projection onto an integral (held): the held stepper's loop
-        _run_compiled(code, p, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, None, None,
-                      (1, 0, 1) if events or held else (0, 0, 0),
-                      np.array([0], dtype=np.int64) if held else None)  # fmt: skip
+        _run_compiled(
+            code,
+            p,
+            y,
+            np.array([0.0, 1e-3]),
+            1e-6,
+            1e-9,
+            None,
+            None,
+            (1, 0, 1) if events or held else (0, 0, 0),
+            np.array([0], dtype=np.int64) if held else None,
+        )
         call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
     _compiled[key] = time.perf_counter() - start
     return _compiled[key]
@@ -185,16 +194,34 @@ def _run_compiled(
     package = for_code(code)
     ev_code, ev_direction, capacity = event
     # the copy of the stepper the run needs (rollingtop._compiled._instances)
-    stepper = (package.stepper_held if icodes.shape[0] > 0
-               else package.stepper_events if ev_code != 0 else package.stepper)  # fmt: skip
+    stepper = (
+        package.stepper_held
+        if icodes.shape[0] > 0
+        else package.stepper_events
+        if ev_code != NONE
+        else package.stepper
+    )
     ev_spec = np.array([ev_code, ev_direction, int(dips)], dtype=np.int64)
     # np.empty: the pages of a large capacity are touched only by events actually found
     ev_t = np.empty(capacity)
     ev_y = np.empty((capacity, N_STATE))
     y = y0.copy()
     f = np.zeros(N_STATE)
-    ctrl, counts, track = call(stepper.start, code, p, y, f, t_eval, rtol, atol, ev_code, w["out"],
-                                    w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
+    ctrl, counts, track = call(
+        stepper.start,
+        code,
+        p,
+        y,
+        f,
+        t_eval,
+        rtol,
+        atol,
+        ev_code,
+        w["out"],
+        w["ytmp"],
+        w["ynew"],
+        w["ws"],
+    )
     t_end = float(t_eval[-1])
     start = time.perf_counter()
     while True:
@@ -231,8 +258,9 @@ def _run_compiled(
         if status != dop.BUDGET_EXHAUSTED:
             break
         if max_steps is not None:
-            check_pace(float(t_eval[0]), float(ctrl[dop.T]), t_end, int(counts[dop.STEPS]),
-                        max_steps)  # fmt: skip
+            check_pace(
+                float(t_eval[0]), float(ctrl[dop.T]), t_end, int(counts[dop.STEPS]), max_steps
+            )
         if max_steps is not None and counts[dop.STEPS] >= max_steps:
             raise IntegrationError(
                 f"max_steps = {max_steps} accepted steps reached at t = {ctrl[dop.T]:.6g} "
@@ -363,7 +391,7 @@ def integrate(
         raise ValueError(f"unknown event {events!r} (known: {', '.join(EVENTS)})")
     if event_direction not in (-1, 0, 1):
         raise ValueError(f"event_direction must be -1, 0 or 1, got {event_direction!r}")
-    event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (0, 0, 1)
+    event = (EVENTS[events], event_direction, max(int(max_events), 1)) if events else (NONE, 0, 1)
     from rollingtop._compiled._integrals import CODES
 
     unknown = [n for n in project_integrals if n not in CODES]

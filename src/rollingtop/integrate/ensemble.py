@@ -68,9 +68,20 @@ def _compile_package_locked(kernels: ModuleType) -> float:
     P = np.array([WARMUP_PARAMS])
     codes = np.full(1, kernels._dispatch.CODES[0], dtype=np.int64)
     with compiling(kernels, "ensemble"):
-        call(kernels.ensemble.batch, codes, P, y, np.array([0.0, 1e-3]), 1e-6, 1e-9, 10,
-             np.zeros((1, 2, N_STATE)), np.zeros((1, N_STATE)), np.zeros((1, 6)),
-             np.zeros(1, dtype=np.int64))  # fmt: skip
+        call(
+            kernels.ensemble.batch,
+            codes,
+            P,
+            y,
+            np.array([0.0, 1e-3]),
+            1e-6,
+            1e-9,
+            10,
+            np.zeros((1, 2, N_STATE)),
+            np.zeros((1, N_STATE)),
+            np.zeros((1, 6)),
+            np.zeros(1, dtype=np.int64),
+        )
     _compiled.add(kernels.PACKAGE)
     return time.perf_counter() - start
 
@@ -130,8 +141,10 @@ def integrate_batch(
     codes = np.ascontiguousarray(codes, dtype=np.int64)
     params = np.ascontiguousarray(params, dtype=float)
     if params.shape != (N, N_PARAMS) or codes.shape != (N,):  # the kernels do not check reads
-        raise ValueError(f"params must have shape ({N}, {N_PARAMS}) and codes ({N},), got "
-                         f"{params.shape} and {codes.shape}")  # fmt: skip
+        raise ValueError(
+            f"params must have shape ({N}, {N_PARAMS}) and codes ({N},), got "
+            f"{params.shape} and {codes.shape}"
+        )
     groups = by_package(codes)  # ValueError for an unknown code
     t_eval = np.ascontiguousarray(t_eval, dtype=float)
     out = np.full((N, t_eval.size, N_STATE), np.nan)
@@ -154,11 +167,15 @@ def integrate_batch(
         rows = slice(idx[0], idx[-1] + 1) if contiguous else idx
         # a slice is a view the kernel writes into; fancy indexing is a copy, written back
         part = out[rows], final[rows], stats[rows]
-        seconds, _ = run_rows(kernels.ensemble.batch,
-                              (codes[rows], params[rows], states[rows], t_eval, rtol, atol,
-                               max_steps, *part),
-                              (0, 1, 2, 7, 8, 9), idx.size, threads=threads, chunk=CHUNK,
-                              poll=poll)  # fmt: skip
+        seconds, _ = run_rows(
+            kernels.ensemble.batch,
+            (codes[rows], params[rows], states[rows], t_eval, rtol, atol, max_steps, *part),
+            (0, 1, 2, 7, 8, 9),
+            idx.size,
+            threads=threads,
+            chunk=CHUNK,
+            poll=poll,
+        )
         wall += seconds
         if not contiguous:
             out[rows], final[rows], stats[rows] = part

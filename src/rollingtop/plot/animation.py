@@ -91,10 +91,22 @@ def _scene(
         # the plane as a coarse grid (the devices' stage has a floor of its own)
         grid = np.linspace(-span / 2, span / 2, 9) if stage is None else np.empty(0)
         for g in grid:
-            ax.plot([mid[0] + g] * 2, [mid[1] - span / 2, mid[1] + span / 2], [0, 0],
-                    color="0.85", lw=0.5, zorder=0)  # fmt: skip
-            ax.plot([mid[0] - span / 2, mid[0] + span / 2], [mid[1] + g] * 2, [0, 0],
-                    color="0.85", lw=0.5, zorder=0)  # fmt: skip
+            ax.plot(
+                [mid[0] + g] * 2,
+                [mid[1] - span / 2, mid[1] + span / 2],
+                [0, 0],
+                color="0.85",
+                lw=0.5,
+                zorder=0,
+            )
+            ax.plot(
+                [mid[0] - span / 2, mid[0] + span / 2],
+                [mid[1] + g] * 2,
+                [0, 0],
+                color="0.85",
+                lw=0.5,
+                zorder=0,
+            )
     ax.view_init(elev=VIEW[0], azim=VIEW[1])
 
     def draw(i: int) -> None:
@@ -113,8 +125,12 @@ def _scene(
 
 
 def _caption(traj: Trajectory, look: str, speed: float) -> str:
-    device = {"plain": "", "roller": "roller-bearing sphere, ", "shell": "shell with a rotor, ",
-              "skates": "sphere of skates, "}[look]  # fmt: skip
+    device = {
+        "plain": "",
+        "roller": "roller-bearing sphere, ",
+        "shell": "shell with a rotor, ",
+        "skates": "sphere of skates, ",
+    }[look]
     return f"{device}{traj.model.name} model, speed x{speed:g}"
 
 
@@ -135,8 +151,15 @@ def frame_figure(
     if not traj.t[0] <= t <= traj.t[-1]:
         raise ValueError(f"t = {t:g} lies outside the trajectory [{traj.t[0]:g}, {traj.t[-1]:g}]")
     times = np.append(traj.t[traj.t < t], t)
-    fig, draw = _scene(traj, times, look=look, camera=camera, size=size, dpi=dpi,
-                       caption=_caption(traj, look, 1.0).removesuffix(", speed x1"))  # fmt: skip
+    fig, draw = _scene(
+        traj,
+        times,
+        look=look,
+        camera=camera,
+        size=size,
+        dpi=dpi,
+        caption=_caption(traj, look, 1.0).removesuffix(", speed x1"),
+    )
     draw(len(times) - 1)
     return fig
 
@@ -199,8 +222,15 @@ def animate(
             f"ends at {t1:g}: simulate longer, or lower duration or speed"
         )
     times = t0 + np.arange(n_frames) / fps * speed
-    fig, draw = _scene(traj, times, look=look, camera=camera, size=size, dpi=dpi,
-                       caption=_caption(traj, look, speed))  # fmt: skip
+    fig, draw = _scene(
+        traj,
+        times,
+        look=look,
+        camera=camera,
+        size=size,
+        dpi=dpi,
+        caption=_caption(traj, look, speed),
+    )
 
     def write(tmp: Path) -> None:
         writer: AbstractMovieWriter

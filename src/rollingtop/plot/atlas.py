@@ -129,15 +129,22 @@ def draw_atlas(
         steps = [colormaps["viridis"](k / max(hi - lo, 1)) for k in range(hi - lo + 1)]
         cmap: Any = ListedColormap(steps) if integer else "viridis"
         vmin, vmax = (lo - 0.5, hi + 0.5) if integer else (None, None)
-        mesh = ax.pcolormesh(_ticks(ax, "x", da, xd), _ticks(ax, "y", da, yd),
-                             np.ma.masked_invalid(values), cmap=cmap, shading="nearest",
-                             vmin=vmin, vmax=vmax)  # fmt: skip
+        mesh = ax.pcolormesh(
+            _ticks(ax, "x", da, xd),
+            _ticks(ax, "y", da, yd),
+            np.ma.masked_invalid(values),
+            cmap=cmap,
+            shading="nearest",
+            vmin=vmin,
+            vmax=vmax,
+        )
         bar = ax.figure.colorbar(mesh, ax=ax, label=variable)
         if integer:
             bar.set_ticks(range(lo, hi + 1))
         ax.set_xlabel(xd)
         ax.set_ylabel(yd)
-    fixed = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                      for k, v in held.items())  # fmt: skip
+    fixed = ", ".join(
+        f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in held.items()
+    )
     ax.set_title(f"{description}" + (f"\nat {fixed}" if fixed else ""), fontsize=9)
     return ax

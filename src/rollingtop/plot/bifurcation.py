@@ -95,8 +95,11 @@ def _thumbnail(ax: Axes, diagram: BifurcationDiagram, k: int, colour: Any) -> No
     ax.xaxis.set_major_locator(MaxNLocator(3))
     ax.yaxis.set_major_locator(MaxNLocator(3, symmetric=True))
     ax.tick_params(labelsize=7, length=2, pad=1)
-    ax.set_title(f"{region.name}: {region.label}\nC2 = {region.C2:.3g}, h = {region.h:.3g}",
-                 fontsize=8, pad=3)  # fmt: skip
+    ax.set_title(
+        f"{region.name}: {region.label}\nC2 = {region.C2:.3g}, h = {region.h:.3g}",
+        fontsize=8,
+        pad=3,
+    )
 
 
 def _on_pole_level(diagram: BifurcationDiagram) -> bool:
@@ -120,12 +123,27 @@ def draw_bifurcation(
     regions = diagram.regions
     cmap = _region_colours(diagram)
     shade = np.ma.masked_less(diagram.region_index, 0)
-    ax.pcolormesh(diagram.C2_grid, diagram.h_grid, shade, cmap=cmap, shading="nearest",
-                  vmin=-0.5, vmax=len(regions) - 0.5, alpha=0.8, rasterized=True)  # fmt: skip
+    ax.pcolormesh(
+        diagram.C2_grid,
+        diagram.h_grid,
+        shade,
+        cmap=cmap,
+        shading="nearest",
+        vmin=-0.5,
+        vmax=len(regions) - 0.5,
+        alpha=0.8,
+        rasterized=True,
+    )
     ax.plot(diagram.C2_grid, diagram.min_U, color="0.3", lw=0.8, ls=":", label="min U")
     if np.isfinite(diagram.pole_energy).any():
-        ax.plot(diagram.C2_grid, diagram.pole_energy, color="#7b3294", lw=1.2, ls="-.",
-                label="U at the pole (above: through the pole)")  # fmt: skip
+        ax.plot(
+            diagram.C2_grid,
+            diagram.pole_energy,
+            color="#7b3294",
+            lw=1.2,
+            ls="-.",
+            label="U at the pole (above: through the pole)",
+        )
     for br in diagram.branches:
         for is_centre, style, colour in ((True, "-", CENTRE_COLOUR), (False, "--", SADDLE_COLOUR)):
             c2 = np.where(br.centre == is_centre, br.C2, np.nan)
@@ -133,12 +151,19 @@ def draw_bifurcation(
     ax.plot([], [], "-", color=CENTRE_COLOUR, label="centres")
     ax.plot([], [], "--", color=SADDLE_COLOUR, label="saddles")
     if diagram.folds:
-        ax.plot([f.C2 for f in diagram.folds], [f.h for f in diagram.folds], "o", color="k",
-                ms=4, label="folds")  # fmt: skip
+        ax.plot(
+            [f.C2 for f in diagram.folds],
+            [f.h for f in diagram.folds],
+            "o",
+            color="k",
+            ms=4,
+            label="folds",
+        )
     box = {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "0.6", "lw": 0.5}
     for r in regions:
-        ax.annotate(r.name, (r.C2, r.h), ha="center", va="center", fontsize=10, weight="bold",
-                    bbox=box)  # fmt: skip
+        ax.annotate(
+            r.name, (r.C2, r.h), ha="center", va="center", fontsize=10, weight="bold", bbox=box
+        )
     if mark_C2 is not None:
         ax.axvline(mark_C2, color="0.4", lw=0.8, ls="-.", label=f"C2 = {mark_C2:g}")
     ax.set_xlim(diagram.C2_grid[0], diagram.C2_grid[-1])
@@ -146,9 +171,11 @@ def draw_bifurcation(
     ax.set_xlabel("C2")
     ax.set_ylabel("h")
     b = diagram.body
-    ax.set_title(f"critical values, M3 = {diagram.M3:g}, C1 = {diagram.C1:g}\n(R = {b.R:g}, "
-                 f"a3 = {b.a3:g}, I1 = {b.I1:g}, I3 = {b.I3:g}, m = {b.m:g}, g = {b.g:g})",
-                 fontsize=9)  # fmt: skip
+    ax.set_title(
+        f"critical values, M3 = {diagram.M3:g}, C1 = {diagram.C1:g}\n(R = {b.R:g}, "
+        f"a3 = {b.a3:g}, I1 = {b.I1:g}, I3 = {b.I3:g}, m = {b.m:g}, g = {b.g:g})",
+        fontsize=9,
+    )
     ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
     return ax
 
@@ -165,8 +192,9 @@ def bifurcation_figure(
     cols = 1 if n_thumb <= 2 else 2
     rows_t = math.ceil(n_thumb / cols)
     extra = 1 if count_map is not None else 0
-    fig = Figure(figsize=(5.6 + 2.7 * cols + 4.4 * extra, max(5.6, 2.8 * rows_t)),
-                 layout="constrained")  # fmt: skip
+    fig = Figure(
+        figsize=(5.6 + 2.7 * cols + 4.4 * extra, max(5.6, 2.8 * rows_t)), layout="constrained"
+    )
     outer = fig.add_gridspec(1, 2 + extra, width_ratios=[5.6, 2.7 * cols] + [4.4] * extra)
     draw_bifurcation(fig.add_subplot(outer[0, 0]), diagram, mark_C2)
     cmap = _region_colours(diagram)
@@ -183,22 +211,38 @@ def bifurcation_figure(
         axc = fig.add_subplot(outer[0, 2])
         counts = np.ma.masked_less(count_map.count, 0)
         top = max(int(np.max(count_map.count)), 1)
-        cm = ListedColormap([colormaps["Blues"](0.15 + 0.7 * i / max(top, 1))
-                             for i in range(top + 1)])  # fmt: skip
-        mesh = axc.pcolormesh(count_map.C1_grid, count_map.C2_grid, counts, cmap=cm,
-                              shading="nearest", vmin=-0.5, vmax=top + 0.5,
-                              rasterized=True)  # fmt: skip
+        cm = ListedColormap(
+            [colormaps["Blues"](0.15 + 0.7 * i / max(top, 1)) for i in range(top + 1)]
+        )
+        mesh = axc.pcolormesh(
+            count_map.C1_grid,
+            count_map.C2_grid,
+            counts,
+            cmap=cm,
+            shading="nearest",
+            vmin=-0.5,
+            vmax=top + 0.5,
+            rasterized=True,
+        )
         axc.plot(count_map.fold_C1, count_map.fold_C2, ".", color="k", ms=1.5, label="folds")
         for pole in (count_map.M3, -count_map.M3):
             axc.axvline(pole, color="0.5", lw=0.8, ls=":")
-        axc.plot([diagram.C1], [mark_C2 if mark_C2 is not None else np.nan], "*", color="w",
-                 mec="k", ms=9)  # fmt: skip
+        axc.plot(
+            [diagram.C1],
+            [mark_C2 if mark_C2 is not None else np.nan],
+            "*",
+            color="w",
+            mec="k",
+            ms=9,
+        )
         axc.set_xlim(count_map.C1_grid[0], count_map.C1_grid[-1])
         axc.set_ylim(count_map.C2_grid[0], count_map.C2_grid[-1])
         axc.set_xlabel("C1")
         axc.set_ylabel("C2")
-        axc.set_title(f"number of steady motions, M3 = {count_map.M3:g}\n"
-                      "(dotted: pole lines C1 = +-M3)", fontsize=9)  # fmt: skip
+        axc.set_title(
+            f"number of steady motions, M3 = {count_map.M3:g}\n(dotted: pole lines C1 = +-M3)",
+            fontsize=9,
+        )
         cbar = fig.colorbar(mesh, ax=axc, ticks=range(top + 1), fraction=0.05)
         cbar.ax.tick_params(labelsize=7)
     return fig

@@ -20,9 +20,15 @@ __all__ = ["classification_figure", "critical_values_figure", "rotation_grid_fig
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: Labels of the integrals in the figure (mathtext).
-SYMBOLS = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}",
-           "jellett": r"\mathrm{jellett}", "routh": r"\mathrm{routh}",
-           "rubber_spin": r"\mathrm{rubber\_spin}"}  # fmt: skip
+SYMBOLS = {
+    "M3": "M_3",
+    "C1": "C_1",
+    "C2": "C_2",
+    "p_horizontal": r"p_{\rm h}",
+    "jellett": r"\mathrm{jellett}",
+    "routh": r"\mathrm{routh}",
+    "rubber_spin": r"\mathrm{rubber\_spin}",
+}
 
 
 def _window(c: ModelClassification) -> tuple[float, float, float, float]:
@@ -78,13 +84,21 @@ def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
             ax.legend(fontsize=7, loc="upper center", frameon=False)
         # the phase portrait: level curves of h on (gamma3, w_tau), the state's own in black
         ax = axes[1, j]
-        w_top = 1.3 * math.sqrt(max(2 * (u_hi - float(np.min(U))), 1e-6) / float(
-            np.min(level.rho(theta))))  # fmt: skip
+        w_top = 1.3 * math.sqrt(
+            max(2 * (u_hi - float(np.min(U))), 1e-6) / float(np.min(level.rho(theta)))
+        )
         w = np.linspace(-w_top, w_top, 301)
         G, Wt = np.meshgrid(gamma3, w)
         H = np.asarray(level.energy(np.arccos(G), Wt), dtype=float)
-        ax.contour(G, Wt, H, levels=np.linspace(u_lo, u_hi, 12)[1:], colors=colour,
-                   linewidths=0.6, alpha=0.7)  # fmt: skip
+        ax.contour(
+            G,
+            Wt,
+            H,
+            levels=np.linspace(u_lo, u_hi, 12)[1:],
+            colors=colour,
+            linewidths=0.6,
+            alpha=0.7,
+        )
         ax.contour(G, Wt, H, levels=[c.h], colors="k", linewidths=1.5)
         ax.plot([c.state[14]], [_w_tau(c.state)], "k*", ms=9)
         ax.set_xlabel(r"$\gamma_3$")
@@ -100,8 +114,9 @@ def classification_figure(classes: Sequence[ModelClassification]) -> Figure:
             ax.set_ylabel("critical values of $h$")
             ax.legend(fontsize=7, frameon=False)
         fixed = ", ".join(f"{k} = {v:.3g}" for k, v in cv.fixed.items())
-        ax.set_title(f"at {fixed}" if fixed else f"{cv.axis}: the level's only integral",
-                     fontsize=8)  # fmt: skip
+        ax.set_title(
+            f"at {fixed}" if fixed else f"{cv.axis}: the level's only integral", fontsize=8
+        )
     return fig
 
 
@@ -118,8 +133,15 @@ def _draw_critical(ax: Any, cv: CriticalValues, colour: str) -> None:
     pts = cv.points
     for kind, marker, label in ((1.0, "o", "centre"), (-1.0, "x", "saddle")):
         sel = pts[:, 3] == kind
-        ax.plot(pts[sel, 0], pts[sel, 2], marker, color=colour if kind > 0 else "k", ms=2.5,
-                ls="none", label=label)  # fmt: skip
+        ax.plot(
+            pts[sel, 0],
+            pts[sel, 2],
+            marker,
+            color=colour if kind > 0 else "k",
+            ms=2.5,
+            ls="none",
+            label=label,
+        )
 
 
 def critical_values_figure(cv: CriticalValues, level: LevelSet, mark: bool = True) -> Figure:
@@ -131,8 +153,7 @@ def critical_values_figure(cv: CriticalValues, level: LevelSet, mark: bool = Tru
     ax, axn = fig.subplots(2, 1, height_ratios=[3, 1], sharex=True)
     _draw_critical(ax, cv, get_model(cv.model).colour)
     if mark:
-        ax.axvline(level.values()[cv.axis], color="0.5", lw=0.8, ls="--",
-                   label="the level's value")  # fmt: skip
+        ax.axvline(level.values()[cv.axis], color="0.5", lw=0.8, ls="--", label="the level's value")
     ax.set_ylabel("critical values of $h$")
     fixed = ", ".join(f"{k} = {v:.4g}" for k, v in cv.fixed.items())
     ax.set_title(f"{cv.model} model" + (f", at {fixed}" if fixed else ""), fontsize=10)

@@ -44,14 +44,27 @@ def draw_path(ax: Axes | None, traj: Trajectory, period_map: PeriodMap | None = 
     ax.plot(*com[0], "s", color="black", ms=5, label="start")
     if len(traj.event_t):
         P = traj.event_y[:, 15:17]
-        ax.plot(P[:, 0], P[:, 1], "o", color="#ff7f0e", ms=4, zorder=4,
-                label="CoM once per period (min of $\\gamma_3$)")  # fmt: skip
+        ax.plot(
+            P[:, 0],
+            P[:, 1],
+            "o",
+            color="#ff7f0e",
+            ms=4,
+            zorder=4,
+            label="CoM once per period (min of $\\gamma_3$)",
+        )
         if period_map is not None and period_map.motion == "bounded":
             c, radius = period_map.center_from(traj.event_y[0, 17], P[0]), period_map.radius
             assert c is not None and radius is not None  # a bounded motion has its circle
             phi = np.linspace(0, 2 * np.pi, 400)
-            ax.plot(c[0] + radius * np.cos(phi), c[1] + radius * np.sin(phi),
-                    "--", color="#ff7f0e", lw=0.8, label="predicted circle")  # fmt: skip
+            ax.plot(
+                c[0] + radius * np.cos(phi),
+                c[1] + radius * np.sin(phi),
+                "--",
+                color="#ff7f0e",
+                lw=0.8,
+                label="predicted circle",
+            )
             ax.plot(*c, "+", color="#ff7f0e", ms=10, mew=1.5)
         elif period_map is not None:
             assert period_map.drift_velocity is not None  # a drifting motion has its velocity
@@ -59,8 +72,14 @@ def draw_path(ax: Axes | None, traj: Trajectory, period_map: PeriodMap | None = 
             psi0 = traj.event_y[0, 17]
             v = complex(vx, vy) * np.exp(1j * psi0)
             span = traj.t[-1] - traj.event_t[0]
-            ax.plot([P[0, 0], P[0, 0] + v.real * span], [P[0, 1], P[0, 1] + v.imag * span], "--",
-                    color="#ff7f0e", lw=0.8, label="predicted drift")  # fmt: skip
+            ax.plot(
+                [P[0, 0], P[0, 0] + v.real * span],
+                [P[0, 1], P[0, 1] + v.imag * span],
+                "--",
+                color="#ff7f0e",
+                lw=0.8,
+                label="predicted drift",
+            )
     kind = ""
     if period_map is not None:
         if period_map.motion == "bounded":
@@ -145,14 +164,17 @@ def draw_reactions(ax: Axes | None, traj: Trajectory) -> Axes:
     ax.set_xlabel("t")
     ax.legend(fontsize=7, loc="upper left")
     ratio = np.nanmax(traj.friction_ratio) if np.any(traj.normal_force > 0) else np.nan
-    ax.set_title(f"friction coefficient needed (max T/N at the samples): {ratio:.4g}",
-                 fontsize=8)  # fmt: skip
+    ax.set_title(f"friction coefficient needed (max T/N at the samples): {ratio:.4g}", fontsize=8)
     return ax
 
 
 #: What :meth:`rollingtop.Trajectory.plot` draws for each ``kind``.
-PANELS = {"path": draw_path, "gamma3": draw_gamma3, "drift": draw_drift,
-          "reactions": draw_reactions}  # fmt: skip
+PANELS = {
+    "path": draw_path,
+    "gamma3": draw_gamma3,
+    "drift": draw_drift,
+    "reactions": draw_reactions,
+}
 
 
 def timeseries_figure(traj: Trajectory, *, figsize: tuple[float, float] = (8.0, 8.0)) -> Figure:
@@ -195,9 +217,14 @@ def compare_figure(
             v = values[name]
             scale = max(abs(v[0]), 1e-300)
             conserved = name in run.integrals
-            a.plot(run.t, (v - v[0]) / scale, color=colour, lw=1.6 if conserved else 0.9,
-                   ls="-" if conserved else "--",
-                   label=f"{model}" + (" (conserved)" if conserved else ""))  # fmt: skip
+            a.plot(
+                run.t,
+                (v - v[0]) / scale,
+                color=colour,
+                lw=1.6 if conserved else 0.9,
+                ls="-" if conserved else "--",
+                label=f"{model}" + (" (conserved)" if conserved else ""),
+            )
     for a, name in zip(axes, shown, strict=True):
         a.set_ylabel(f"{name}:\n(I - I0)/|I0|", fontsize=8)
         a.legend(fontsize=7, loc="upper left")

@@ -41,8 +41,9 @@ def pole_limits_table(
             orbit = min(orbits(level, h), key=lambda o: o.pole_distance)
             pm = period_map(level, h, orbit)
             npl = near_pole(level, h, orbit)
-            rows[side].append((10.0**k, orbit.period, pm.delta_psi,
-                               npl.friction_needed if npl else math.nan))  # fmt: skip
+            rows[side].append(
+                (10.0**k, orbit.period, pm.delta_psi, npl.friction_needed if npl else math.nan)
+            )
             if npl is not None:
                 info[side] = npl
     return {"rows": {s: np.array(r) for s, r in rows.items()}, "limits": info}
@@ -65,8 +66,10 @@ def pole_limits_figure(
     any_lim = lim.get(+1) or lim.get(-1)
     fig = Figure(figsize=figsize, layout="constrained")
     axT, axP, axF = fig.subplots(3, 1, sharex=True)
-    style = {+1: dict(color="tab:blue", marker="o", label="C1 > M3"),
-             -1: dict(color="tab:orange", marker="s", label="C1 < M3")}  # fmt: skip
+    style = {
+        +1: dict(color="tab:blue", marker="o", label="C1 > M3"),
+        -1: dict(color="tab:orange", marker="s", label="C1 < M3"),
+    }
     for side, r in rows.items():
         d, T, dpsi, mu = r.T
         axT.plot(d, T, ms=3, lw=1, **style[side])
@@ -79,15 +82,36 @@ def pole_limits_figure(
     d = rows[+1][:, 0]
     axP.plot(d, d * np.log(1 / d), color="0.4", lw=0.8, ls=":", label=r"$\delta\,\log(1/\delta)$")
     axP.plot([], [], color="0.3", marker="o", ms=3, lw=1, label=r"$|T - T_{lim}|$")
-    axP.plot([], [], color="0.3", marker="x", ms=4, lw=1, ls="--",
-             label=r"$|\Delta\psi - \Delta\psi_{lim}|$")  # fmt: skip
+    axP.plot(
+        [],
+        [],
+        color="0.3",
+        marker="x",
+        ms=4,
+        lw=1,
+        ls="--",
+        label=r"$|\Delta\psi - \Delta\psi_{lim}|$",
+    )
     if any_lim:
-        axT.axhline(any_lim.period_limit, color="0.3", ls=":", lw=1,
-                    label=f"limit T = {any_lim.period_limit:.10g}")  # fmt: skip
-        axT.axhline(any_lim.pole_level_period, color="crimson", ls="--", lw=1,
-                    label=f"pole level C1 = M3: T = {any_lim.pole_level_period:.10g}")  # fmt: skip
-        limits = ", ".join(f"{lim[s].delta_psi_limit:.6g} (C1 {'>' if s > 0 else '<'} M3)"
-                           for s in (+1, -1) if s in lim)  # fmt: skip
+        axT.axhline(
+            any_lim.period_limit,
+            color="0.3",
+            ls=":",
+            lw=1,
+            label=f"limit T = {any_lim.period_limit:.10g}",
+        )
+        axT.axhline(
+            any_lim.pole_level_period,
+            color="crimson",
+            ls="--",
+            lw=1,
+            label=f"pole level C1 = M3: T = {any_lim.pole_level_period:.10g}",
+        )
+        limits = ", ".join(
+            f"{lim[s].delta_psi_limit:.6g} (C1 {'>' if s > 0 else '<'} M3)"
+            for s in (+1, -1)
+            if s in lim
+        )
         axP.set_title(
             rf"limits of $\Delta\psi$: {limits}; on the pole level "
             rf"$\Delta\psi$ = {any_lim.pole_level_delta_psi:.6g}",

@@ -39,8 +39,7 @@ __all__ = ["default_h_levels", "draw_portrait", "draw_potential", "phase_portrai
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: The abscissa's label: ``gamma3``, or the signed angle in a pole case.
-_XLABEL = {False: r"$\gamma_3$",
-           True: r"$\theta$ (signed nutation angle, $\gamma_3 = \cos\theta$)"}  # fmt: skip
+_XLABEL = {False: r"$\gamma_3$", True: r"$\theta$ (signed nutation angle, $\gamma_3 = \cos\theta$)"}
 
 
 def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
@@ -147,12 +146,19 @@ def _draw_orbits(
     drawn_sep = drawn = False
     for h, x, y, separatrix in curves:
         if separatrix:
-            ax.plot(x, y, color="crimson", lw=1.8, zorder=3,
-                    label=None if drawn_sep else "separatrix")  # fmt: skip
+            ax.plot(
+                x, y, color="crimson", lw=1.8, zorder=3, label=None if drawn_sep else "separatrix"
+            )
             drawn_sep = True
         else:
-            ax.plot(x, y, color=_colour(levels, h), lw=1.0, zorder=2,
-                    label=None if drawn else "orbits (colour: h)")  # fmt: skip
+            ax.plot(
+                x,
+                y,
+                color=_colour(levels, h),
+                lw=1.0,
+                zorder=2,
+                label=None if drawn else "orbits (colour: h)",
+            )
             drawn = True
     if show_contact and not level.pole:
         gg = np.linspace(max(g_lo, -0.999), min(g_hi, 0.999), 90)
@@ -165,8 +171,11 @@ def _draw_orbits(
     for pole_theta in level.pole_thetas:
         ax.axvline(pole_theta, color="0.5", ls="--", lw=0.8, zorder=0)
     if level.pole:
-        names = {"south": "south pole (gamma3 = +1)", "north": "north pole (gamma3 = -1)",
-                 "both": "poles (gamma3 = +1 at 0, -1 at pi)"}  # fmt: skip
+        names = {
+            "south": "south pole (gamma3 = +1)",
+            "north": "north pole (gamma3 = -1)",
+            "both": "poles (gamma3 = +1 at 0, -1 at pi)",
+        }
         ax.plot([], [], color="0.5", ls="--", lw=0.8, label=names[level.pole])
     ax.plot([], [], "o", color="black", ms=5, label="steady motion (centre)")
     if saddle_levels:
@@ -175,8 +184,12 @@ def _draw_orbits(
     ax.set_ylim(-w_top, w_top)
     ax.set_ylabel(r"$\omega_\tau$")
     ax.axhline(0, color="0.85", lw=0.6, zorder=0)
-    pole = {None: "", "south": ", south pole case", "north": ", north pole case",
-            "both": ", no spin: both poles"}[level.pole]  # fmt: skip
+    pole = {
+        None: "",
+        "south": ", south pole case",
+        "north": ", north pole case",
+        "both": ", no spin: both poles",
+    }[level.pole]
     symbols = {"M3": "M_3", "C1": "C_1", "C2": "C_2", "p_horizontal": r"p_{\rm h}"}
     upright = {k: r"\mathrm{" + k.replace("_", r"\_") + "}" for k in level.values()}
     named = r",\ ".join(f"{symbols.get(k, upright[k])}={v:g}" for k, v in level.values().items())
@@ -238,8 +251,16 @@ def _draw_potential(
     ax.set_ylabel(r"$U,\ h$")
     what = r"$U(\theta)$" if level.pole else r"$U(\gamma_3)$"
     label_box = {"facecolor": "white", "edgecolor": "none", "alpha": 0.85, "pad": 1.5}
-    ax.text(0.01, 0.95, what + r" and the levels $h$", transform=ax.transAxes, va="top",
-            fontsize=8, zorder=5, bbox=label_box)  # fmt: skip
+    ax.text(
+        0.01,
+        0.95,
+        what + r" and the levels $h$",
+        transform=ax.transAxes,
+        va="top",
+        fontsize=8,
+        zorder=5,
+        bbox=label_box,
+    )
 
 
 def _levels(level: LevelSet, h_levels: Sequence[float] | None) -> list[float]:
@@ -324,7 +345,12 @@ def phase_portrait(
     fig = Figure(figsize=figsize, layout="constrained")
     ax, axu = fig.subplots(2, 1, height_ratios=[3, 1.3], sharex=True)
     window = _draw_orbits(ax, level, levels, motions, show_contact)
-    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncols=3, fontsize=8,
-               frameon=False)  # fmt: skip
+    fig.legend(
+        *ax.get_legend_handles_labels(),
+        loc="outside lower center",
+        ncols=3,
+        fontsize=8,
+        frameon=False,
+    )
     _draw_potential(axu, level, levels, motions, window)
     return fig

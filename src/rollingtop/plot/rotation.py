@@ -44,26 +44,38 @@ def rotation_figure(
     n0 = rmap.N[:, :, 0]
     dist = np.abs(n0 - np.round(n0))
     dist = np.where(np.isfinite(dist), np.maximum(dist, 1e-4), np.nan)
-    mesh = ax.pcolormesh(rmap.C2_grid, rmap.h_grid, dist, shading="nearest", cmap="magma",
-                         norm=LogNorm(vmin=1e-4, vmax=0.5), rasterized=True)  # fmt: skip
+    mesh = ax.pcolormesh(
+        rmap.C2_grid,
+        rmap.h_grid,
+        dist,
+        shading="nearest",
+        cmap="magma",
+        norm=LogNorm(vmin=1e-4, vmax=0.5),
+        rasterized=True,
+    )
     cbar = fig.colorbar(mesh, ax=ax, fraction=0.05)
     cbar.set_label("|N - nearest integer|, first orbit", fontsize=8)
     for br in diagram.branches:
         ax.plot(br.C2, br.h, color="w", lw=0.9, alpha=0.8)
-    for q, colour, what in ((1, "cyan", "N integer (drift)"), (2, "#7fff00", "N = k + 1/2"),
-                            (3, "#ffd700", "N = p/3")):  # fmt: skip
+    for q, colour, what in (
+        (1, "cyan", "N integer (drift)"),
+        (2, "#7fff00", "N = k + 1/2"),
+        (3, "#ffd700", "N = p/3"),
+    ):
         res = [r for r in rmap.resonances if r["orbit"] == 0 and r["q"] == q]
         if res:
-            ax.plot([r["C2"] for r in res], [r["h"] for r in res], ".", color=colour, ms=3,
-                    label=what)  # fmt: skip
+            ax.plot(
+                [r["C2"] for r in res], [r["h"] for r in res], ".", color=colour, ms=3, label=what
+            )
     for name, ex in examples.items():
         ax.plot(ex["C2"], ex["h"], MARKERS[name], color="w", mec="k", ms=7, label=name)
     ax.set_xlim(rmap.C2_grid[0], rmap.C2_grid[-1])
     ax.set_ylim(rmap.h_grid[0], rmap.h_grid[-1])
     ax.set_xlabel("C2")
     ax.set_ylabel("h")
-    ax.set_title(f"rotation number N = Delta psi / 2 pi, M3 = {rmap.M3:g}, C1 = {rmap.C1:g}",
-                 fontsize=9)  # fmt: skip
+    ax.set_title(
+        f"rotation number N = Delta psi / 2 pi, M3 = {rmap.M3:g}, C1 = {rmap.C1:g}", fontsize=9
+    )
     ax.legend(fontsize=7, loc="upper left", framealpha=0.85)
     for k, name in enumerate(("drifting", "closed", "quasi-periodic")):
         sub = fig.add_subplot(grid[0, 1 + k])
@@ -78,7 +90,10 @@ def rotation_figure(
         sub.plot(cp[0, 0], cp[0, 1], MARKERS[name], color="w", mec="k", ms=5)
         sub.set_aspect("equal", adjustable="datalim")
         frac = "" if ex["q"] in (None, 1) else f" = {ex['p']}/{ex['q']}"
-        sub.set_title(f"contact point, {name}: N = {ex['N']:.4g}{frac}\nC2 = {ex['C2']:.4g}, "
-                      f"h = {ex['h']:.4g}", fontsize=8)  # fmt: skip
+        sub.set_title(
+            f"contact point, {name}: N = {ex['N']:.4g}{frac}\nC2 = {ex['C2']:.4g}, "
+            f"h = {ex['h']:.4g}",
+            fontsize=8,
+        )
         sub.tick_params(labelsize=6)
     return fig

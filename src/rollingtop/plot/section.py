@@ -42,20 +42,36 @@ def section_figure(ds: xr.Dataset, *, marker_size: float = 0.6) -> Figure:
         single = max(np.ptp(g3[ok]), np.ptp(wn[ok])) < SAME_POINT
         colour = cmap((k + 0.5) / K)
         if lost[k]:
-            ax.plot(g3[ok], wn[ok], "o", ms=SINGLE_SIZE if single else 4 * marker_size,
-                    mfc="none", mec=colour, mew=0.4, rasterized=True)  # fmt: skip
+            ax.plot(
+                g3[ok],
+                wn[ok],
+                "o",
+                ms=SINGLE_SIZE if single else 4 * marker_size,
+                mfc="none",
+                mec=colour,
+                mew=0.4,
+                rasterized=True,
+            )
         else:
-            ax.plot(g3[ok], wn[ok], ".", ms=SINGLE_SIZE if single else marker_size,
-                    color=colour, rasterized=True)  # fmt: skip
+            ax.plot(
+                g3[ok],
+                wn[ok],
+                ".",
+                ms=SINGLE_SIZE if single else marker_size,
+                color=colour,
+                rasterized=True,
+            )
     ax.set_xlabel(r"$\gamma_3$ at the crossing")
     ax.set_ylabel(r"$\omega_n = (\omega, n)$")
     held = ds.attrs["held"].replace(",", ", ")
     energy = float(ds["level_energy"].values[0])
     found = int(ds["n_crossings"].sum())
-    ax.set_title(f"Poincare section w_tau = 0 (upward), model {ds.attrs['model']}\n"
-                 f"E = {energy:.6g}; held: {held}; {K} trajectories, {found} crossings"
-                 + (f"; {int(lost.sum())} lose contact (open circles)" if lost.any() else ""),
-                 fontsize=9)  # fmt: skip
+    ax.set_title(
+        f"Poincare section w_tau = 0 (upward), model {ds.attrs['model']}\n"
+        f"E = {energy:.6g}; held: {held}; {K} trajectories, {found} crossings"
+        + (f"; {int(lost.sum())} lose contact (open circles)" if lost.any() else ""),
+        fontsize=9,
+    )
     body = ", ".join(f"{k[5:]} = {ds.attrs[k]:g}" for k in ds.attrs if k.startswith("body_"))
     ax.text(0.01, 0.01, body, transform=ax.transAxes, fontsize=7, color="0.35")
     return fig
@@ -79,7 +95,10 @@ def indicators_figure(result: ChaosIndicators) -> Figure:
     ax2.set_xlabel("t")
     ax2.set_ylabel("MEGNO")
     ax2.legend(fontsize=8)
-    fig.suptitle(f"model {result.model.name}: lambda(t_end) = {lam[-1]:.4g}, "
-                 f"<Y>(t_end) = {result.megno_mean[-1]:.4g}", fontsize=10)  # fmt: skip
+    fig.suptitle(
+        f"model {result.model.name}: lambda(t_end) = {lam[-1]:.4g}, "
+        f"<Y>(t_end) = {result.megno_mean[-1]:.4g}",
+        fontsize=10,
+    )
     fig.tight_layout()
     return fig

@@ -158,8 +158,13 @@ class Fold:
     theta: float = math.nan
 
     def to_dict(self) -> dict[str, Any]:
-        return {"C2": self.C2, "gamma3": self.gamma3, "h": self.h, "kind": self.kind,
-                "theta": self.theta}  # fmt: skip
+        return {
+            "C2": self.C2,
+            "gamma3": self.gamma3,
+            "h": self.h,
+            "kind": self.kind,
+            "theta": self.theta,
+        }
 
 
 def folds(body: SphericalTop, M3: float, C1: float) -> list[Fold]:
@@ -181,8 +186,13 @@ def folds(body: SphericalTop, M3: float, C1: float) -> list[Fold]:
             for k in np.flatnonzero(sign[:-1] * sign[1:] < 0):
                 if not (np.isfinite(d[k]) and np.isfinite(d[k + 1])):
                     continue
-                t = brentq(lambda x: float(_dc2_star(level, np.array(x))), th[k], th[k + 1],
-                           xtol=1e-15, rtol=4 * np.finfo(float).eps)  # fmt: skip
+                t = brentq(
+                    lambda x: float(_dc2_star(level, np.array(x))),
+                    th[k],
+                    th[k + 1],
+                    xtol=1e-15,
+                    rtol=4 * np.finfo(float).eps,
+                )
                 if t0 is not None and abs(t - t0) < FAMILY_GAP:
                     continue  # where the curve meets the family of a3 = 0: a pitchfork
                 c2 = float(_c2_star(level, t))

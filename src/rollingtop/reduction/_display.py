@@ -51,8 +51,11 @@ def steady_count(motions: Sequence[SteadyMotion]) -> str:
 
 def _title(obj: object) -> str:
     """The name a user imports the object's type by."""
-    public = {"SteadyMotions": "rollingtop.reduction", "Orbits": "rollingtop.reduction",
-              "BifurcationDiagram": "rollingtop.reduction.bifurcation"}  # fmt: skip
+    public = {
+        "SteadyMotions": "rollingtop.reduction",
+        "Orbits": "rollingtop.reduction",
+        "BifurcationDiagram": "rollingtop.reduction.bifurcation",
+    }
     name = type(obj).__name__
     return f"{public.get(name, 'rollingtop.reduction')}.{name}"
 
@@ -83,10 +86,31 @@ def steady_html(motions: SteadyMotions) -> str:
     """The steady motions of a level: the count by type, then ``rollingtop equilibria``'s
     columns, one row per motion."""
     level = motions.level
-    header = ["gamma3", "U", "type", "omega", "period", "psi'", "|v_CoM|", "CoM radius",
-              "linearly stable"]  # fmt: skip
-    rows = [[m.gamma3, m.U, m.type, m.frequency, m.period, m.precession_rate, m.com_speed,
-             m.com_radius, m.linearly_stable] for m in motions]  # fmt: skip
+    header = [
+        "gamma3",
+        "U",
+        "type",
+        "omega",
+        "period",
+        "psi'",
+        "|v_CoM|",
+        "CoM radius",
+        "linearly stable",
+    ]
+    rows = [
+        [
+            m.gamma3,
+            m.U,
+            m.type,
+            m.frequency,
+            m.period,
+            m.precession_rate,
+            m.com_speed,
+            m.com_radius,
+            m.linearly_stable,
+        ]
+        for m in motions
+    ]
     sections = [("", table(header, rows)), ("", f"<div>{escape(_model(level))}</div>")]
     return block(_title(motions), f"{steady_count(motions)} on {level.describe()}", sections)
 
@@ -97,30 +121,59 @@ def orbits_html(found: Orbits) -> str:
     level, h = found.level, found.h
     values = {**level.values(), "h": h, "energy E": level.full_energy(h)}
     header = ["gamma3_min", "gamma3_max", "period", "+-", "kind", "through the pole", "note"]
-    rows = [[Num(o.gamma3_min, 10), Num(o.gamma3_max, 10), Num(o.period, 12),
-             Num(o.period_error, 2), o.kind, o.pole_passage, o.note] for o in found]  # fmt: skip
-    return block(_title(found), f"{count(len(found), 'orbit')} on {level.describe()} at h = {h:g}",
-                 [("level", row_table(values)), ("", table(header, rows)),
-                  ("", f"<div>{escape(_model(level))}</div>")])  # fmt: skip
+    rows = [
+        [
+            Num(o.gamma3_min, 10),
+            Num(o.gamma3_max, 10),
+            Num(o.period, 12),
+            Num(o.period_error, 2),
+            o.kind,
+            o.pole_passage,
+            o.note,
+        ]
+        for o in found
+    ]
+    return block(
+        _title(found),
+        f"{count(len(found), 'orbit')} on {level.describe()} at h = {h:g}",
+        [
+            ("level", row_table(values)),
+            ("", table(header, rows)),
+            ("", f"<div>{escape(_model(level))}</div>"),
+        ],
+    )
 
 
 def diagram_html(diagram: BifurcationDiagram) -> str:
     """A bifurcation diagram: the body, ``(M3, C1)`` and the window, the counts, the folds and
     the regions (what orbits each holds, a representative level)."""
     c2, h = diagram.C2_grid, diagram.h_grid
-    window = {"M3": diagram.M3, "C1": diagram.C1, "C2 from": c2[0], "C2 to": c2[-1],
-              "h from": h[0], "h to": h[-1], "grid": f"{len(c2)} x {len(h)}"}  # fmt: skip
+    window = {
+        "M3": diagram.M3,
+        "C1": diagram.C1,
+        "C2 from": c2[0],
+        "C2 to": c2[-1],
+        "h from": h[0],
+        "h to": h[-1],
+        "grid": f"{len(c2)} x {len(h)}",
+    }
     folds = [[f.C2, f.h, f.gamma3, f.kind] for f in diagram.folds]
     regions = [[r.name, r.label, r.C2, r.h, r.cells] for r in diagram.regions]
     branches = count(len(diagram.branches), "branch", "branches")
-    summary = (f"{branches} of critical values, {count(len(diagram.folds), 'fold')}, "
-               f"{count(len(diagram.regions), 'region')}")  # fmt: skip
-    return block(_title(diagram), "meridian model, the (C2, h) plane of " + summary, [
-        ("body", row_table(diagram.body.to_dict())),
-        ("window", row_table(window)),
-        ("folds", table(["C2", "h", "gamma3", "kind"], folds)),
-        ("regions", table(["region", "a level in it holds", "C2", "h", "grid cells"], regions)),
-    ])  # fmt: skip
+    summary = (
+        f"{branches} of critical values, {count(len(diagram.folds), 'fold')}, "
+        f"{count(len(diagram.regions), 'region')}"
+    )
+    return block(
+        _title(diagram),
+        "meridian model, the (C2, h) plane of " + summary,
+        [
+            ("body", row_table(diagram.body.to_dict())),
+            ("window", row_table(window)),
+            ("folds", table(["C2", "h", "gamma3", "kind"], folds)),
+            ("regions", table(["region", "a level in it holds", "C2", "h", "grid cells"], regions)),
+        ],
+    )
 
 
 def plot_level(level: LevelSet, ax: Axes | None, **kw: Any) -> Axes:

@@ -291,8 +291,9 @@ def _wall_period(
         mirror = _north_wall(level, h, t_end, mid) if wall and not left else None
         if mirror is not None:
             mirrored, x_end = mirror
-            value, err = half_integral(mirrored, h, x_end, math.pi - mid, True, True,
-                                       [math.pi - p for p in peaks], weight)  # fmt: skip
+            value, err = half_integral(
+                mirrored, h, x_end, math.pi - mid, True, True, [math.pi - p for p in peaks], weight
+            )
         else:
             value, err = half_integral(level, h, t_end, mid, wall, left, peaks, weight)
         total, error = total + value, error + err

@@ -55,12 +55,18 @@ class Region:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "name": self.name, "label": self.label, "orbits": len(self.signature),
-            "centres_per_orbit": list(self.signature), "C2": self.C2, "h": self.h,
+            "name": self.name,
+            "label": self.label,
+            "orbits": len(self.signature),
+            "centres_per_orbit": list(self.signature),
+            "C2": self.C2,
+            "h": self.h,
             "centre_gamma3": [list(g) for g in self.centre_gamma3],
             "through_pole": list(self.through_pole),
-            "C2_range": list(self.C2_range), "h_range": list(self.h_range), "cells": self.cells,
-        }  # fmt: skip
+            "C2_range": list(self.C2_range),
+            "h_range": list(self.h_range),
+            "cells": self.cells,
+        }
 
 
 #: Marks an orbit (a tuple of centre indices) that passes through the pole.
@@ -120,8 +126,9 @@ def region_orbits(level: LevelSet, h: float) -> list[tuple[int, bool]]:
     pole; ``[]``: no motion (``h <= min U``)."""
     _base_level(level.body, level.M3, level.C1)  # refuses the level without spin
     theta, U, u2 = _critical(level)
-    return [(len(_centres(o)), THROUGH_POLE in o)
-            for o in _orbits_at(U, u2 > 0, h, theta, _pole(level))]  # fmt: skip
+    return [
+        (len(_centres(o)), THROUGH_POLE in o) for o in _orbits_at(U, u2 > 0, h, theta, _pole(level))
+    ]
 
 
 def region_signature(level: LevelSet, h: float) -> tuple[int, ...]:

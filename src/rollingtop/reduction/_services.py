@@ -11,6 +11,7 @@ motion in absolute space) asks the level through these, whatever the model.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from typing import Any, ClassVar, TypeAlias, TypeVar
 
 import numpy as np
@@ -60,8 +61,10 @@ def check_level_values(level: Any, names: tuple[str, ...]) -> None:
         object.__setattr__(level, name, float(x))
     b = level.body
     if not b.symmetric:
-        raise LevelSetError(f"the reduction needs a dynamically symmetric body (I1 = I2), got "
-                            f"I1 = {b.I1:g}, I2 = {b.I2:g}")  # fmt: skip
+        raise LevelSetError(
+            f"the reduction needs a dynamically symmetric body (I1 = I2), got "
+            f"I1 = {b.I1:g}, I2 = {b.I2:g}"
+        )
 
 
 def check_level_size(level: Any) -> None:
@@ -80,7 +83,7 @@ def check_level_size(level: Any) -> None:
         )
 
 
-class LevelServices:
+class LevelServices(ABC):
     """The services of a level set (module docstring); a level provides ``body``, ``M3``,
     :attr:`integrals`, ``v_tau(theta)`` and ``flow(theta, w_tau)``."""
 
@@ -90,13 +93,13 @@ class LevelServices:
     #: of a ``[level]`` table and of the level in JSON output (:meth:`values`).
     integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "C2")
 
+    @abstractmethod
     def v_tau(self, theta: Any) -> Any:
         """``v_tau`` at ``theta`` (the level's own)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def flow(self, theta: Any, w_tau: Any) -> tuple[Any, Any]:
         """``(theta', w_tau')`` (the level's own)."""
-        raise NotImplementedError
 
     #: :meth:`full_energy` in words.
     energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
@@ -150,6 +153,9 @@ class LevelServices:
         t = np.asarray(theta, dtype=float)[..., None]
         wt = np.asarray(w_tau, dtype=float)[..., None]
         v_tau = (np.asarray(self.v_tau(theta), dtype=float) + 0.0 * wt[..., 0])[..., None]
-        v: FloatArray = (v_tau * frame["tau"] - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
-                         - b.R * np.sin(t) * wt * frame["e3"])  # fmt: skip
+        v: FloatArray = (
+            v_tau * frame["tau"]
+            - (b.R * np.cos(t) + b.a3) * wt * frame["n"]
+            - b.R * np.sin(t) * wt * frame["e3"]
+        )
         return v

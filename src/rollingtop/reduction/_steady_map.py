@@ -49,15 +49,18 @@ class SteadyCountMap:
 
     def to_dict(self) -> dict[str, Any]:
         values, cells = np.unique(self.count[self.count >= 0], return_counts=True)
-        return json_ready({
-            "M3": self.M3,
-            "C1_range": [float(self.C1_grid[0]), float(self.C1_grid[-1])],
-            "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
-            "grid": [len(self.C1_grid), len(self.C2_grid)],
-            "steady_counts": {str(int(v)): int(c) for v, c in zip(values, cells, strict=True)},
-            "fold_curve": [[float(a), float(b)] for a, b in
-                           zip(self.fold_C1, self.fold_C2, strict=True)],
-        })  # fmt: skip
+        return json_ready(
+            {
+                "M3": self.M3,
+                "C1_range": [float(self.C1_grid[0]), float(self.C1_grid[-1])],
+                "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
+                "grid": [len(self.C1_grid), len(self.C2_grid)],
+                "steady_counts": {str(int(v)): int(c) for v, c in zip(values, cells, strict=True)},
+                "fold_curve": [
+                    [float(a), float(b)] for a, b in zip(self.fold_C1, self.fold_C2, strict=True)
+                ],
+            }
+        )
 
 
 def steady_count_map(
@@ -98,5 +101,4 @@ def steady_count_map(
         for f in folds(body, M3, float(c1)):
             fold_c1.append(float(c1))
             fold_c2.append(f.C2)
-    return SteadyCountMap(float(M3), C1_grid, C2_grid, count, np.array(fold_c1),
-                          np.array(fold_c2))  # fmt: skip
+    return SteadyCountMap(float(M3), C1_grid, C2_grid, count, np.array(fold_c1), np.array(fold_c2))

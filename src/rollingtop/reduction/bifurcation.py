@@ -137,20 +137,25 @@ class BifurcationDiagram:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary: the folds, the regions and the grid's extent."""
-        return json_ready({
-            "M3": self.M3, "C1": self.C1,
-            "folds": [f.to_dict() for f in self.folds],
-            "regions": [r.to_dict() for r in self.regions],
-            "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
-            "h_range": [float(self.h_grid[0]), float(self.h_grid[-1])],
-            "grid": [len(self.C2_grid), len(self.h_grid)],
-        })  # fmt: skip
+        return json_ready(
+            {
+                "M3": self.M3,
+                "C1": self.C1,
+                "folds": [f.to_dict() for f in self.folds],
+                "regions": [r.to_dict() for r in self.regions],
+                "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
+                "h_range": [float(self.h_grid[0]), float(self.h_grid[-1])],
+                "grid": [len(self.C2_grid), len(self.h_grid)],
+            }
+        )
 
     def __repr__(self) -> str:
-        return (f"<BifurcationDiagram: M3 = {self.M3:g}, C1 = {self.C1:g}; "
-                f"{count(len(self.folds), 'fold')}, {count(len(self.regions), 'region')} in C2 = "
-                f"{self.C2_grid[0]:g} .. {self.C2_grid[-1]:g}, h = {self.h_grid[0]:g} .. "
-                f"{self.h_grid[-1]:g}>")  # fmt: skip
+        return (
+            f"<BifurcationDiagram: M3 = {self.M3:g}, C1 = {self.C1:g}; "
+            f"{count(len(self.folds), 'fold')}, {count(len(self.regions), 'region')} in C2 = "
+            f"{self.C2_grid[0]:g} .. {self.C2_grid[-1]:g}, h = {self.h_grid[0]:g} .. "
+            f"{self.h_grid[-1]:g}>"
+        )
 
     def _repr_html_(self) -> str:
         """The notebook's view: body, window, the folds and the regions (their orbits)."""
@@ -244,8 +249,9 @@ def bifurcation_diagram(
         marks.append(Fold(_pitchfork_c2(level, t0), math.cos(t0), math.nan, "pitchfork", t0))
     c2_lo, c2_hi = C2_range if C2_range is not None else _default_c2_range(level, marks)
     if not (math.isfinite(c2_hi - c2_lo) and c2_lo < c2_hi):  # its width too: a grid's spacing
-        raise LevelSetError(f"C2 range ({c2_lo:g}, {c2_hi:g}) must be finite and increasing, "
-                            "and its width finite")  # fmt: skip
+        raise LevelSetError(
+            f"C2 range ({c2_lo:g}, {c2_hi:g}) must be finite and increasing, and its width finite"
+        )
     C2_grid = np.linspace(c2_lo, c2_hi, nc)
     if t0 is not None:
         branches.append(_family_branch(level, t0, (c2_lo, c2_hi)))
@@ -284,8 +290,9 @@ def bifurcation_diagram(
         h_range = _default_h_range(branches, (c2_lo, c2_hi), float(np.nanmin(min_U)))
     h_lo, h_hi = h_range
     if not (math.isfinite(h_hi - h_lo) and h_lo < h_hi):
-        raise LevelSetError(f"h range ({h_lo:g}, {h_hi:g}) must be finite and increasing, and "
-                            "its width finite")  # fmt: skip
+        raise LevelSetError(
+            f"h range ({h_lo:g}, {h_hi:g}) must be finite and increasing, and its width finite"
+        )
     h_grid = np.linspace(h_lo, h_hi, nh)
     # regions: nodes of neighbouring columns with the same orbits and overlapping h intervals
     parent = list(range(len(nodes)))
@@ -326,8 +333,9 @@ def bifurcation_diagram(
         los = [max(nodes[b][1], h_lo) for b in group]
         his = [min(nodes[b][2], h_hi) for b in group]
         where = tuple(tuple(float(gammas[j][k]) for k in _centres(orbit)) for orbit in orbits)
-        reps.append((float(C2_grid[j]), 0.5 * (lo_c + hi_c), orbits, group, min(los), max(his),
-                     where))  # fmt: skip
+        reps.append(
+            (float(C2_grid[j]), 0.5 * (lo_c + hi_c), orbits, group, min(los), max(his), where)
+        )
     reps.sort(key=lambda r: (r[0], r[1]))
     region_index = np.full((nh, nc), -1, dtype=np.int64)
     regions = []
@@ -338,14 +346,33 @@ def bifurcation_diagram(
             region_index[(h_grid > lo_a) & (h_grid <= hi_a), j] = n_reg
         sig = tuple(len(_centres(o)) for o in orbits)
         passing = tuple(THROUGH_POLE in o for o in orbits)
-        regions.append(Region(
-            name=_region_name(n_reg), signature=sig, label=describe_signature(sig, passing),
-            C2=c2, h=h, centre_gamma3=where, through_pole=passing,
-            C2_range=(float(C2_grid[min(cols)]), float(C2_grid[max(cols)])),
-            h_range=(lo, hi), cells=len(group),
-        ))  # fmt: skip
-    return BifurcationDiagram(body, float(level.M3), float(level.C1), branches, fs, regions,
-                              C2_grid, h_grid, region_index, min_U, pole_energy)  # fmt: skip
+        regions.append(
+            Region(
+                name=_region_name(n_reg),
+                signature=sig,
+                label=describe_signature(sig, passing),
+                C2=c2,
+                h=h,
+                centre_gamma3=where,
+                through_pole=passing,
+                C2_range=(float(C2_grid[min(cols)]), float(C2_grid[max(cols)])),
+                h_range=(lo, hi),
+                cells=len(group),
+            )
+        )
+    return BifurcationDiagram(
+        body,
+        float(level.M3),
+        float(level.C1),
+        branches,
+        fs,
+        regions,
+        C2_grid,
+        h_grid,
+        region_index,
+        min_U,
+        pole_energy,
+    )
 
 
 def _kinds(orbits: tuple[tuple[int, ...], ...]) -> list[tuple[int, bool]]:

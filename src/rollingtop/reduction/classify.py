@@ -84,9 +84,14 @@ class CriticalValues:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
-        return {"model": self.model, "axis": self.axis, "fixed": json_ready(self.fixed),
-                "x": _plain(self.x), "count": self.count.tolist(),
-                "points": _plain(self.points)}  # fmt: skip
+        return {
+            "model": self.model,
+            "axis": self.axis,
+            "fixed": json_ready(self.fixed),
+            "x": _plain(self.x),
+            "count": self.count.tolist(),
+            "points": _plain(self.points),
+        }
 
 
 def _plain(a: NDArray[Any]) -> list[Any]:
@@ -97,9 +102,12 @@ def _plain(a: NDArray[Any]) -> list[Any]:
 
 
 def critical_values(
-    level: LevelSet, *, axis: str | None = None, window: tuple[float, float] | None = None,
+    level: LevelSet,
+    *,
+    axis: str | None = None,
+    window: tuple[float, float] | None = None,
     n: int = 121,
-) -> CriticalValues:  # fmt: skip
+) -> CriticalValues:
     """The critical values of ``level``'s model along the integral ``axis`` (default
     :data:`AXES`), the others held at ``level``'s values.
 
@@ -118,8 +126,10 @@ def critical_values(
     values = level.values()
     axis = AXES[level.model] if axis is None else axis
     if axis not in values:
-        raise ScenarioError(f"axis {axis!r} is not an integral of the {level.model} model's "
-                            f"level ({', '.join(values)})")  # fmt: skip
+        raise ScenarioError(
+            f"axis {axis!r} is not an integral of the {level.model} model's "
+            f"level ({', '.join(values)})"
+        )
     if not 3 <= int(n) <= 2001:
         raise ScenarioError(f"n = {n} must be between 3 and 2001")
     x0 = values[axis]
@@ -170,16 +180,23 @@ class ModelClassification:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict: ``model``, ``level`` (its integrals, ``h`` and the full energy),
         ``orbit`` (``None`` on a steady motion or a separatrix), ``equilibria``, ``critical``."""
-        return json_ready({
-            "model": self.model,
-            "level": {**self.level.values(), "h": self.h,
-                      "energy": self.level.full_energy(self.h), "pole": self.level.pole},
-            "orbit": None if self.orbit is None else {**self.orbit.to_dict(),
-                                                      "delta_psi": self.delta_psi},
-            "equilibria": [m.to_dict() for m in self.steady],
-            "critical": self.critical.to_dict(),
-            "note": self.note,
-        })  # fmt: skip
+        return json_ready(
+            {
+                "model": self.model,
+                "level": {
+                    **self.level.values(),
+                    "h": self.h,
+                    "energy": self.level.full_energy(self.h),
+                    "pole": self.level.pole,
+                },
+                "orbit": None
+                if self.orbit is None
+                else {**self.orbit.to_dict(), "delta_psi": self.delta_psi},
+                "equilibria": [m.to_dict() for m in self.steady],
+                "critical": self.critical.to_dict(),
+                "note": self.note,
+            }
+        )
 
 
 def classify_models(
@@ -222,8 +239,11 @@ def classify_models(
 
     # the models of this body: a shell-rotor pair's under the pair's model, a bare body's under
     # the others (ContactModel.own_inertia)
-    names = ([m for m, c in MODELS.items() if m in REDUCTIONS and c.own_inertia == body.has_shell]
-             if models is None else list(models))  # fmt: skip
+    names = (
+        [m for m, c in MODELS.items() if m in REDUCTIONS and c.own_inertia == body.has_shell]
+        if models is None
+        else list(models)
+    )
     out = []
     for name in names:
         reduction = reduction_of(name)
@@ -240,8 +260,9 @@ def classify_models(
             # the shell-rotor pair's last slot is its shell's spin, not a carried direction:
             # the geometric one then (reduced_components on 17 components)
             theta = float(reduce_state(y[:17] if MODELS[name].own_inertia else y)["theta"])
-            found = [o for o in orbits(level, h)
-                     if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]  # fmt: skip
+            found = [
+                o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9
+            ]
             steady = steady_motions(level)
         except RollingTopError as err:  # a level the model does not reduce, a flat U: others go on
             refused[name] = str(err)
@@ -249,8 +270,9 @@ def classify_models(
         orbit = found[0] if found and found[0].kind == "periodic" else None
         note = "" if orbit is not None else "the state lies on a steady motion or a separatrix"
         note = "; ".join(x for x in (projected, note) if x)
-        out.append(ModelClassification(name, level, h, y, orbit, steady,
-                                       critical_values(level, n=n), note))  # fmt: skip
+        out.append(
+            ModelClassification(name, level, h, y, orbit, steady, critical_values(level, n=n), note)
+        )
     return out
 
 
@@ -309,10 +331,15 @@ class RotationGrid:
         """JSON-ready dict, with ``N_range`` (``None`` without a periodic orbit)."""
         finite = self.N[np.isfinite(self.N)]
         span = None if finite.size == 0 else [float(finite.min()), float(finite.max())]
-        return {"model": self.model, "axis": self.axis, "fixed": json_ready(self.fixed),
-                "x": _plain(self.x), "h": _plain(self.h),
-                "N": [[_plain(cell) for cell in row] for row in self.N],
-                "N_range": span}  # fmt: skip
+        return {
+            "model": self.model,
+            "axis": self.axis,
+            "fixed": json_ready(self.fixed),
+            "x": _plain(self.x),
+            "h": _plain(self.h),
+            "N": [[_plain(cell) for cell in row] for row in self.N],
+            "N_range": span,
+        }
 
 
 def rotation_grid(
@@ -339,8 +366,9 @@ def rotation_grid(
     values = level.values()
     if h_range is None:
         if cv.points.size == 0:
-            raise ScenarioError(f"no steady motion of the {level.model} model in the window: "
-                                "give the h range")  # fmt: skip
+            raise ScenarioError(
+                f"no steady motion of the {level.model} model in the window: give the h range"
+            )
         lo, hi = float(cv.points[:, 2].min()), float(cv.points[:, 2].max())
         h_range = (lo + 1e-6 * max(1.0, abs(lo)), hi + 0.5 * (hi - lo) + 1e-3)
     h_lo, h_hi = h_range

@@ -84,8 +84,10 @@ class Reduction:
         unknown = [n for n in values if n not in self.names]
         if missing or unknown:
             what = f"missing {', '.join(missing)}" if missing else f"unknown {', '.join(unknown)}"
-            raise ScenarioError(f"a level of the {self.model} model's reduction is fixed by "
-                                f"{', '.join(self.names)} ({what})")  # fmt: skip
+            raise ScenarioError(
+                f"a level of the {self.model} model's reduction is fixed by "
+                f"{', '.join(self.names)} ({what})"
+            )
         given = {n: float(values[n]) for n in self.names}
         return self.level_type(body, **given, scale=scale)
 
@@ -117,8 +119,10 @@ class Reduction:
 def _largest_input(body: SphericalTop, y: NDArray[np.float64]) -> str:
     """The body parameter or velocity of ``y`` farthest from 1 in magnitude, as ``name = value``
     (the input to blame for an overflow)."""
-    named = {k: float(getattr(body, k)) for k in ("R", "m", "g", "a3", "I1", "I2", "I3",
-                                                   "shell_mass", "shell_inertia")}  # fmt: skip
+    named = {
+        k: float(getattr(body, k))
+        for k in ("R", "m", "g", "a3", "I1", "I2", "I3", "shell_mass", "shell_inertia")
+    }
     named |= {"|v|": float(np.linalg.norm(y[0:3])), "|omega|": float(np.linalg.norm(y[W]))}
     sizes = {k: abs(math.log10(abs(v))) for k, v in named.items() if v != 0 and np.isfinite(v)}
     worst = max(sizes, key=sizes.__getitem__)
@@ -128,25 +132,47 @@ def _largest_input(body: SphericalTop, y: NDArray[np.float64]) -> str:
 REDUCTIONS: dict[str, Reduction] = {
     r.model: r
     for r in (
-        Reduction("meridian", LevelSet, reduced_integrals,
-                  "E - I3 w3^2/2 - m g R",
-                  "Kilin and Ivanova 2023, Sec. 3 (eqs. 3.8-3.11)"),
-        Reduction("smooth", SmoothLevel, smooth_integrals,
-                  "E - I3 w3^2/2 - m g R",
-                  "Lagrange's top about its centre of mass with the vertical motion's mass "
-                  "(Routh, Advanced Rigid Dynamics, Sec. 242)"),
-        Reduction("rough", RoughLevel, rough_integrals, "E - m g R",
-                  "Routh's sphere: Jellett's and Routh's integrals (Routh, Advanced Rigid "
-                  "Dynamics, Sec. 243; Borisov and Mamaev, Rigid Body Dynamics)"),
-        Reduction("rubber", RubberLevel, rubber_integrals, "E - m g R",
-                  "rolling without slipping or spinning: the integral linear in w "
-                  "(Borisov, Mamaev and Bizyaev 2013; rollingtop.reduction.rubber)"),
-        Reduction("shell-rotor", ShellRotorLevel, shell_rotor_integrals,
-                  "E - I3 w3^2/2 - m g R",
-                  "the pair's Lagrange, Jellett and F6 integrals (rollingtop.symbolic.shell_rotor;"
-                  " the meridian model's reduction as the shell's mass and inertia vanish)"),
+        Reduction(
+            "meridian",
+            LevelSet,
+            reduced_integrals,
+            "E - I3 w3^2/2 - m g R",
+            "Kilin and Ivanova 2023, Sec. 3 (eqs. 3.8-3.11)",
+        ),
+        Reduction(
+            "smooth",
+            SmoothLevel,
+            smooth_integrals,
+            "E - I3 w3^2/2 - m g R",
+            "Lagrange's top about its centre of mass with the vertical motion's mass "
+            "(Routh, Advanced Rigid Dynamics, Sec. 242)",
+        ),
+        Reduction(
+            "rough",
+            RoughLevel,
+            rough_integrals,
+            "E - m g R",
+            "Routh's sphere: Jellett's and Routh's integrals (Routh, Advanced Rigid "
+            "Dynamics, Sec. 243; Borisov and Mamaev, Rigid Body Dynamics)",
+        ),
+        Reduction(
+            "rubber",
+            RubberLevel,
+            rubber_integrals,
+            "E - m g R",
+            "rolling without slipping or spinning: the integral linear in w "
+            "(Borisov, Mamaev and Bizyaev 2013; rollingtop.reduction.rubber)",
+        ),
+        Reduction(
+            "shell-rotor",
+            ShellRotorLevel,
+            shell_rotor_integrals,
+            "E - I3 w3^2/2 - m g R",
+            "the pair's Lagrange, Jellett and F6 integrals (rollingtop.symbolic.shell_rotor;"
+            " the meridian model's reduction as the shell's mass and inertia vanish)",
+        ),
     )
-}  # fmt: skip
+}
 
 
 def reduction_of(model: str | ContactModel) -> Reduction:

@@ -160,8 +160,7 @@ def near_pole(level: LevelSet, h: float, orbit: Orbit) -> NearPole | None:
     if found:
         c = found[0]
         T_lim, _ = half_integral(pole_level, h, c.theta_max, 0.0, False, False)
-        S, _ = half_integral(pole_level, h, c.theta_max, 0.0, False, False,
-                             weight="psi_dot")  # fmt: skip
+        S, _ = half_integral(pole_level, h, c.theta_max, 0.0, False, False, weight="psi_dot")
         b = lv.body
         A = float(lv.rho(0.0)) / (2 * b.I1**2)
         B = b.m * (b.R + b.a3) * lv.C2 / b.I1**2
@@ -169,8 +168,18 @@ def near_pole(level: LevelSet, h: float, orbit: Orbit) -> NearPole | None:
         wall = 2 * math.asin(B / math.sqrt(B * B + 4 * A * E))
         dpsi_lim = S + wall - math.copysign(math.pi, lv.M3 - lv.C1)
         T_pole = c.period
-        dpsi_pole, _ = period(pole_level, h, c.theta_min, c.theta_max, peaks=[0.0],
-                              weight="psi_dot")  # fmt: skip
+        dpsi_pole, _ = period(
+            pole_level, h, c.theta_min, c.theta_max, peaks=[0.0], weight="psi_dot"
+        )
     mu, n_min = _friction(lv, h, o)
-    return NearPole("north" if north else "south", offset, o.theta_min, T_lim, dpsi_lim,
-                    T_pole, dpsi_pole, mu, n_min)  # fmt: skip
+    return NearPole(
+        "north" if north else "south",
+        offset,
+        o.theta_min,
+        T_lim,
+        dpsi_lim,
+        T_pole,
+        dpsi_pole,
+        mu,
+        n_min,
+    )

@@ -96,13 +96,37 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
                 f"no motion on {level.describe()} at h = {h:.12g}: below U = {U0:.12g}"
             )
         if h - U0 <= STEADY_TOLERANCE * max(abs(h), 1e-300):
-            return [Orbit(1.0, 1.0, 0.0, 0.0, math.nan, 0.0, "steady", True, 0.0,
-                          "at rest: U is constant on this level (a3 g = 0), every gamma3 is a "
-                          "neutral equilibrium")]  # fmt: skip
+            return [
+                Orbit(
+                    1.0,
+                    1.0,
+                    0.0,
+                    0.0,
+                    math.nan,
+                    0.0,
+                    "steady",
+                    True,
+                    0.0,
+                    "at rest: U is constant on this level (a3 g = 0), every gamma3 is a "
+                    "neutral equilibrium",
+                )
+            ]
         T, err = rolling_over_period(level, h)
         w_max = float(np.max(level.w_tau(np.array([0.0, math.pi]), h)))  # at the lighter pole
-        return [Orbit(-1.0, 1.0, -math.pi, math.pi, T, err, "periodic", True, w_max,
-                      "rolls over: passes through both poles each period")]  # fmt: skip
+        return [
+            Orbit(
+                -1.0,
+                1.0,
+                -math.pi,
+                math.pi,
+                T,
+                err,
+                "periodic",
+                True,
+                w_max,
+                "rolls over: passes through both poles each period",
+            )
+        ]
     centre, saddle = poles
     Uc, Us = float(level.U(centre)), float(level.U(saddle))
     scale = max(abs(h), abs(Uc), abs(Us), 1e-300)
@@ -114,24 +138,70 @@ def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
     g_c = math.cos(centre)
     if h - Uc <= STEADY_TOLERANCE * scale:
         m = steady_motion(level, centre)
-        return [Orbit(g_c, g_c, centre, centre, m.period, 0.0, "steady", False, 0.0,
-                      "at rest at the pole (h at the minimum of U); period of small "
-                      "oscillations")]  # fmt: skip
+        return [
+            Orbit(
+                g_c,
+                g_c,
+                centre,
+                centre,
+                m.period,
+                0.0,
+                "steady",
+                False,
+                0.0,
+                "at rest at the pole (h at the minimum of U); period of small oscillations",
+            )
+        ]
     w_max = float(level.w_tau(centre, h))
     if abs(h - Us) <= SEPARATRIX_TOLERANCE * scale:
-        return [Orbit(-1.0, 1.0, saddle - math.pi, saddle + math.pi, math.inf, math.inf,
-                      "separatrix", True, w_max,
-                      f"on the separatrix through the upright pole (|h - U(saddle)| = "
-                      f"{abs(h - Us):.2g}): the period grows without bound")]  # fmt: skip
+        return [
+            Orbit(
+                -1.0,
+                1.0,
+                saddle - math.pi,
+                saddle + math.pi,
+                math.inf,
+                math.inf,
+                "separatrix",
+                True,
+                w_max,
+                f"on the separatrix through the upright pole (|h - U(saddle)| = "
+                f"{abs(h - Us):.2g}): the period grows without bound",
+            )
+        ]
     if h > Us:
         T, err = rolling_over_period(level, h)
-        return [Orbit(-1.0, 1.0, saddle - math.pi, saddle + math.pi, T, err, "periodic", True,
-                      w_max, "rolls over: passes through both poles each period")]  # fmt: skip
+        return [
+            Orbit(
+                -1.0,
+                1.0,
+                saddle - math.pi,
+                saddle + math.pi,
+                T,
+                err,
+                "periodic",
+                True,
+                w_max,
+                "rolls over: passes through both poles each period",
+            )
+        ]
     # rocking about the centre, between turning points symmetric about it
     t1 = turning_point(level, h, centre - math.pi + 1e-300, centre)
     t2 = 2 * centre - t1
     T, err = period(level, h, t1, t2)
     g_turn = math.cos(t1)
     g_min, g_max = (min(g_c, g_turn), max(g_c, g_turn))
-    return [Orbit(g_min, g_max, t1, t2, T, err, "periodic", True, w_max,
-                  f"planar rocking through the pole gamma3 = {g_c:+.0f} (no spin)")]  # fmt: skip
+    return [
+        Orbit(
+            g_min,
+            g_max,
+            t1,
+            t2,
+            T,
+            err,
+            "periodic",
+            True,
+            w_max,
+            f"planar rocking through the pole gamma3 = {g_c:+.0f} (no spin)",
+        )
+    ]

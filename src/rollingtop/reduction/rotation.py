@@ -71,8 +71,9 @@ def rotation_number(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, flo
     # saddle there makes the integrand's logarithmic peak near a separatrix)
     inside = [float(c) for c in critical_points(exact_level) if lo < c < hi]
     peaks = [t for t in (exact_level.pole_theta,) if t is not None] + inside
-    dpsi, err = period(exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max, peaks=peaks,
-                       weight="psi_dot")  # fmt: skip
+    dpsi, err = period(
+        exact_level, h, exact_orbit.theta_min, exact_orbit.theta_max, peaks=peaks, weight="psi_dot"
+    )
     return dpsi / (2 * math.pi), err / (2 * math.pi)
 
 
@@ -130,14 +131,17 @@ class RotationMap:
 
     def to_dict(self) -> dict[str, Any]:
         finite = self.N[np.isfinite(self.N)]
-        return json_ready({
-            "M3": self.M3, "C1": self.C1,
-            "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
-            "h_range": [float(self.h_grid[0]), float(self.h_grid[-1])],
-            "grid": [len(self.C2_grid), len(self.h_grid)],
-            "N_range": [float(finite.min()), float(finite.max())] if finite.size else None,
-            "resonances": self.resonances,
-        })  # fmt: skip
+        return json_ready(
+            {
+                "M3": self.M3,
+                "C1": self.C1,
+                "C2_range": [float(self.C2_grid[0]), float(self.C2_grid[-1])],
+                "h_range": [float(self.h_grid[0]), float(self.h_grid[-1])],
+                "grid": [len(self.C2_grid), len(self.h_grid)],
+                "N_range": [float(finite.min()), float(finite.max())] if finite.size else None,
+                "resonances": self.resonances,
+            }
+        )
 
 
 def _family_code(theta_c: FloatArray, centre: NDArray[np.bool_], orbit: Orbit) -> int:
@@ -181,9 +185,13 @@ def _family_steps(
 
 
 def _solve_level(
-    level: LevelSet, bracket: tuple[float, float], k: int, count: int, target: float,
+    level: LevelSet,
+    bracket: tuple[float, float],
+    k: int,
+    count: int,
+    target: float,
     xtol: float,
-) -> float | None:  # fmt: skip
+) -> float | None:
     """The ``h`` in ``bracket`` where orbit ``k`` of ``count`` has ``N = target`` (Brent's
     method), or ``None`` where ``N - target`` does not change sign."""
     try:
@@ -230,8 +238,10 @@ def rotation_map(
     """
     nc, nh = (int(x) for x in resolution)
     if nc < 2 or nh < 2 or max_orbits < 1:
-        raise LevelSetError(f"resolution = {resolution} must be at least (2, 2) and max_orbits "
-                            f"= {max_orbits} at least 1")  # fmt: skip
+        raise LevelSetError(
+            f"resolution = {resolution} must be at least (2, 2) and max_orbits "
+            f"= {max_orbits} at least 1"
+        )
     C2_grid = np.linspace(*C2_range, nc)
     h_grid = np.linspace(*h_range, nh)
     N = np.full((nh, nc, max_orbits), np.nan)
@@ -240,8 +250,9 @@ def rotation_map(
     for j, c2 in enumerate(C2_grid):
         level = LevelSet(body, M3, C1, float(c2))
         if level.pole == "both":
-            raise LevelSetError(f"{level.describe()}: without spin the axis does not precess "
-                                "(N = 0); no map")  # fmt: skip
+            raise LevelSetError(
+                f"{level.describe()}: without spin the axis does not precess (N = 0); no map"
+            )
         theta_c = critical_points(level)
         centre = level.d2U(theta_c) > 0 if theta_c.size else np.zeros(0, dtype=bool)
         for i, h in enumerate(h_grid):
@@ -254,13 +265,21 @@ def rotation_map(
                 family[i, j, k] = _family_code(theta_c, centre, o)
         for i, k, count in _family_steps(N, family, j):
             bracket = (float(h_grid[i]), float(h_grid[i + 1]))
-            for frac in _fractions_between(float(N[i, j, k]), float(N[i + 1, j, k]),
-                                           CURVE_DENOMINATOR):  # fmt: skip
+            for frac in _fractions_between(
+                float(N[i, j, k]), float(N[i + 1, j, k]), CURVE_DENOMINATOR
+            ):
                 h_res = _solve_level(level, bracket, k, count, float(frac), 1e-12)
                 if h_res is not None:
-                    resonances.append({"N": float(frac), "p": frac.numerator,
-                                       "q": frac.denominator, "C2": float(c2),
-                                       "h": float(h_res), "orbit": k})  # fmt: skip
+                    resonances.append(
+                        {
+                            "N": float(frac),
+                            "p": frac.numerator,
+                            "q": frac.denominator,
+                            "C2": float(c2),
+                            "h": float(h_res),
+                            "orbit": k,
+                        }
+                    )
         if progress is not None:
             progress(j + 1, nc)
     return RotationMap(float(M3), float(C1), C2_grid, h_grid, N, family, resonances)
@@ -311,8 +330,14 @@ def class_examples(body: SphericalTop, rmap: RotationMap) -> dict[str, dict[str,
     if rmap.resonances:
         r = next((r for r in rmap.resonances if r["orbit"] == 0 and r["q"] == 1), None)
         if r is not None:
-            out["drifting"] = {"C2": r["C2"], "h": r["h"], "orbit": 0, "N": float(r["N"]),
-                               "p": r["p"], "q": 1}  # fmt: skip
+            out["drifting"] = {
+                "C2": r["C2"],
+                "h": r["h"],
+                "orbit": 0,
+                "N": float(r["N"]),
+                "p": r["p"],
+                "q": 1,
+            }
     best: Fraction | None = None
     for j in range(n0.shape[1]):
         for i, k, _ in _family_steps(rmap.N, rmap.family, j):
@@ -324,15 +349,26 @@ def class_examples(body: SphericalTop, rmap: RotationMap) -> dict[str, dict[str,
     if best is not None:
         found = _crossing(body, rmap, float(best))
         if found is not None:
-            out["closed"] = {"C2": found[0], "h": found[1], "orbit": 0, "N": float(best),
-                             "p": best.numerator, "q": best.denominator}  # fmt: skip
+            out["closed"] = {
+                "C2": found[0],
+                "h": found[1],
+                "orbit": 0,
+                "N": float(best),
+                "p": best.numerator,
+                "q": best.denominator,
+            }
     dist = np.full(n0.shape, -1.0)
     ok = np.isfinite(n0)
     fracs = np.array(sorted({p / q for q in range(1, 5) for p in range(-8 * q, 8 * q + 1)}))
     dist[ok] = np.min(np.abs(n0[ok][:, None] - fracs[None, :]), axis=1)
     row, col = (int(x) for x in np.unravel_index(int(np.argmax(dist)), dist.shape))
     if dist[row, col] > 0:
-        out["quasi-periodic"] = {"C2": float(rmap.C2_grid[col]), "h": float(rmap.h_grid[row]),
-                                 "orbit": 0, "N": float(n0[row, col]), "p": None,
-                                 "q": None}  # fmt: skip
+        out["quasi-periodic"] = {
+            "C2": float(rmap.C2_grid[col]),
+            "h": float(rmap.h_grid[row]),
+            "orbit": 0,
+            "N": float(n0[row, col]),
+            "p": None,
+            "q": None,
+        }
     return out

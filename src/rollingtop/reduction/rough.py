@@ -94,8 +94,12 @@ class RoughLevel(LevelSet):
         for name in ("M3", "C1", "C2"):
             object.__setattr__(self, name, 0.0)
         # values read from a state: round-off of |I w| |r| (scale) counts as zero
-        size = max(abs(self.jellett), abs(self.routh) * self.body.R,
-                   abs(float(self.scale)) * (self.body.R + abs(self.body.a3)), 1e-300)  # fmt: skip
+        size = max(
+            abs(self.jellett),
+            abs(self.routh) * self.body.R,
+            abs(float(self.scale)) * (self.body.R + abs(self.body.a3)),
+            1e-300,
+        )
         south, north = (abs(x) <= POLE_LEVEL_TOLERANCE * size for x in self.pole_offsets())
         pole = "both" if south and north else "south" if south else "north" if north else None
         if pole == "both":  # no spin: jellett = routh = 0 exactly (module docstring)
@@ -214,8 +218,9 @@ class RoughLevel(LevelSet):
         s, c, k, w3, w_n, dk, dw3, dw_n = self._parts(theta)
         A = b.R * s * w3 + k * w_n
         dA = b.R * c * w3 + b.R * s * dw3 + dk * w_n + k * dw_n
-        out: _AnalyticResult = (b.I1 * w_n * dw_n + b.I3 * w3 * dw3 + b.m * A * dA
-                                - b.m * b.g * b.a3 * s)  # fmt: skip
+        out: _AnalyticResult = (
+            b.I1 * w_n * dw_n + b.I3 * w3 * dw3 + b.m * A * dA - b.m * b.g * b.a3 * s
+        )
         return out
 
     def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
@@ -240,8 +245,12 @@ class RoughLevel(LevelSet):
 
     def pole_label(self) -> str:
         """The pole level in words, for :meth:`describe`."""
-        return {None: "", "south": " (south pole level)", "north": " (north pole level)",
-                "both": " (no spin: both poles)"}[self.pole]  # fmt: skip
+        return {
+            None: "",
+            "south": " (south pole level)",
+            "north": " (north pole level)",
+            "both": " (no spin: both poles)",
+        }[self.pole]
 
     #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here (``M3 = 0``).
     energy_formula: ClassVar[str] = "h + m g R"

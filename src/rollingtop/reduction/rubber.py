@@ -93,8 +93,9 @@ class RubberLevel(LevelSet):
         for name in ("M3", "C1", "C2"):
             object.__setattr__(self, name, 0.0)
         # the round-off of a value read from a state: |F| <~ |w| sqrt(I3 J) <~ |I w| * O(1)
-        scale = abs(float(self.scale)) * math.sqrt(1.0 + self.body.m * self.body.R**2
-                                                     / min(self.body.I1, self.body.I3))  # fmt: skip
+        scale = abs(float(self.scale)) * math.sqrt(
+            1.0 + self.body.m * self.body.R**2 / min(self.body.I1, self.body.I3)
+        )
         if F == 0.0 or abs(F) <= POLE_TOLERANCE * scale:
             F = 0.0
         object.__setattr__(self, "rubber_spin", F)
@@ -161,8 +162,7 @@ class RubberLevel(LevelSet):
         if self.pole == "both":
             return gravity
         F = np.float64(self.rubber_spin)
-        out: _AnalyticResult = (-(F * F) * np.cos(theta)
-                                / (b.I3 * np.sin(theta) ** 3) + gravity)  # fmt: skip
+        out: _AnalyticResult = -(F * F) * np.cos(theta) / (b.I3 * np.sin(theta) ** 3) + gravity
         return out
 
     def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]

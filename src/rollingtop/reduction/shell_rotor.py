@@ -82,8 +82,9 @@ class ShellRotorLevel(LevelSet):
     model: ClassVar[str] = "shell-rotor"
     near_pole_limits: ClassVar[bool] = False
     #: :attr:`LevelSet.pole_advice`.
-    pole_advice: ClassVar[str] = ("for the pole level set (m + ms) jellett = -k_p (M3 + Js Omega3) "
-                                  "at the pole exactly")  # fmt: skip
+    pole_advice: ClassVar[str] = (
+        "for the pole level set (m + ms) jellett = -k_p (M3 + Js Omega3) at the pole exactly"
+    )
 
     #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
     #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
@@ -98,11 +99,17 @@ class ShellRotorLevel(LevelSet):
         object.__setattr__(self, "C1", 0.0)
         b = self.body
         if not b.has_shell:
-            raise LevelSetError("the shell-rotor reduction needs a shell (shell_mass, "
-                                "shell_inertia > 0)")  # fmt: skip
+            raise LevelSetError(
+                "the shell-rotor reduction needs a shell (shell_mass, shell_inertia > 0)"
+            )
         object.__setattr__(self, "pole", None)
-        size = max(abs(self.jellett) * (b.m + b.shell_mass), abs(self.M3) * b.R,
-                   abs(self.C2), abs(float(self.scale)) * (b.R + abs(b.a3)), 1e-300)  # fmt: skip
+        size = max(
+            abs(self.jellett) * (b.m + b.shell_mass),
+            abs(self.M3) * b.R,
+            abs(self.C2),
+            abs(float(self.scale)) * (b.R + abs(b.a3)),
+            1e-300,
+        )
         south, north = (abs(x) <= POLE_LEVEL_TOLERANCE * size for x in self.pole_offsets())
         pole = "both" if south and north else "south" if south else "north" if north else None
         if pole == "both":
@@ -146,8 +153,10 @@ class ShellRotorLevel(LevelSet):
             over_s = self._w_n_over_s(theta, c, kp, omega3, sqrtN)
             w_n = over_s * s
             # w_n' = num' / (R s D0) - c w_n / s with num' = s G (G below): regular at the pole
-            G = -M * b.R * (self.M3 + Js * omega3) + kp * Js * (
-                0.5 * dN_dc * omega3 + b.R * self.M3 * kp) / N  # fmt: skip
+            G = (
+                -M * b.R * (self.M3 + Js * omega3)
+                + kp * Js * (0.5 * dN_dc * omega3 + b.R * self.M3 * kp) / N
+            )
             dw_n = G / (b.R * D0) - c * over_s
             return s, c, kp, omega3, w_n, dkp, domega3, dw_n
         num = M * self.jellett + kp * (self.M3 + Js * omega3)
@@ -184,8 +193,11 @@ class ShellRotorLevel(LevelSet):
         t0 = 2 * math.sqrt(kappa) * sqrtN0 / (D * (1 + x0))
         # (t - t0) / sigma: sqrt N (1 + x0) - sqrt N0 (1 + x) = -(sqrtN0 - sqrtN)(1 + x0)
         # + sqrtN0 (x0 - x), x0 - x = 4 kappa sigma / D
-        dt = (2 * math.sqrt(kappa) / D) * (-2 * dsqrt * (1 + x0) + sqrtN0 * 4 * kappa / D) / (
-            (1 + x) * (1 + x0))  # fmt: skip
+        dt = (
+            (2 * math.sqrt(kappa) / D)
+            * (-2 * dsqrt * (1 + x0) + sqrtN0 * 4 * kappa / D)
+            / ((1 + x) * (1 + x0))
+        )
         z = dt / (1 + t * t0)  # arctan(sigma z) = arctan t - arctan t0
         with np.errstate(all="ignore"):
             ratio = np.arctan(sigma * z) / sigma
@@ -207,8 +219,9 @@ class ShellRotorLevel(LevelSet):
             N, phi = pair_weight(b, c)
             omega3 = (self.C2 - b.R * self.M3 * float(phi)) / math.sqrt(float(N))
             kp = (b.m + b.shell_mass) * b.R * c + b.m * b.a3
-            out.append((b.m + b.shell_mass) * self.jellett
-                       + kp * (self.M3 + b.shell_inertia * omega3))  # fmt: skip
+            out.append(
+                (b.m + b.shell_mass) * self.jellett + kp * (self.M3 + b.shell_inertia * omega3)
+            )
         return out[0], out[1]
 
     def mirrored(self) -> ShellRotorLevel:
@@ -218,8 +231,12 @@ class ShellRotorLevel(LevelSet):
         ``k_p / sqrt(N)``)."""
         body = replace(self.body, a3=-self.body.a3)
         shift = float(pair_weight(body, 0.0)[1]) - float(pair_weight(self.body, 0.0)[1])
-        return ShellRotorLevel(body=body, M3=-self.M3, C2=-self.C2 - self.body.R * self.M3 * shift,
-                               jellett=self.jellett)  # fmt: skip
+        return ShellRotorLevel(
+            body=body,
+            M3=-self.M3,
+            C2=-self.C2 - self.body.R * self.M3 * shift,
+            jellett=self.jellett,
+        )
 
     def omega3(self, theta: Real) -> Real:
         """The shell's spin about the axis, ``Omega3 = (C2 - R M3 Phi) / sqrt(N)``."""
@@ -250,9 +267,12 @@ class ShellRotorLevel(LevelSet):
         M = b.m + b.shell_mass
         s, c, kp, omega3, w_n, _, _, _ = self._parts(theta)
         A = b.I1 + b.shell_inertia + M * b.R**2 * c * c + 2 * b.m * b.R * b.a3 * c + b.m * b.a3**2
-        U: Real = (0.5 * A * w_n * w_n + b.R * s * kp * w_n * omega3
-                   + 0.5 * (b.shell_inertia + M * b.R**2 * s * s) * omega3 * omega3
-                   + b.m * b.g * b.a3 * c)  # fmt: skip
+        U: Real = (
+            0.5 * A * w_n * w_n
+            + b.R * s * kp * w_n * omega3
+            + 0.5 * (b.shell_inertia + M * b.R**2 * s * s) * omega3 * omega3
+            + b.m * b.g * b.a3 * c
+        )
         return U
 
     def dU(self, theta: _Analytic) -> _AnalyticResult:  # type: ignore[override]
@@ -264,9 +284,15 @@ class ShellRotorLevel(LevelSet):
         dA = -s * (2 * M * b.R**2 * c + 2 * b.m * b.R * b.a3)
         B, dB = b.R * s * kp, b.R * (c * kp + s * dkp)
         W, dW = b.shell_inertia + M * b.R**2 * s * s, 2 * M * b.R**2 * s * c
-        out: _AnalyticResult = (0.5 * dA * wn * wn + A * wn * dwn + dB * wn * om
-                                + B * (dwn * om + wn * dom) + 0.5 * dW * om * om + W * om * dom
-                                - b.m * b.g * b.a3 * s)  # fmt: skip
+        out: _AnalyticResult = (
+            0.5 * dA * wn * wn
+            + A * wn * dwn
+            + dB * wn * om
+            + B * (dwn * om + wn * dom)
+            + 0.5 * dW * om * om
+            + W * om * dom
+            - b.m * b.g * b.a3 * s
+        )
         return out
 
     def rho(self, theta: Real) -> Real:
@@ -280,12 +306,16 @@ class ShellRotorLevel(LevelSet):
         finite at the pole (:meth:`_w_n_over_s`)."""
         if self.pole == "north":  # w_n kept, s the mirror's
             mirror = self.mirrored()
-            return mirror.psi_dot(np.pi - np.asarray(theta)) if np.ndim(theta) else float(
-                mirror.psi_dot(math.pi - theta))  # fmt: skip
+            return (
+                mirror.psi_dot(np.pi - np.asarray(theta))
+                if np.ndim(theta)
+                else float(mirror.psi_dot(math.pi - theta))
+            )
         if self.pole is not None:
             parts = self._parts(theta)
-            over = self._w_n_over_s(theta, parts[1], parts[2], parts[3],
-                                    np.sqrt(pair_weight(self.body, parts[1])[0]))  # fmt: skip
+            over = self._w_n_over_s(
+                theta, parts[1], parts[2], parts[3], np.sqrt(pair_weight(self.body, parts[1])[0])
+            )
             rate: float | FloatArray = -over
             return rate if np.ndim(theta) else float(rate)
         rate = -self._parts(theta)[4] / np.sin(theta)
@@ -297,7 +327,8 @@ class ShellRotorLevel(LevelSet):
         b = self.body
         _, dw = self.flow(theta, w_tau)
         N: Real = (b.m + b.shell_mass) * b.g + b.m * b.a3 * (
-            np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau)  # fmt: skip
+            np.sin(theta) * dw - np.cos(theta) * w_tau * w_tau
+        )
         return N
 
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
@@ -310,8 +341,12 @@ class ShellRotorLevel(LevelSet):
 
     def pole_label(self) -> str:
         """The pole level in words, for :meth:`describe`."""
-        return {None: "", "south": " (south pole level)", "north": " (north pole level)",
-                "both": " (no spin: both poles)"}[self.pole]  # fmt: skip
+        return {
+            None: "",
+            "south": " (south pole level)",
+            "north": " (north pole level)",
+            "both": " (no spin: both poles)",
+        }[self.pole]
 
 
 def shell_rotor_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:

@@ -66,8 +66,10 @@ class SmoothLevel(LevelSet):
         if isinstance(p, bool) or not isinstance(p, int | float | np.floating | np.integer):
             raise LevelSetError(f"level p_horizontal = {p!r} must be a number")
         if not (math.isfinite(p) and p >= 0.0):
-            raise LevelSetError(f"level p_horizontal = {p!r} must be finite and >= 0 (the size "
-                                "of the horizontal momentum)")  # fmt: skip
+            raise LevelSetError(
+                f"level p_horizontal = {p!r} must be finite and >= 0 (the size "
+                "of the horizontal momentum)"
+            )
         object.__setattr__(self, "p_horizontal", float(p))
         super().__post_init__()
 

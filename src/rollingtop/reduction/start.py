@@ -11,6 +11,7 @@ started on a given level (paper Sec. 3; ``docs/model.md``, "One degree of freedo
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -24,10 +25,23 @@ from rollingtop.reduction.variables import reduced_integrals, state_from_level
 __all__ = ["level_energy", "level_of_state", "reduced_energy", "start_on_level"]
 
 
+def _meridian_default(name: str) -> None:
+    warnings.warn(
+        f"{name}() without model= assumes the meridian model; pass model='meridian' (or "
+        f"another reduced model's name): the default goes in rollingtop 0.3",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
 def level_of_state(body: SphericalTop, y: ArrayLike, model: str | None = None) -> LevelSet:
-    """The level set ``(M3, C1, C2)`` of the state ``y`` (shape (18,)) of the meridian model;
-    with ``model``, that model's own level
-    (:meth:`rollingtop.reduction.models.Reduction.level_of_state`).
+    """The level set of the state ``y`` under ``model``
+    (:meth:`rollingtop.reduction.models.Reduction.level_of_state`); for the meridian model
+    ``(M3, C1, C2)`` with ``y`` of shape (18,).
+
+    .. deprecated:: 0.2
+        Without ``model`` the meridian model is assumed, with a ``DeprecationWarning``; pass
+        the model's name.
 
     The values come from :func:`~rollingtop.reduction.reduced_integrals`; ``|I w|`` of the state
     is the round-off scale of ``M3`` and ``C1`` in the pole decision
@@ -37,21 +51,27 @@ def level_of_state(body: SphericalTop, y: ArrayLike, model: str | None = None) -
         from rollingtop.reduction.models import reduction_of
 
         return reduction_of(model).level_of_state(body, y)
+    _meridian_default("level_of_state")
     y = np.asarray(y, dtype=float)
     ints = reduced_integrals(body, y)
     scale = float(np.linalg.norm(body.inertia * y[W]))
-    return LevelSet(body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]),
-                    scale=scale)  # fmt: skip
+    return LevelSet(body, float(ints["M3"]), float(ints["C1"]), float(ints["C2"]), scale=scale)
 
 
 def reduced_energy(body: SphericalTop, y: ArrayLike, model: str | None = None) -> float:
-    """The reduced energy ``h = E - I3 w3^2/2 - m g R`` of the state ``y`` (shape (18,)) of the
-    meridian model; with ``model``, that model's own ``h``
-    (:meth:`rollingtop.reduction.models.Reduction.reduced_energy`)."""
+    """The reduced energy of the state ``y`` under ``model``
+    (:meth:`rollingtop.reduction.models.Reduction.reduced_energy`); for the meridian model
+    ``h = E - I3 w3^2/2 - m g R``.
+
+    .. deprecated:: 0.2
+        Without ``model`` the meridian model is assumed, with a ``DeprecationWarning``; pass
+        the model's name.
+    """
     if model is not None:
         from rollingtop.reduction.models import reduction_of
 
         return reduction_of(model).reduced_energy(body, y)
+    _meridian_default("reduced_energy")
     return float(reduced_integrals(body, np.asarray(y, dtype=float))["h"])
 
 
@@ -106,6 +126,7 @@ def start_on_level(
         if first.rolls_over or not 0.0 < theta < math.pi:  # no turning point on that branch
             theta = math.pi / 2
         # theta itself: a turning point beside a pole keeps its distance from it (cos rounds)
-        return state_from_level(level, h, math.cos(theta), branch=branch, phi=phi, psi=psi,
-                                theta=theta)  # fmt: skip
+        return state_from_level(
+            level, h, math.cos(theta), branch=branch, phi=phi, psi=psi, theta=theta
+        )
     return state_from_level(level, h, gamma3, branch=branch, phi=phi, psi=psi)

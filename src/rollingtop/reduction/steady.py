@@ -172,10 +172,6 @@ def _critical_points(level: LevelSet, points: int) -> NDArray[np.float64]:
     return found
 
 
-def _scale(level: LevelSet, theta: float) -> float:
-    return max(abs(float(level.U(theta))), abs(float(level.d2U(theta))), 1e-300)
-
-
 #: Real parts below this times the eigenvalues' size count as zero.
 STABLE_TOLERANCE = 1e-6
 

@@ -172,8 +172,12 @@ def states_on_level(level: LevelSet, gamma3: ArrayLike, w_tau: ArrayLike) -> Flo
     # phi = 0: gamma = (0, s, gamma3), tau = (-1, 0, 0), n = (0, -1, 0), nu = (0, -gamma3, s);
     # psi = 0: alpha = nu, beta = -tau (the frames of state_from_level)
     gamma = np.stack([np.zeros_like(s), s, g3], axis=-1)
-    frame = {"tau": np.array([-1.0, 0.0, 0.0]), "n": np.array([0.0, -1.0, 0.0]),
-             "e3": np.array([0.0, 0.0, 1.0]), "gamma": gamma}  # fmt: skip
+    frame = {
+        "tau": np.array([-1.0, 0.0, 0.0]),
+        "n": np.array([0.0, -1.0, 0.0]),
+        "e3": np.array([0.0, 0.0, 1.0]),
+        "gamma": gamma,
+    }
     y[..., 0:3] = level.com_velocity(theta, wt, frame)
     y[..., 3] = -wt
     y[..., 4] = -w_n

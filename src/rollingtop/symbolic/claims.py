@@ -8,7 +8,7 @@ between the full and the reduced equations. It is decided by
    manifold is parametrised *rationally* (``gamma`` by two rational parameters with
    ``s = sqrt(1 - gamma3^2)`` itself rational, the velocity by the constraints' free components)
    and the result cancelled to a normal form -- zero is a proof. The normal form is computed
-   first in sympy's field of rational functions (:func:`_field_value`: each distinct
+   first in sympy's field of rational functions (:func:`._exact._field_value`: each distinct
    subexpression once, reduced by the gcd as it is formed), and where an intermediate result
    grows beyond :data:`FIELD_TERMS_LIMIT` terms by ``cancel(together(...))`` on the substituted
    expression, the faster of the two on the claims where each was measured;
@@ -17,7 +17,7 @@ between the full and the reduced equations. It is decided by
    every one of several independent points establishes it with the certainty of polynomial
    identity testing (a nonzero rational function vanishes on a set of measure zero).
 
-   The evaluation walks the expression as the graph it is (:func:`_rational_value`): a
+   The evaluation walks the expression as the graph it is (:func:`._exact._rational_value`): a
    derived rate has a few hundred distinct subexpressions but, once the manifold's rational
    functions are substituted, a tree of up to 10^6 nodes, which sympy's substitution and
    arithmetic visit one by one (seconds per claim). Each distinct subexpression is evaluated
@@ -32,9 +32,7 @@ Each result says which method decided it.
 from __future__ import annotations
 
 import importlib
-import math
 import random
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
@@ -44,17 +42,21 @@ from typing import Any
 import sympy as sp
 
 from rollingtop.contact import MODELS, get_model
+from rollingtop.symbolic._exact import (
+    _field_value,
+    _free_parts,
+    _NotRational,
+    _random_rational,
+    _rational_value,
+    _TooLarge,
+    _tree_size,
+)
 from rollingtop.symbolic.equations import SYMBOLS, derive
 
 __all__ = ["Claim", "ClaimResult", "claims_for", "decide", "verify"]
 
 #: Above this many operations the exact route is skipped for the random rational points.
 EXACT_OPS_LIMIT = 4000
-#: The field route of the exact simplification gives up above this many terms in a numerator
-#: or denominator (the smooth model's momentum rates reach 610-667 and take 12-15 s there, 5-7 s
-#: by ``cancel``; every other claim stays below 130 and takes at most 0.8 s there, up to 9 s by
-#: ``cancel``: measured on the claims of every model).
-FIELD_TERMS_LIMIT = 160
 #: An expression (before the manifold's substitution) with a tree larger than this goes straight
 #: to the random rational points: its operation count (4000 at most for the exact route) would
 #: cost more than the evaluation itself (every claim's tree above it counts > 20000 operations).
@@ -149,159 +151,6 @@ def _manifold(model: str) -> dict[Any, Any]:
     return subs
 
 
-def _random_rational(rng: random.Random, lo: int = -3, hi: int = 3) -> Any:
-    return sp.Rational(Fraction(rng.randint(lo * 97, hi * 97), rng.randint(1, 97)))
-
-
-class _NotRational(Exception):
-    """A subexpression whose value at a rational point need not be rational."""
-
-
-def _tree_size(expr: Any, limit: int) -> int:
-    """Nodes of ``expr``'s tree, counted up to ``limit + 1``."""
-    n = 0
-    for _ in sp.preorder_traversal(expr):
-        n += 1
-        if n > limit:
-            break
-    return n
-
-
-def _symbols(expr: Any) -> set[Any]:
-    """``expr.free_symbols``, each distinct subexpression visited once (sympy's property walks
-    the tree: seconds for the shell-rotor pair's rates, whose few hundred subexpressions repeat
-    10^6 times)."""
-    seen: set[int] = set()
-    out: set[Any] = set()
-    stack = [expr]
-    while stack:
-        e = stack.pop()
-        if id(e) in seen:
-            continue
-        seen.add(id(e))
-        if e.is_Symbol:
-            out.add(e)
-        else:
-            stack.extend(e.args)
-    return out
-
-
-def _free_parts(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...],
-                subs: dict[Any, Any]) -> tuple[Any, dict[Any, Any], list[Any]]:  # fmt: skip
-    """``expr`` sympified, the manifold's substitutions it needs, and the symbols left free once
-    they, the parameters' and ``I2 = I1`` (if ``symmetric``) are made, sorted by name."""
-    expr = sp.sympify(expr)
-    present = _symbols(expr)
-    subs = {x: image for x, image in subs.items() if x in present}
-    replaced = set(subs) | {a for a, _ in params} | ({S.I2} if symmetric else set())
-    base = set(present)
-    for image in (*subs.values(), *(sp.sympify(b) for _, b in params)):
-        base |= _symbols(image)
-    return expr, subs, sorted(base - replaced, key=lambda x: x.name)
-
-
-class _TooLarge(Exception):
-    """An intermediate rational function beyond :data:`FIELD_TERMS_LIMIT` terms."""
-
-
-def _field_value(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...],
-                 subs: dict[Any, Any]) -> Any:  # fmt: skip
-    """``expr`` on the manifold as an element of sympy's sparse field of rational functions
-    (:func:`sympy.polys.fields.field` over QQ): the substitutions of :func:`_on_manifold` made
-    on the field's values, each distinct subexpression once. Zero is the zero element, so the
-    claim is decided exactly. Raises :class:`_NotRational` for a node outside the field and
-    :class:`_TooLarge` (module docstring)."""
-    from sympy.polys.fields import field
-
-    expr, subs, symbols = _free_parts(expr, symmetric, params, subs)
-    if not symbols:
-        return sp.cancel(expr)
-    K, *gens = field(symbols, sp.QQ)
-    values: dict[Any, Any] = dict(zip(symbols, gens, strict=True))
-
-    def value_of(e: Any) -> Any:
-        memo: dict[Any, Any] = {}
-
-        def value(e: Any) -> Any:
-            found = memo.get(e)
-            if found is not None:
-                return found
-            if e.is_Symbol:
-                out = values[e]
-            elif e.is_Rational:
-                out = K(sp.QQ(int(e.p), int(e.q)))
-            elif e.is_Add or e.is_Mul:
-                out = value(e.args[0])
-                for a in e.args[1:]:
-                    out = out + value(a) if e.is_Add else out * value(a)
-            elif e.is_Pow and e.exp.is_Integer:
-                out = value(e.base) ** int(e.exp)
-            else:
-                raise _NotRational(str(e))
-            if len(out.numer) > FIELD_TERMS_LIMIT or len(out.denom) > FIELD_TERMS_LIMIT:
-                raise _TooLarge
-            memo[e] = out
-            return out
-
-        return value(sp.sympify(e))
-
-    if symmetric and S.I1 in values:
-        values[S.I2] = values[S.I1]
-    for a, b in params:
-        values[a] = value_of(b)
-    values.update({x: value_of(image) for x, image in subs.items()})
-    depth = sys.getrecursionlimit()
-    sys.setrecursionlimit(max(depth, 20000))
-    try:
-        return value_of(expr)
-    finally:
-        sys.setrecursionlimit(depth)
-
-
-def _rational_value(expr: Any, values: dict[Any, Fraction]) -> Fraction:
-    """``expr`` at the point ``values`` (symbol -> Fraction), exactly, each distinct subexpression
-    once (module docstring). Raises :class:`_NotRational` for a node other than a symbol, a
-    rational number, a sum, a product or an integer power (a root that is not exact), and
-    ``ZeroDivisionError`` at a pole of the rational function."""
-    memo: dict[Any, Fraction] = {}
-
-    def value(e: Any) -> Fraction:
-        found = memo.get(e)
-        if found is not None:
-            return found
-        if e.is_Symbol:
-            out = values[e]
-        elif e.is_Rational:
-            out = Fraction(int(e.p), int(e.q))
-        elif e.is_Add:
-            out = sum((value(a) for a in e.args), Fraction(0))
-        elif e.is_Mul:
-            out = Fraction(1)
-            for a in e.args:
-                out *= value(a)
-        elif e.is_Pow and e.exp.is_Integer:
-            out = value(e.base) ** int(e.exp)
-        elif e.is_Pow and e.exp == sp.S.Half:  # exact only for squares of rationals
-            base = value(e.base)
-            if base < 0:
-                raise _NotRational(str(e))
-            num, den = math.isqrt(base.numerator), math.isqrt(base.denominator)
-            if num * num != base.numerator or den * den != base.denominator:
-                raise _NotRational(str(e))
-            out = Fraction(num, den)
-        else:
-            raise _NotRational(str(e))
-        memo[e] = out
-        return out
-
-    depth = sys.getrecursionlimit()
-    sys.setrecursionlimit(max(depth, 20000))  # a deep sum of products recurses once per level
-    try:
-        return value(expr)
-    finally:
-        sys.setrecursionlimit(depth)
-
-
 def _draw(rng: random.Random, x: Any) -> Any:
     """A random rational for the symbol ``x``: ``q, k`` in (0, 1), masses and inertias
     positive, anything else in [-3, 3]."""
@@ -312,8 +161,13 @@ def _draw(rng: random.Random, x: Any) -> Any:
     return _random_rational(rng)
 
 
-def _on_manifold(expr: Any, model: str, symmetric: bool, params: tuple[tuple[Any, Any], ...],
-                 subs: dict[Any, Any]) -> Any:  # fmt: skip
+def _on_manifold(
+    expr: Any,
+    model: str,
+    symmetric: bool,
+    params: tuple[tuple[Any, Any], ...],
+    subs: dict[Any, Any],
+) -> Any:
     """``expr`` with the manifold's substitutions, then the parameters', then ``I2 = I1``."""
     on = sp.sympify(expr).xreplace(subs)
     if params:  # after the manifold, whose velocities involve the parameters
@@ -323,8 +177,13 @@ def _on_manifold(expr: Any, model: str, symmetric: bool, params: tuple[tuple[Any
     return on
 
 
-def _evaluate_fast(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ...],
-                   subs: dict[Any, Any], rng: random.Random) -> tuple[bool, str]:  # fmt: skip
+def _evaluate_fast(
+    expr: Any,
+    symmetric: bool,
+    params: tuple[tuple[Any, Any], ...],
+    subs: dict[Any, Any],
+    rng: random.Random,
+) -> tuple[bool, str]:
     """The random rational points by :func:`_rational_value`: the same substitutions as
     :func:`_on_manifold`, in the same order, made on the point's values instead of the
     expression (raises :class:`_NotRational` where a value need not be rational)."""
@@ -346,8 +205,9 @@ def _evaluate_fast(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ..
         except ZeroDivisionError:
             continue
         if val != 0:
-            return False, (f"exact evaluation: nonzero ({float(val):.6g}) at a random rational "
-                           "point")  # fmt: skip
+            return False, (
+                f"exact evaluation: nonzero ({float(val):.6g}) at a random rational point"
+            )
         done += 1
         if done == N_POINTS:
             return True, f"exact evaluation at {N_POINTS} random rational points"
@@ -355,9 +215,12 @@ def _evaluate_fast(expr: Any, symmetric: bool, params: tuple[tuple[Any, Any], ..
 
 
 def decide(
-    expr: Any, model: str, symmetric: bool = True, seed: int = 1,
+    expr: Any,
+    model: str,
+    symmetric: bool = True,
+    seed: int = 1,
     params: tuple[tuple[Any, Any], ...] = (),
-) -> tuple[bool, str]:  # fmt: skip
+) -> tuple[bool, str]:
     """Does ``expr`` (a function of the state, ``s``, ``theta`` and the parameters) vanish on
     the manifold of ``model`` (with the parameter values ``params``, if any)? Returns
     ``(holds, method)``."""
@@ -433,9 +296,17 @@ def _reduced_claims() -> dict[str, tuple[Any, Any]]:
         "gamma3": (g3, s * w_tau),
         "v_tau": (v_tau, w_tau * w_n * k_ / s),
         "w_n": (w_n, w_tau * (M3 / S.I1 + g3 * w_n / s)),
-        "w_tau": (w_tau, -(S.m * S.a3 * s * (S.g + S.R * w_tau**2) + M3 * w_n
-                          + S.I1 * g3 * w_n**2 / s + S.m * v_tau * w_n * k_ / s) / rho),
-    }  # fmt: skip
+        "w_tau": (
+            w_tau,
+            -(
+                S.m * S.a3 * s * (S.g + S.R * w_tau**2)
+                + M3 * w_n
+                + S.I1 * g3 * w_n**2 / s
+                + S.m * v_tau * w_n * k_ / s
+            )
+            / rho,
+        ),
+    }
     return rhs
 
 
@@ -481,11 +352,20 @@ def claims_for(model: str) -> list[Claim]:
     # the integrals the model claims (those with a square root through their square)
     names = [n + "^2" if n in SQUARED else n for n in get_model(model).integrals_symmetric]
     for name in names:
-        label = (f"{name[:-2]} integral conserved (its square)" if name.endswith("^2")
-                 else f"{name} integral conserved")  # fmt: skip
+        label = (
+            f"{name[:-2]} integral conserved (its square)"
+            if name.endswith("^2")
+            else f"{name} integral conserved"
+        )
         out.append(Claim(label, model, F[name]))
-    out.append(Claim("energy integral conserved, general body (I1 != I2)", model, F["energy"],
-                     symmetric=False))  # fmt: skip
+    out.append(
+        Claim(
+            "energy integral conserved, general body (I1 != I2)",
+            model,
+            F["energy"],
+            symmetric=False,
+        )
+    )
     # the classical integrals the model loses: shown to vary (a nonzero rate)
     for name in LOST_CANDIDATES:
         if name not in get_model(model).integrals_symmetric:
@@ -500,8 +380,14 @@ def claims_for(model: str) -> list[Claim]:
             )
         )
         for var, (expr, rhs) in _reduced_claims().items():
-            out.append(Claim(f"reduced system (3.3): {var}' follows from the full equations",
-                             model, (expr, rhs), "reduced"))  # fmt: skip
+            out.append(
+                Claim(
+                    f"reduced system (3.3): {var}' follows from the full equations",
+                    model,
+                    (expr, rhs),
+                    "reduced",
+                )
+            )
     out.extend(_model_claims(model))
     return out
 
@@ -519,8 +405,13 @@ def check(claim: Claim, seed: int = 1) -> ClaimResult:
         expr = claim.expr
     holds, method = decide(expr, claim.model, claim.symmetric, seed=seed, params=claim.params)
     proved = holds == claim.vanishes
-    return ClaimResult(claim.name, claim.model, "proved" if proved else "failed", method,
-                       time.perf_counter() - start)  # fmt: skip
+    return ClaimResult(
+        claim.name,
+        claim.model,
+        "proved" if proved else "failed",
+        method,
+        time.perf_counter() - start,
+    )
 
 
 def verify(
@@ -558,7 +449,13 @@ def verify(
         if measure:
             start = time.perf_counter()
             holds, method = invariant_measure_claim()
-            decided(ClaimResult("invariant measure rho(gamma3) of the reduced system", model,
-                                "proved" if holds else "failed", method,
-                                time.perf_counter() - start))  # fmt: skip
+            decided(
+                ClaimResult(
+                    "invariant measure rho(gamma3) of the reduced system",
+                    model,
+                    "proved" if holds else "failed",
+                    method,
+                    time.perf_counter() - start,
+                )
+            )
     return results

@@ -116,7 +116,9 @@ def discover_linear_integrals() -> LinearIntegrals:
                 break
         if not progress:
             raise RuntimeError("the coefficient conditions are not triangular")
-    result = {name: sp.simplify(known.get(f, sp.Integer(0)))
-              for name, f in zip("ABCD", unknowns, strict=True)}  # fmt: skip
+    result = {
+        name: sp.simplify(known.get(f, sp.Integer(0)))
+        for name, f in zip("ABCD", unknowns, strict=True)
+    }
     integral = result["A"] * vt + result["B"] * wn + result["C"] * wt + result["D"] * w3
     return LinearIntegrals(x, result, tuple(constants), conditions, integral)

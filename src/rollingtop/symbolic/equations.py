@@ -74,8 +74,9 @@ def _make_symbols() -> Symbols:
     def vec(name: str) -> Any:
         return sp.Matrix(sp.symbols(f"{name}1:4", real=True))
 
-    return Symbols(R, m, g, a3_, I1, I2, I3, vec("v"), vec("w"), vec("gamma"), vec("alpha"),
-                   vec("beta"))  # fmt: skip
+    return Symbols(
+        R, m, g, a3_, I1, I2, I3, vec("v"), vec("w"), vec("gamma"), vec("alpha"), vec("beta")
+    )
 
 
 SYMBOLS = _make_symbols()
@@ -127,13 +128,18 @@ def derive(model: str, symmetric: bool = True) -> Derivation:
     dLdw = sp.Matrix([sp.diff(L, x) for x in S.w])
     dLdg = sp.Matrix([sp.diff(L, x) for x in S.gamma])
     M = sp.Matrix(6, 6, lambda i, j: sp.diff(L, u[i], u[j]))
-    F = sp.Matrix.vstack(_cross(dLdv, S.w), _cross(dLdw, S.w) + _cross(dLdv, S.v)
-                         + _cross(dLdg, S.gamma))  # fmt: skip
+    F = sp.Matrix.vstack(
+        _cross(dLdv, S.w), _cross(dLdw, S.w) + _cross(dLdv, S.v) + _cross(dLdg, S.gamma)
+    )
     gdot = _cross(S.gamma, S.w)
     cons = constraints(model)
     J = sp.Matrix([[sp.diff(c, x) for x in u] for c in cons])
-    b = sp.Matrix([sum(sp.diff(J[k, :].dot(sp.Matrix(u)), S.gamma[i]) * gdot[i]
-                       for i in range(3)) for k in range(len(cons))])  # fmt: skip
+    b = sp.Matrix(
+        [
+            sum(sp.diff(J[k, :].dot(sp.Matrix(u)), S.gamma[i]) * gdot[i] for i in range(3))
+            for k in range(len(cons))
+        ]
+    )
     Minv = sp.diag(*[1 / M[i, i] for i in range(6)])
     A = J * Minv * J.T
     rhs = -b - J * Minv * F

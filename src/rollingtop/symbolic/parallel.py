@@ -82,12 +82,18 @@ def reduced_system(s: Any = s_sym, g3: Any = G) -> dict[Any, Any]:
     return {
         G: s * WT,
         WT: (-I1 * g3 * WN**2 / s - I3 * W3 * WN + m * a3**2 * g3 * s * WT**2 - m * g * a3 * s) / K,
-        WN: (-I3 * m * k * VN * WN / s + I3 * (I3 + m * R * (R + a3 * g3)) * W3 * WT
-             + (I1 * I3 * g3 + m * R * s**2 * (I1 * R * g3 - I3 * k)) * WN * WT / s) / D,
-        W3: -R * m * (I1 * VN * WN + I1 * (R + a3 * g3) * WN * WT
-                      + s * (I3 * k - I1 * R * g3) * W3 * WT) / D,
+        WN: (
+            -I3 * m * k * VN * WN / s
+            + I3 * (I3 + m * R * (R + a3 * g3)) * W3 * WT
+            + (I1 * I3 * g3 + m * R * s**2 * (I1 * R * g3 - I3 * k)) * WN * WT / s
+        )
+        / D,
+        W3: -R
+        * m
+        * (I1 * VN * WN + I1 * (R + a3 * g3) * WN * WT + s * (I3 * k - I1 * R * g3) * W3 * WT)
+        / D,
         VN: WN * (k * WN + R * s * W3) / s,
-    }  # fmt: skip
+    }
 
 
 def _reduced_of_state() -> dict[Any, Any]:
@@ -282,21 +288,40 @@ def claims() -> list[Claim]:
     field = reduced_system()
     of_state = _reduced_of_state()
     for x, rhs in field.items():
-        out.append(Claim(f"reduced system: {x}' follows from the full equations", "parallel",
-                         (of_state[x], _in_state(rhs)), "reduced"))  # fmt: skip
-    out.append(Claim("slip along nu conserved when a3 = 0, I3 = I1", "parallel",
-                     _in_state(SLIP_NU), params=((S.a3, 0), (S.I3, S.I1))))  # fmt: skip
+        out.append(
+            Claim(
+                f"reduced system: {x}' follows from the full equations",
+                "parallel",
+                (of_state[x], _in_state(rhs)),
+                "reduced",
+            )
+        )
+    out.append(
+        Claim(
+            "slip along nu conserved when a3 = 0, I3 = I1",
+            "parallel",
+            _in_state(SLIP_NU),
+            params=((S.a3, 0), (S.I3, S.I1)),
+        )
+    )
     q = sp.Symbol("q", positive=True)
     limit = {S.I3: 0}
     _, K, _ = _shorthands(s_sym, G)
     density = s_sym * K
     limit_field = {x: f.xreplace(limit) for x, f in field.items()}
     div = _rational(sp.together(_divergence(limit_field, density)), q)
-    out.append(Claim("limit I3 -> 0: div(s K field) = 0 (invariant measure)",
-                     "parallel", div, "identity"))  # fmt: skip
+    out.append(
+        Claim("limit I3 -> 0: div(s K field) = 0 (invariant measure)", "parallel", div, "identity")
+    )
     h0 = _h0()
     dh0 = sum(sp.diff(h0, x) * f for x, f in limit_field.items())
     dh0 += sp.diff(h0, s_sym) * (-G * WT)  # s' = -gamma3 w_tau
-    out.append(Claim("limit I3 -> 0: h0 = K w_tau^2/2 + I1 w_n^2/2 + m g a3 gamma3 conserved",
-                     "parallel", _rational(dh0, q), "identity"))  # fmt: skip
+    out.append(
+        Claim(
+            "limit I3 -> 0: h0 = K w_tau^2/2 + I1 w_n^2/2 + m g a3 gamma3 conserved",
+            "parallel",
+            _rational(dh0, q),
+            "identity",
+        )
+    )
     return out

@@ -48,9 +48,13 @@ def claims() -> list[Claim]:
     g3_dot = g1 * w[1] - g2 * w[0]  # (gamma x w)_3
     A = ode_coefficient(g3).xreplace({1 - g3**2: s_sym**2})
     out = [
-        Claim("linear ODE: Omega' = A(gamma3) gamma3' Omega follows from the full equations",
-              "rubber", (omega, A * g3_dot * omega), "reduced"),
-    ]  # fmt: skip
+        Claim(
+            "linear ODE: Omega' = A(gamma3) gamma3' Omega follows from the full equations",
+            "rubber",
+            (omega, A * g3_dot * omega),
+            "reduced",
+        ),
+    ]
     x = sp.Symbol("x", real=True)
     f = sp.sqrt(1 - x**2) * sp.sqrt(_J(x))
     residual = sp.cancel(sp.together(sp.diff(f, x) / f + ode_coefficient(x)))
@@ -62,6 +66,12 @@ def claims() -> list[Claim]:
     w_tau = (-g2 * w[0] + g1 * w[1]) / s_sym
     rho = S.I1 + S.m * (S.a3**2 + S.R**2 + 2 * S.a3 * S.R * g3)
     split = T - rho * w_tau**2 / 2 - _J(g3) * omega**2 / 2
-    out.append(Claim("kinetic energy = rho w_tau^2/2 + J Omega^2/2 (the potential U)", "rubber",
-                     split, "identity"))  # fmt: skip
+    out.append(
+        Claim(
+            "kinetic energy = rho w_tau^2/2 + J Omega^2/2 (the potential U)",
+            "rubber",
+            split,
+            "identity",
+        )
+    )
     return out

@@ -86,8 +86,7 @@ def section_one(
     no_targets = np.zeros(0)
     no_work = np.zeros((1, 8))
     # the event code read from the array: the literal W_TAU would compile a second start
-    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew,
-                                ws)  # fmt: skip
+    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew, ws)
     wanted = ev_t.shape[0]
     last_events, last_steps = 0, 0
     while True:
@@ -95,9 +94,30 @@ def section_one(
             status = dop.INTERRUPTED
             break
         budget = min(STOP_POLL_STEPS // 10, max_steps - counts[dop.STEPS])
-        status = run(code, p, y, f, ctrl, counts, track, t_eval, out, ev_spec, ev_t, ev_y,
-                         budget, K, ynew, ytmp, y_old, Fd, ws, no_codes, no_targets,
-                         no_work)  # fmt: skip
+        status = run(
+            code,
+            p,
+            y,
+            f,
+            ctrl,
+            counts,
+            track,
+            t_eval,
+            out,
+            ev_spec,
+            ev_t,
+            ev_y,
+            budget,
+            K,
+            ynew,
+            ytmp,
+            y_old,
+            Fd,
+            ws,
+            no_codes,
+            no_targets,
+            no_work,
+        )
         if counts[dop.N_EVENTS] >= wanted:
             status = dop.FINISHED
             break
@@ -138,8 +158,20 @@ def section_batch(
         if read_flag(stop) != 0:
             stats[k, 0] = dop.INTERRUPTED
         else:
-            section_one(codes[k], p, Y0[k], t_max, rtol, atol, max_steps, max_gap, ev_t[k],
-                        ev_y[k], stats[k], stop)  # fmt: skip
+            section_one(
+                codes[k],
+                p,
+                Y0[k],
+                t_max,
+                rtol,
+                atol,
+                max_steps,
+                max_gap,
+                ev_t[k],
+                ev_y[k],
+                stats[k],
+                stop,
+            )
 
 
 @compiled(nogil=True)
@@ -165,5 +197,17 @@ def indicator_batch(
         if read_flag(stop) != 0:
             stats[k, 0] = dop.INTERRUPTED
         else:
-            run_indicators(codes[k], p, Y0[k], D0[k], t_samples, rtol, atol, max_steps, out[k],
-                           states, stats[k], s_stop)  # fmt: skip
+            run_indicators(
+                codes[k],
+                p,
+                Y0[k],
+                D0[k],
+                t_samples,
+                rtol,
+                atol,
+                max_steps,
+                out[k],
+                states,
+                stats[k],
+                s_stop,
+            )

@@ -100,9 +100,15 @@ _GOLDEN = 0.3819660112501051
 
 @kernel
 def normal_at(
-    code: int, p: FloatArray, Fd: FloatArray, y: FloatArray, x: float, ytmp: FloatArray,
-    dy: FloatArray, ws: Workspace,
-) -> tuple[float, float]:  # fmt: skip
+    code: int,
+    p: FloatArray,
+    Fd: FloatArray,
+    y: FloatArray,
+    x: float,
+    ytmp: FloatArray,
+    dy: FloatArray,
+    ws: Workspace,
+) -> tuple[float, float]:
     """The contact force ``(N, |F_t|)`` at the fraction ``x`` of the step, on the dense output
     (projected onto the constraints, as the samples are)."""
     dense_eval(Fd, y, x, ytmp)
@@ -113,9 +119,17 @@ def normal_at(
 
 @kernel
 def dip_minimum(
-    code: int, p: FloatArray, Fd: FloatArray, y: FloatArray, t: float, h: float,
-    ytmp: FloatArray, dy: FloatArray, ws: Workspace, found: FloatArray,
-) -> int:  # fmt: skip
+    code: int,
+    p: FloatArray,
+    Fd: FloatArray,
+    y: FloatArray,
+    t: float,
+    h: float,
+    ytmp: FloatArray,
+    dy: FloatArray,
+    ws: Workspace,
+    found: FloatArray,
+) -> int:
     """The normal force's minimum inside the step ``[t, t + h]`` on the dense output: sampled at
     :data:`DIP_SAMPLES` - 1 interior points, the best one refined by golden sections. Writes
     ``found = (t_min, N_min, t_lost)`` (``t_lost``: where the force first turns negative, by
@@ -242,10 +256,21 @@ def event_turn(
 
 @kernel
 def _record_event(
-    ev_code: int, code: int, p: FloatArray, Fd: FloatArray, y: FloatArray, t: float, h: float,
-    lo: float, hi: float, counts: IntArray, ev_t: FloatArray, ev_y: FloatArray,
-    ytmp: FloatArray, ws: Workspace,
-) -> None:  # fmt: skip
+    ev_code: int,
+    code: int,
+    p: FloatArray,
+    Fd: FloatArray,
+    y: FloatArray,
+    t: float,
+    h: float,
+    lo: float,
+    hi: float,
+    counts: IntArray,
+    ev_t: FloatArray,
+    ev_y: FloatArray,
+    ytmp: FloatArray,
+    ws: Workspace,
+) -> None:
     """Locate the zero in ``[lo, hi]`` of the step and record its time and projected state
     (only counted once the capacity is full)."""
     m = counts[N_EVENTS]
@@ -259,11 +284,24 @@ def _record_event(
 
 @kernel
 def step_events(
-    code: int, p: FloatArray, K: FloatArray, Fd: FloatArray, y: FloatArray, ynew: FloatArray,
-    t: float, h: float, y_acc: FloatArray, ctrl: FloatArray, counts: IntArray,
-    ev_spec: IntArray, ev_t: FloatArray, ev_y: FloatArray, ytmp: FloatArray, ws: Workspace,
+    code: int,
+    p: FloatArray,
+    K: FloatArray,
+    Fd: FloatArray,
+    y: FloatArray,
+    ynew: FloatArray,
+    t: float,
+    h: float,
+    y_acc: FloatArray,
+    ctrl: FloatArray,
+    counts: IntArray,
+    ev_spec: IntArray,
+    ev_t: FloatArray,
+    ev_y: FloatArray,
+    ytmp: FloatArray,
+    ws: Workspace,
     dense_ready: bool,
-) -> bool:  # fmt: skip
+) -> bool:
     """The zeros of the event function inside the accepted step ``[t, t + h]`` from ``y``
     (``y_acc``: the accepted, projected new state), in the direction asked, recorded in time
     order. A sign change between the ends is one zero. Ends of one sign hide two zeros where
@@ -286,8 +324,9 @@ def step_events(
                 counts[NFEV] += 3
                 dense_ready = True
             _record_event(ev_code, code, p, Fd, y, t, h, 0.0, 1.0, counts, ev_t, ev_y, ytmp, ws)
-    elif g_old != 0.0 and dip_predicted(ctrl[EV_PREV_T], sign * ctrl[EV_PREV_G], t,
-                                        sign * g_old, t + h, sign * g_new):  # fmt: skip
+    elif g_old != 0.0 and dip_predicted(
+        ctrl[EV_PREV_T], sign * ctrl[EV_PREV_G], t, sign * g_old, t + h, sign * g_new
+    ):
         if not dense_ready:
             prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
             counts[NFEV] += 3
@@ -296,11 +335,9 @@ def step_events(
         dense_eval(Fd, y, x, ytmp)
         if sign * event_value(ev_code, code, ytmp) < 0.0:  # two zeros: away, then back
             if direction == 0 or (direction > 0) == (sign < 0.0):
-                _record_event(ev_code, code, p, Fd, y, t, h, 0.0, x, counts, ev_t, ev_y, ytmp,
-                              ws)  # fmt: skip
+                _record_event(ev_code, code, p, Fd, y, t, h, 0.0, x, counts, ev_t, ev_y, ytmp, ws)
             if direction == 0 or (direction > 0) == (sign > 0.0):
-                _record_event(ev_code, code, p, Fd, y, t, h, x, 1.0, counts, ev_t, ev_y, ytmp,
-                              ws)  # fmt: skip
+                _record_event(ev_code, code, p, Fd, y, t, h, x, 1.0, counts, ev_t, ev_y, ytmp, ws)
     ctrl[EV_PREV_T], ctrl[EV_PREV_G] = t, g_old
     ctrl[G_OLD] = g_new
     return dense_ready

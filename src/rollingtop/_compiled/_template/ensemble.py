@@ -68,16 +68,38 @@ def batch(
         p = P[k]
         code = codes[k]
         # the event code read from the array: a literal 0 would compile a second start
-        ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out[k], ytmp,
-                                    ynew, ws)  # fmt: skip
+        ctrl, counts, track = start(
+            code, p, y, f, t_eval, rtol, atol, ev_spec[0], out[k], ytmp, ynew, ws
+        )
         while True:
             if read_flag(stop) != 0:
                 status = dop.INTERRUPTED
                 break
             budget = min(STOP_POLL_STEPS, max_steps - counts[dop.STEPS])
-            status = run(code, p, y, f, ctrl, counts, track, t_eval, out[k], ev_spec, ev_t, ev_y,
-                         budget, K, ynew, ytmp, y_old, Fd, ws, no_codes, no_targets,
-                         no_work)  # fmt: skip
+            status = run(
+                code,
+                p,
+                y,
+                f,
+                ctrl,
+                counts,
+                track,
+                t_eval,
+                out[k],
+                ev_spec,
+                ev_t,
+                ev_y,
+                budget,
+                K,
+                ynew,
+                ytmp,
+                y_old,
+                Fd,
+                ws,
+                no_codes,
+                no_targets,
+                no_work,
+            )
             if status != dop.BUDGET_EXHAUSTED or counts[dop.STEPS] >= max_steps:
                 break
         for i in range(n):

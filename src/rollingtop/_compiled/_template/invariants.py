@@ -302,17 +302,20 @@ def project_integrals(
                 for k in range(18):
                     src[k] = y[k]
                 if _tilt(trial, src, 0.0) and _tilt(trial, src, TILT_STEP):
-                    up = _tilted_energy(code, p, trial, src, TILT_STEP, ic, icodes, targets, pw,
-                                        ws, minv)  # fmt: skip
-                    down = _tilted_energy(code, p, trial, src, -TILT_STEP, ic, icodes, targets,
-                                          pw, ws, minv)  # fmt: skip
+                    up = _tilted_energy(
+                        code, p, trial, src, TILT_STEP, ic, icodes, targets, pw, ws, minv
+                    )
+                    down = _tilted_energy(
+                        code, p, trial, src, -TILT_STEP, ic, icodes, targets, pw, ws, minv
+                    )
                     slope = (up - down) / (2.0 * TILT_STEP)
                     if slope != 0.0 and math.isfinite(slope):
                         phi = -res / slope
                         # taken only if it brings the energy nearer (a small slope near a
                         # centre of U would jump the attitude the wrong way)
-                        after = _tilted_energy(code, p, trial, src, phi, ic, icodes, targets, pw,
-                                               ws, minv)  # fmt: skip
+                        after = _tilted_energy(
+                            code, p, trial, src, phi, ic, icodes, targets, pw, ws, minv
+                        )
                         if abs(after - targets[i]) < abs(res):
                             tilt = abs(phi)
                 # pw's rows were used by the trials: the rows of y again

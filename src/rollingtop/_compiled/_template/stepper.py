@@ -372,8 +372,7 @@ def run(
                 counts[MONITOR_EVALS] += 3
                 dense_ready = True
             found = K[14]  # stages 14-16 are free once the dense output is built
-            counts[MONITOR_EVALS] += dip_minimum(code, p, Fd, y_old, t, h, ytmp, K[13], ws,
-                                                 found)  # fmt: skip
+            counts[MONITOR_EVALS] += dip_minimum(code, p, Fd, y_old, t, h, ytmp, K[13], ws, found)
             if not math.isnan(found[2]) and math.isnan(track[T_CONTACT_LOST]):
                 track[T_CONTACT_LOST] = found[2]
             update_track(track, found[0], found[1], 0.0)
@@ -383,8 +382,25 @@ def run(
         track[LAST_NORMAL] = N
         update_track(track, t_new, N, T_force)
         if EVENTS and ev_spec[EV_CODE] != 0:
-            dense_ready = step_events(code, p, K, Fd, y_old, ynew, t, h, y, ctrl, counts,
-                                      ev_spec, ev_t, ev_y, ytmp, ws, dense_ready)  # fmt: skip
+            dense_ready = step_events(
+                code,
+                p,
+                K,
+                Fd,
+                y_old,
+                ynew,
+                t,
+                h,
+                y,
+                ctrl,
+                counts,
+                ev_spec,
+                ev_t,
+                ev_y,
+                ytmp,
+                ws,
+                dense_ready,
+            )
         t = t_new
         counts[STEPS] += 1
         taken += 1

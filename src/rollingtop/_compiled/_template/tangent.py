@@ -86,9 +86,14 @@ def aug_rhs(
 
 @kernel
 def project_tangent(
-    code: int, p: FloatArray, y: FloatArray, d: FloatArray, y1: FloatArray, y2: FloatArray,
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    d: FloatArray,
+    y1: FloatArray,
+    y2: FloatArray,
     ws: Workspace,
-) -> None:  # fmt: skip
+) -> None:
     """``d`` in place onto the tangent space of the constraint manifold at ``y`` (on it): the
     central difference of :func:`project` along ``d``; ``y1, y2`` are scratch."""
     e = fd_scale(y, d)
@@ -200,8 +205,11 @@ def advance(
                 e3 += err3[i] * err3[i]
             err = 0.0 if (e5 == 0.0 and e3 == 0.0) else h * e5 / math.sqrt((e5 + 0.01 * e3) * N_ERR)
             if err < 1.0:
-                factor = dop.MAX_FACTOR if err == 0.0 else min(
-                    dop.MAX_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT)  # fmt: skip
+                factor = (
+                    dop.MAX_FACTOR
+                    if err == 0.0
+                    else min(dop.MAX_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT)
+                )
                 if rejected > 0:
                     factor = min(1.0, factor)
                 # from the step taken, which a sample time may have shortened: scaling the
@@ -209,8 +217,11 @@ def advance(
                 # rejection then could not bring it below the distance to the sample
                 h_abs = h * factor
                 break
-            h_abs = h * (dop.MIN_FACTOR if not math.isfinite(err) else max(
-                dop.MIN_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT))  # fmt: skip
+            h_abs = h * (
+                dop.MIN_FACTOR
+                if not math.isfinite(err)
+                else max(dop.MIN_FACTOR, dop.SAFETY * err**dop.ERROR_EXPONENT)
+            )
             counts[REJECTED] += 1
             rejected += 1
             if rejected >= dop.MAX_REJECTED_IN_A_ROW:
@@ -278,9 +289,19 @@ def start_indicators(
     ctrl[LOG_SUM] = 0.0
     aug_rhs(code, p, z, fz, scratch[2], scratch[0], scratch[1], ws)
     # the initial step of the plain integrator, from the motion alone
-    ctrl[H_ABS] = initial_step(code, p, z[0:N_STATE].copy(), fz[0:N_STATE].copy(), t_end, 0.0,
-                               ctrl[RTOL], ctrl[ATOL], znew[0:N_STATE], ztmp[0:N_STATE],
-                               ws)  # fmt: skip
+    ctrl[H_ABS] = initial_step(
+        code,
+        p,
+        z[0:N_STATE].copy(),
+        fz[0:N_STATE].copy(),
+        t_end,
+        0.0,
+        ctrl[RTOL],
+        ctrl[ATOL],
+        znew[0:N_STATE],
+        ztmp[0:N_STATE],
+        ws,
+    )
 
 
 @compiled()
@@ -312,8 +333,22 @@ def indicators_chunk(
     status = dop.FINISHED
     k = k0
     while k < t_samples.shape[0]:
-        status = advance(code, p, z, fz, ctrl, counts, t_samples[k], K, znew, ztmp, scratch, ws,
-                         s_stop, step_limit)  # fmt: skip
+        status = advance(
+            code,
+            p,
+            z,
+            fz,
+            ctrl,
+            counts,
+            t_samples[k],
+            K,
+            znew,
+            ztmp,
+            scratch,
+            ws,
+            s_stop,
+            step_limit,
+        )
         if status != dop.FINISHED:
             break
         t = ctrl[T]
@@ -378,5 +413,6 @@ def run_indicators(
         for j in range(3):
             out[k, j] = np.nan
     start_indicators(code, p, y0, d0, t_samples[-1], z, fz, ctrl)
-    indicators_chunk(code, p, z, fz, ctrl, counts, t_samples, 0, max_steps, out, states, stats,
-                     s_stop)  # fmt: skip
+    indicators_chunk(
+        code, p, z, fz, ctrl, counts, t_samples, 0, max_steps, out, states, stats, s_stop
+    )

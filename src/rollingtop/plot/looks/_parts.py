@@ -61,16 +61,24 @@ def floor_tiles(
     y1 = np.clip((gy + 1) * tile, *y).ravel()
     z = np.zeros_like(x0)
     quads = np.stack(
-        [np.stack([x0, y0, z], 1), np.stack([x1, y0, z], 1), np.stack([x1, y1, z], 1),
-         np.stack([x0, y1, z], 1)], 1)  # fmt: skip
+        [
+            np.stack([x0, y0, z], 1),
+            np.stack([x1, y0, z], 1),
+            np.stack([x1, y1, z], 1),
+            np.stack([x0, y1, z], 1),
+        ],
+        1,
+    )
     return quads, ((gx + gy) % 2).ravel().astype(int)
 
 
 def shadow(centre: FloatArray, radius: float, n: int = 32) -> FloatArray:
     """A disk on the plane under ``centre`` (the light from straight above): one polygon."""
     u = 2 * np.pi * np.arange(n) / n
-    return np.stack([centre[0] + radius * np.cos(u), centre[1] + radius * np.sin(u),
-                     np.full(n, 1e-3 * radius)], 1)[None]  # fmt: skip
+    return np.stack(
+        [centre[0] + radius * np.cos(u), centre[1] + radius * np.sin(u), np.full(n, 1e-3 * radius)],
+        1,
+    )[None]
 
 
 class Stage:
@@ -84,8 +92,9 @@ class Stage:
         ax.computed_zorder = False
         self.ax, self.R = ax, R
         self.floor = Poly3DCollection(np.zeros((0, 4, 3)), linewidths=0.0, zorder=0)
-        self.shade = Poly3DCollection(shadow(np.zeros(3), 0.8 * R), facecolor=(0, 0, 0, 0.18),
-                                      linewidths=0.0, zorder=0.5)  # fmt: skip
+        self.shade = Poly3DCollection(
+            shadow(np.zeros(3), 0.8 * R), facecolor=(0, 0, 0, 0.18), linewidths=0.0, zorder=0.5
+        )
         ax.add_collection3d(self.floor, autolim=False)
         ax.add_collection3d(self.shade, autolim=False)
         self.colours = np.array([to_rgba("#eef1f4"), to_rgba("#d9dee4")])

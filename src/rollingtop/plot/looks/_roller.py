@@ -77,8 +77,11 @@ def draw_rollers(
         facing = layout.centre @ q.T @ mesh.eye  # rollers on the far side are behind the hub
         shown = np.flatnonzero(facing > -0.45)
         barrels = roller_quads(
-            RollerLayout(layout.centre[shown], layout.axis[shown], layout.radius[shown],
-                         layout.half_angle), angle[i, shown])  # fmt: skip
+            RollerLayout(
+                layout.centre[shown], layout.axis[shown], layout.radius[shown], layout.half_angle
+            ),
+            angle[i, shown],
+        )
         colours = np.where(stripes[None, :, None] == 1, rgba(STRIPE, 1), rgba(ROLLER, 1))
         colours = np.broadcast_to(colours, (len(shown), stripes.size, 4)).copy()
         colours[shown == contact[i]] = np.where(

@@ -66,11 +66,13 @@ def draw_skates(
     def draw(i: int) -> None:
         colours = base.copy()
         colours[(disk == contact[i]) & (part == 2)] = rgba(CONTACT, 1)[0]
-        mesh.update([
-            Faces(place(quads, geom, i), colours, gloss=0.6, shininess=50),
-            Faces(place(north.quads, geom, i), north.colours),
-            Faces(place(south.quads, geom, i), south.colours),
-        ])  # fmt: skip
+        mesh.update(
+            [
+                Faces(place(quads, geom, i), colours, gloss=0.6, shininess=50),
+                Faces(place(north.quads, geom, i), north.colours),
+                Faces(place(south.quads, geom, i), south.colours),
+            ]
+        )
 
     return draw
 
