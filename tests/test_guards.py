@@ -227,7 +227,9 @@ def test_ctrl_c_to_the_atlas_process_group_is_one_line(tmp_path):
     assert status == 130 and lines == [
         "rollingtop: error: interrupted by SIGINT; no output was written"
     ], lines
-    assert took < 5.0
+    # promptness is test_no_silent_answers' (STOP_S, one worker); here the whole group's
+    # lines: a bound against a hang only (5.2 s under pytest-xdist with the suite beside it)
+    assert took < 30.0
     assert not (tmp_path / "a.nc").exists()
 
 

@@ -535,3 +535,22 @@ def test_a_long_path_keeps_the_reason_in_the_message(tmp_path, length):
         check_output_path(path, (".nc", ".csv"))
     assert "unknown output format '.xlsx' (use .nc or .csv)" in one_line(str(info.value))
     assert short_repr("a'b\n" * 40)[-1] in "'\""  # escapes still inside the quotes
+
+
+@pytest.mark.parametrize("length", [40, 79, 80, 81, 200])
+def test_a_long_path_keeps_its_file_name_in_the_message(length):
+    """A long path is cut at its start: the file's name stays ('missing/sec.nc' was cut to
+    'missi…' under pytest-xdist's longer temporary folders)."""
+    from rollingtop._errors import QUOTE_CHARS, short_path
+    from rollingtop.cli._errors import one_line
+    from rollingtop.io import OutputError, check_output_path
+
+    path = "/" + "p" * (length - len("/missing/sec.nc")) + "/missing/sec.nc"
+    quoted = short_path(path)
+    assert len(quoted) <= QUOTE_CHARS and quoted[0] == quoted[-1] == "'"
+    assert quoted.endswith("/missing/sec.nc'") and (quoted == repr(path)) == (len(path) < 78)
+    with pytest.raises(OutputError) as info:
+        check_output_path(path, (".nc", ".csv"))
+    line = one_line(str(info.value))
+    assert "sec.nc" in line and "does not exist" in line, line
+    assert short_path("a'b\n" * 40)[0] in "'\""  # escapes still inside the quotes

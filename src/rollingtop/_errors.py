@@ -54,6 +54,18 @@ class ContactLostWarning(UserWarning):
 QUOTE_CHARS = 80
 
 
+def short_path(path: object, limit: int = QUOTE_CHARS) -> str:
+    """A path quoted for an error message, cut at its start where it is long (``'…/out/a.nc'``):
+    its end names the file."""
+    text = str(path)
+    if len(repr(text)) <= limit:
+        return repr(text)
+    cut = limit - 3
+    while cut > 0 and len(repr("…" + text[-cut:])) > limit:  # escapes take more room
+        cut -= 1
+    return repr("…" + text[-cut:])
+
+
 def short_repr(value: object, limit: int = QUOTE_CHARS) -> str:
     """``repr(value)`` cut to ``limit`` characters (with an ellipsis), for error messages."""
     if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 4 * limit:

@@ -28,7 +28,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, TypeAlias
 
-from rollingtop._errors import OutputError, short_repr
+from rollingtop._errors import OutputError, short_path, short_repr
 
 if TYPE_CHECKING:
     from _typeshed import ReadableBuffer
@@ -123,18 +123,18 @@ def check_output_path(path: PathArg, suffixes: Iterable[str]) -> Path:
     if path.suffix.lower() not in suffixes:
         given = short_repr(path.suffix) if path.suffix else repr("(none)")
         raise OutputError(
-            f"cannot write {short_repr(str(path))}: unknown output format {given} "
+            f"cannot write {short_path(path)}: unknown output format {given} "
             f"(use {' or '.join(suffixes)})"
         )
     parent = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
-        raise OutputError(f"cannot write {short_repr(str(path))}: it is a folder")
+        raise OutputError(f"cannot write {short_path(path)}: it is a folder")
     if not parent.is_dir():
         raise OutputError(
-            f"cannot write {short_repr(str(path))}: folder {short_repr(str(parent))} does not exist"
+            f"cannot write {short_path(path)}: folder {short_path(parent)} does not exist"
         )
     if not os.access(parent, os.W_OK | os.X_OK) or (path.exists() and not os.access(path, os.W_OK)):
-        raise OutputError(f"cannot write {short_repr(str(path))}: permission denied")
+        raise OutputError(f"cannot write {short_path(path)}: permission denied")
     return path
 
 
