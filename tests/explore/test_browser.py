@@ -10,13 +10,18 @@ import sys
 import time
 
 import numpy as np
+import pytest
 
 from rollingtop.explore.server import TIMED_CHANGE_JS
 
 from ..conftest import EXAMPLES
 from ..test_cli import run_cli
 
-#: A change that has not redrawn the page within this is a hang (the redraw takes about 0.1 s;
+#: Under pytest-xdist (``--dist loadgroup``, the README's command) these tests share one worker,
+#: and so one served page and one browser (the module's fixtures), instead of one per worker.
+pytestmark = pytest.mark.xdist_group("browser")
+
+#: A change that has not redrawn the page within this is a hang (a redraw takes a few tenths of a s;
 #: benchmarks/explore_page.py measures it -- speed is never asserted as a time in a test).
 HANG_S = 10.0
 
