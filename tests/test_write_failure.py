@@ -220,7 +220,10 @@ def test_newer_outputs_under_a_file_size_limit(tmp_path, case):
                           text=True, check=False,
                           preexec_fn=_limit(ZARR_LIMIT if case == "atlas-zarr" else 16 << 10),
                           timeout=300)  # fmt: skip
-    lines = [x for x in proc.stderr.strip().splitlines() if "compiling" not in x]
+    # a kernel not yet in the cache is compiled, and under the limit not saved (one notice
+    # each: which tests ran before, on which pytest-xdist worker, decides; not this test's)
+    lines = [x for x in proc.stderr.strip().splitlines()
+             if "compiling" not in x and "not saved to numba's cache" not in x]  # fmt: skip
     assert proc.returncode == 1 and "Traceback" not in proc.stderr, proc.stderr
     assert len(lines) == 1 and os.strerror(errno.EFBIG) in lines[0], proc.stderr
     if name is not None:

@@ -61,9 +61,9 @@ def short_path(path: object, limit: int = QUOTE_CHARS) -> str:
     if len(repr(text)) <= limit:
         return repr(text)
     cut = limit - 3
-    while cut > 0 and len(repr("…" + text[-cut:])) > limit:  # escapes take more room
+    while cut > 1 and len(repr("…" + text[len(text) - cut :])) > limit:  # escapes: more room
         cut -= 1
-    return repr("…" + text[-cut:])
+    return repr("…" + text[len(text) - cut :])
 
 
 def short_repr(value: object, limit: int = QUOTE_CHARS) -> str:
