@@ -4,8 +4,9 @@ change and the click-to-start trajectory; and the server's memory over many sess
 Run:  python benchmarks/explore_page.py [--changes 16] [--clicks 5] [--sessions 100] [--write]
 
 ``rollingtop explore examples/fig5.toml`` in a child process, Debian's chromium (headless,
-pytest-playwright's library) on it. A change of ``C2`` across the fold (-1 and -2: the count of
-steady motions goes 1, 3, 1, ...) is timed in the page, from the input's change event to the
+pytest-playwright's library) on it. A change of ``C2`` across the fold (-1 and -2, each 0.001
+lower than the last, so that the server has no view of it cached: the count of steady motions
+goes 1, 3, 1, ...) is timed in the page, from the input's change event to the
 updated readout (``rollingtop.explore.server.TIMED_CHANGE_JS``); a click on the phase portrait
 is timed from the click to the trajectory's summary. Medians and ranges are printed; with
 ``--write`` they go into ``benchmarks/results.json`` (``explore``) and into the block between
@@ -59,9 +60,13 @@ def measure(changes: int, clicks: int) -> dict[str, Any]:
             page.goto(url)
             page.get_by_text("steady motions: 3").first.wait_for(timeout=60_000)
             redraw = []
-            for k in range(changes):
-                value, want = ("-1.0", "steady motions: 1") if k % 2 == 0 else (
-                    "-2.0", "steady motions: 3")  # fmt: skip
+            for k in range(changes):  # a new C2 each time: no view the server has cached
+                lo, hi = -1.0 - 0.001 * k, -2.0 - 0.001 * k
+                value, want = (
+                    (repr(lo), "steady motions: 1")
+                    if k % 2 == 0
+                    else (repr(hi), "steady motions: 3")
+                )
                 ms = page.evaluate(TIMED_CHANGE_JS, [C2_INPUT, value, want, 10_000])
                 if ms < 0:
                     raise SystemExit(f"change {k}: no redraw within 10 s")

@@ -266,3 +266,27 @@ def test_a_closed_page_is_freed(fig5):
     refs = [open_and_close() for _ in range(3)]
     gc.collect()
     assert [r() for r in refs] == [None, None, None]
+
+
+def test_views_are_cached_on_the_state(fig5):
+    """Issue 37, item 5: the page's views are kept per state for the whole server. Equal states
+    (the level's keys in another order) hash alike and get the same view; it is the uncached
+    computation's, with read-only arrays (a cached view is shared by every session)."""
+    from dataclasses import replace
+
+    from rollingtop.explore.view import cached_diagram_view, cached_level_view, diagram_view
+
+    other = replace(fig5, level=dict(reversed(list(fig5.level.items()))))
+    assert list(other.level) != list(fig5.level)
+    assert other == fig5 and hash(other) == hash(fig5)
+    assert hash(replace(fig5, h=fig5.h + 0.1)) != hash(fig5)
+    lv, dv = cached_level_view(fig5), cached_diagram_view(fig5)
+    assert cached_level_view(other) is lv and cached_diagram_view(other) is dv
+    fresh = level_view(fig5)
+    assert lv.readout == fresh.readout and lv.steady == fresh.steady
+    np.testing.assert_array_equal(lv.U_y, fresh.U_y)
+    np.testing.assert_array_equal(dv.centres[1], diagram_view(fig5).centres[1])
+    with pytest.raises(ValueError, match="read-only"):
+        lv.U_y[0] = 0.0
+    with pytest.raises(ValueError, match="read-only"):
+        dv.centres[0][0] = 0.0

@@ -29,7 +29,13 @@ from rollingtop.explore._plots import Plots
 from rollingtop.explore._work import Latest
 from rollingtop.explore.path import PATH_SAMPLES, PATH_T_END, path_view
 from rollingtop.explore.section import section_view
-from rollingtop.explore.view import BODY_KEYS, ExploreState, diagram_view, level_view, parse_query
+from rollingtop.explore.view import (
+    BODY_KEYS,
+    ExploreState,
+    cached_diagram_view,
+    cached_level_view,
+    parse_query,
+)
 
 __all__ = ["ExplorePage", "LOOKS"]
 
@@ -93,7 +99,7 @@ class ExplorePage:
         self.plots.diagram.on_event(Tap, self._on_diagram_tap)
         self._build_widgets()
         self.level_work = Latest(self.on_document, self._compute_level, self._apply_level)
-        self.diagram_work = Latest(self.on_document, diagram_view, self._apply_diagram)
+        self.diagram_work = Latest(self.on_document, cached_diagram_view, self._apply_diagram)
         self.path_work = Latest(self.on_document, self._compute_path, self._apply_path)
         self.frame_work = Latest(self.on_document, self._compute_frame, self._apply_frame)
         if query is None and self.location is not None:
@@ -314,7 +320,7 @@ class ExplorePage:
     # ---- work and its results ------------------------------------------------------------
     def _compute_level(self, state: ExploreState) -> Any:
         if state.reduces:
-            return level_view(state)
+            return cached_level_view(state)
         return section_view(state)
 
     def _apply_level(self, state: ExploreState, view: Any) -> None:

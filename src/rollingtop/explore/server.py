@@ -21,7 +21,7 @@ from typing import Any
 
 from rollingtop._errors import Interrupted, ScenarioError
 from rollingtop.explore.path import path_view
-from rollingtop.explore.view import ExploreState, level_view
+from rollingtop.explore.view import ExploreState, cached_level_view
 
 __all__ = ["CHROMIUM_FLAGS", "LOOPBACK", "TIMED_CHANGE_JS", "serve", "spawn", "warm_up"]
 
@@ -76,7 +76,7 @@ def warm_up(base: ExploreState) -> None:
     with the command line's notice)."""
     if not base.reduces:
         return  # a section compiles on the page's first request (its kernel's notice then)
-    view = level_view(base)
+    view = cached_level_view(base)
     x = view.steady[0][0] if view.steady else float(view.U_x[len(view.U_x) // 2])
     try:
         path_view(base, x, 0.0, t_end=0.1)

@@ -8,6 +8,7 @@ see the same numbers as the command line (``rollingtop equilibria``, ``portrait`
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -33,6 +34,8 @@ __all__ = [
     "parse_query",
     "level_view",
     "diagram_view",
+    "cached_level_view",
+    "cached_diagram_view",
 ]
 
 #: The body's parameters on the page (sliders), in order.
@@ -74,6 +77,12 @@ class ExploreState:
         w, _ = admissible_omega(self.model, gamma, omega)
         y: FloatArray = initial_state(self.body, self.model, gamma=gamma, omega=w)
         return y
+
+    def __hash__(self) -> int:
+        """Equal views hash alike (the level's order does not matter, as in ``==``): the page
+        caches its views on the state (:func:`cached_level_view`)."""
+        level = tuple(sorted(self.level.items()))
+        return hash((self.model, self.body, level, self.h, self.start, self.own))
 
     @property
     def reduces(self) -> bool:
@@ -385,3 +394,31 @@ def _padded(lim: tuple[float, float]) -> tuple[float, float]:
     """``lim`` widened by 5 % on each side (by 1 if it is a point)."""
     pad = 0.05 * (lim[1] - lim[0]) or 1.0
     return lim[0] - pad, lim[1] + pad
+
+
+#: Views kept per server (every session of one scenario opens on the same state, and a slider
+#: moved back returns to one): about 100 KB each.
+VIEW_CACHE_SIZE = 64
+
+
+def _frozen(view: Any) -> Any:
+    """``view`` with its arrays read-only: a cached view is shared by every session."""
+    for value in vars(view).values():
+        for a in value if isinstance(value, tuple) else (value,):
+            if isinstance(a, np.ndarray):
+                a.flags.writeable = False
+    return view
+
+
+@functools.lru_cache(maxsize=VIEW_CACHE_SIZE)
+def cached_level_view(state: ExploreState) -> LevelView:
+    """:func:`level_view`, computed once per state for the whole server (its arrays
+    read-only)."""
+    return _frozen(level_view(state))  # type: ignore[no-any-return]
+
+
+@functools.lru_cache(maxsize=VIEW_CACHE_SIZE)
+def cached_diagram_view(state: ExploreState) -> DiagramView:
+    """:func:`diagram_view`, computed once per state for the whole server (its arrays
+    read-only)."""
+    return _frozen(diagram_view(state))  # type: ignore[no-any-return]
