@@ -117,3 +117,20 @@ def machine() -> dict:
         "scipy": scipy.__version__,
         "numba": numba.__version__,
     }
+
+
+def replace_between(text: str, start: str, end: str, block: str, where: object) -> str:
+    """``text`` with what lies between its marker lines ``start`` and ``end`` replaced by
+    ``block`` (``SystemExit`` naming ``where`` when a marker is missing)."""
+    head, sep, rest = text.partition(start)
+    _, sep2, tail = rest.partition(end)
+    if not sep or not sep2:
+        raise SystemExit(f"{where}: markers {start!r} ... {end!r} not found")
+    return f"{head}{start}\n{block}\n{end}{tail}"
+
+
+def write_atomically(path: Path, text: str) -> None:
+    """``path``'s new text, renamed into place (a reader never sees half a file)."""
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)

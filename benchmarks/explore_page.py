@@ -33,6 +33,9 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import replace_between, write_atomically  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results.json"
 PAGE = ROOT / "docs" / "guide" / "explore.md"
@@ -159,17 +162,8 @@ def write(res: dict[str, Any]) -> None:
     results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     results["explore"] = res
     # its date is its own (results["dates"] dates the performance page's parts)
-    tmp = RESULTS.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(results, indent=2))
-    os.replace(tmp, RESULTS)
-    text = PAGE.read_text()
-    head, sep, rest = text.partition(START)
-    _, sep2, tail = rest.partition(END)
-    if not sep or not sep2:
-        raise SystemExit(f"{PAGE}: the explore-latency markers are missing")
-    tmp = PAGE.with_suffix(".md.tmp")
-    tmp.write_text(f"{head}{START}\n{block(res)}\n{END}{tail}")
-    os.replace(tmp, PAGE)
+    write_atomically(RESULTS, json.dumps(results, indent=2))
+    write_atomically(PAGE, replace_between(PAGE.read_text(), START, END, block(res), PAGE))
 
 
 def main() -> None:

@@ -42,7 +42,15 @@ from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import ROOT, compiled_rhs_factory, machine, median_time, numpy_rhs_factory  # noqa: E402
+from _common import (  # noqa: E402
+    ROOT,
+    compiled_rhs_factory,
+    machine,
+    median_time,
+    numpy_rhs_factory,
+    replace_between,
+    write_atomically,
+)
 
 
 def w1(t_end, repeat, numpy_repeat):
@@ -393,19 +401,12 @@ def docs_block(res) -> str:
 
 def replace_block(text: str, block: str, where: object = DOCS_PAGE) -> str:
     """``text`` with the lines between its benchmark markers replaced by ``block``."""
-    head, sep, rest = text.partition(DOCS_START)
-    _, sep2, tail = rest.partition(DOCS_END)
-    if not sep or not sep2:
-        raise SystemExit(f"{where}: benchmark markers not found")
-    return f"{head}{DOCS_START}\n{block}\n{DOCS_END}{tail}"
+    return replace_between(text, DOCS_START, DOCS_END, block, where)
 
 
 def write_docs(res, path: Path = DOCS_PAGE) -> None:
     """Replace the block between the page's markers with the new results (atomically)."""
-    text = replace_block(path.read_text(), docs_block(res), path)
-    tmp = path.with_suffix(".md.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    write_atomically(path, replace_block(path.read_text(), docs_block(res), path))
 
 
 README = ROOT / "README.md"
@@ -461,13 +462,8 @@ def readme_block(res) -> str:
 
 def write_readme(res, path: Path = README) -> None:
     """Replace the README's performance block with the new results (atomically)."""
-    head, sep, rest = path.read_text().partition(README_START)
-    _, sep2, tail = rest.partition(README_END)
-    if not sep or not sep2:
-        raise SystemExit(f"{path}: performance markers not found")
-    tmp = path.with_suffix(".md.tmp")
-    tmp.write_text(f"{head}{README_START}\n{readme_block(res)}\n{README_END}{tail}")
-    os.replace(tmp, path)
+    text = replace_between(path.read_text(), README_START, README_END, readme_block(res), path)
+    write_atomically(path, text)
 
 
 def run_scaling(quick: bool) -> dict:
