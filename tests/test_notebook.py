@@ -15,6 +15,11 @@ from rollingtop.reduction import orbits, steady_motions
 from .conftest import EXAMPLES, ROOT
 from .html_view import num, read
 
+#: One pytest-xdist worker runs this module
+#: (the tour is executed once, by a module fixture;
+#: split over two workers, the fixture would run on each).
+pytestmark = pytest.mark.xdist_group("notebook")
+
 # the test extra's nbclient runs the tour on ipykernel's kernel
 nbclient = pytest.importorskip("nbclient", reason="needs the test extra: nbclient, ipykernel")
 pytest.importorskip("ipykernel", reason="needs the test extra: nbclient, ipykernel")

@@ -23,6 +23,11 @@ from ..conftest import FREE, GAMMA0, OMEGA0, PAPER_BODY
 from ..dynamics import reference
 from ..reduction import plain
 
+#: One pytest-xdist worker runs this module
+#: (its module fixtures compute sections once;
+#: split over two workers, the fixture would run on each).
+pytestmark = pytest.mark.xdist_group("section")
+
 PAPER = SphericalTop(**PAPER_BODY)
 #: |w_tau| at a located (and polished) crossing.
 W_TAU_TOL = 1e-11

@@ -16,6 +16,11 @@ from rollingtop.symbolic import parallel as P
 from rollingtop.symbolic.claims import Claim, s_sym
 from rollingtop.symbolic.equations import SYMBOLS as S
 
+#: One pytest-xdist worker runs this module
+#: (its module fixture derives the equations once;
+#: split over two workers, the fixture would run on each).
+pytestmark = pytest.mark.xdist_group("parallel-cases")
+
 SLIP_ATOL = 1e-8  # slip along nu over t = 100 at rtol 1e-11, through the pole passages
 #: Outside the case the slip varies by far more than the tolerance that holds it in the case
 #: (over t = 20: 1.07 with a3 = 0.1; 3.7e-3 with I3 = 0.3 != I1, where it drifts slowly).
