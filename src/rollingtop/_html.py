@@ -5,12 +5,43 @@ object puts its own rows together, so this module knows none of rollingtop's typ
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from html import escape
 from numbers import Integral, Real
 from typing import Any, NamedTuple
 
-__all__ = ["Num", "block", "count", "number", "row_table", "table", "trajectory_html"]
+__all__ = [
+    "Num",
+    "block",
+    "count",
+    "html_view",
+    "number",
+    "register_view",
+    "row_table",
+    "table",
+    "trajectory_html",
+]
+
+#: The HTML view of each type that has one registered (:func:`register_view`).
+_VIEWS: dict[type, Callable[[Any], str]] = {}
+
+
+def register_view(cls: type, view: Callable[[Any], str]) -> None:
+    """Make ``view(obj)`` the HTML view (:func:`html_view`) of ``cls`` and its subclasses.
+
+    The module that composes a type's view registers it (``rollingtop.reduction._display``,
+    imported by ``rollingtop.reduction``), so the type's own module, whose ``_repr_html_``
+    calls :func:`html_view`, never imports the module that reads it: no import cycle."""
+    _VIEWS[cls] = view
+
+
+def html_view(obj: object) -> str:
+    """The registered HTML view of ``obj``'s type, or of its nearest base that has one."""
+    for cls in type(obj).__mro__:
+        if cls in _VIEWS:
+            return _VIEWS[cls](obj)
+    raise LookupError(f"no HTML view is registered for {type(obj).__name__}")
+
 
 #: Scoped to the ``rollingtop-repr`` block; Jupyter's theme variables where they exist.
 STYLE = (

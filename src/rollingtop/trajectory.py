@@ -14,6 +14,7 @@ import numpy as np
 
 from rollingtop._compiled import for_code
 from rollingtop._errors import RollingTopError
+from rollingtop._figures import TRAJECTORY_KINDS, draw
 from rollingtop._html import trajectory_html
 from rollingtop._jit import call
 from rollingtop._json import finite_or_none
@@ -305,12 +306,13 @@ class Trajectory(NetCDFOutput):
         """Draw the motion on ``ax`` (default: a new figure's) and return ``ax``: ``kind`` is
         ``"path"`` (the paths on the plane of ``rollingtop path``; ``kw``: ``period_map``), or
         ``"gamma3"``, ``"drift"`` (the first integrals' relative drift), ``"reactions"``: the
-        panels of ``rollingtop plot`` (:data:`rollingtop.plot.paths.PANELS`)."""
-        from rollingtop.plot.paths import PANELS
-
-        if kind not in PANELS:
-            raise RollingTopError(f"kind = {kind!r}: one of {', '.join(map(repr, PANELS))}")
-        return PANELS[kind](ax, self, **kw)
+        panels of ``rollingtop plot`` (:data:`rollingtop.plot.paths.PANELS`, named in
+        :data:`rollingtop._figures.TRAJECTORY_KINDS`)."""
+        if kind not in TRAJECTORY_KINDS:
+            known = ", ".join(map(repr, TRAJECTORY_KINDS))
+            raise RollingTopError(f"kind = {kind!r}: one of {known}")
+        axes: Axes = draw(kind, ax, self, **kw)
+        return axes
 
     # ---- export -----------------------------------------------------------------------------
     def _attrs(self) -> dict[str, str | float]:

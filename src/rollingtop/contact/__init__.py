@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 
 from rollingtop._errors import ContactModelError
 from rollingtop.contact import meridian, parallel, rough, rubber, shell_rotor, smooth
-from rollingtop.contact._base import ContactModel, Kernel
+from rollingtop.contact._base import ContactModel, Kernel, register_kernels
 
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
@@ -104,3 +104,6 @@ def kernels_of(model: ContactModel) -> tuple[Kernel, ...]:
 def kernel_by_code(code: int) -> Kernel:
     """The kernel with compiled selector ``code``."""
     return KERNELS[code]
+
+
+register_kernels({model.name: kernels_of(model) for model in MODELS.values()})

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 import numpy as np
 
+from rollingtop._errors import ContactModelError
 from rollingtop._types import ComplexArray, FloatArray
 
 if TYPE_CHECKING:
@@ -60,6 +61,17 @@ class Kernel:
     variant: str | None
     code: int
     carries_direction: bool = False
+
+
+#: The kernels of each registered model by its name, its own first, then its variants in
+#: declaration order: set by the registry (:mod:`rollingtop.contact`, which imports this module)
+#: as it numbers the kernels, read by :attr:`ContactModel.kernels`.
+_KERNELS_OF: dict[str, tuple[Kernel, ...]] = {}
+
+
+def register_kernels(kernels: Mapping[str, tuple[Kernel, ...]]) -> None:
+    """Record each model's kernels (the registry's numbering, :data:`_KERNELS_OF`)."""
+    _KERNELS_OF.update(kernels)
 
 
 @dataclass(frozen=True)
@@ -278,10 +290,15 @@ class ContactModel:
 
     @property
     def kernels(self) -> tuple[Kernel, ...]:
-        """The model's compiled kernels: its own (first), then one per variant."""
-        from rollingtop.contact import kernels_of
-
-        return kernels_of(self)
+        """The model's compiled kernels: its own (first), then one per variant (numbered by the
+        registry, :mod:`rollingtop.contact`)."""
+        try:
+            return _KERNELS_OF[self.name]
+        except KeyError:
+            raise ContactModelError(
+                f"contact model {self.name!r} is not registered (rollingtop.contact.MODULES), so "
+                "it has no compiled kernels"
+            ) from None
 
     @property
     def code(self) -> int:

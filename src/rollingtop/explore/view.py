@@ -263,15 +263,11 @@ def joined(curves: list[tuple[FloatArray, FloatArray]]) -> tuple[FloatArray, Flo
 
 def orbit_curves(level: Any, h: float) -> list[tuple[FloatArray, FloatArray]]:
     """The closed curves of the orbits of ``(level, h)`` in ``(gamma3, w_tau)``: the portrait's
-    own (``rollingtop.plot.portrait._orbit_curve``); none below ``min U``."""
-    from rollingtop.plot.portrait import _orbit_curve as orbit_curve
-    from rollingtop.reduction import LevelSetError, orbits
+    own (:func:`rollingtop.reduction.curves.level_curves`, 200 points a branch); none below
+    ``min U``."""
+    from rollingtop.reduction.curves import level_curves
 
-    try:
-        comps = orbits(level, h)
-    except LevelSetError:
-        return []
-    return [orbit_curve(level, h, o, n=200) for o in comps if o.kind != "steady"]
+    return level_curves(level, h, n=200)
 
 
 def level_view(state: ExploreState) -> LevelView:
@@ -279,10 +275,10 @@ def level_view(state: ExploreState) -> LevelView:
 
     The steady motions are :func:`rollingtop.reduction.steady_motions` of the level: the count
     ``rollingtop equilibria`` prints. The background orbits are at the portrait's energies
-    (:func:`rollingtop.plot.portrait.default_h_levels`), the current one at ``h``.
+    (:func:`rollingtop.reduction.curves.default_h_levels`), the current one at ``h``.
     """
-    from rollingtop.plot.portrait import default_h_levels
     from rollingtop.reduction import LevelSetError, steady_motions
+    from rollingtop.reduction.curves import default_h_levels
 
     level = state.level_set()
     steady = steady_motions(level)

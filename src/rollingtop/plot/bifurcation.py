@@ -16,6 +16,7 @@ from matplotlib.ticker import MaxNLocator
 
 from rollingtop.plot._axes import axes_for
 from rollingtop.reduction.bifurcation import BifurcationDiagram, SteadyCountMap
+from rollingtop.reduction.curves import level_curves
 from rollingtop.reduction.level import LevelSet
 
 __all__ = ["bifurcation_figure", "draw_bifurcation"]
@@ -24,52 +25,8 @@ CENTRE_COLOUR = "#1f4e9c"
 SADDLE_COLOUR = "#c0392b"
 
 
-#: Points of the first sweep for the orbits of a level, and per orbit on its closed curve.
-SWEEP_POINTS = 4001
-ORBIT_POINTS = 400
 #: Margin around a thumbnail's orbits, as a fraction of their extent along each axis.
 THUMB_MARGIN = 0.08
-
-
-def _orbit_curves(level: LevelSet, h: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Each orbit of ``level`` at energy ``h`` as ``(x, w)``: ``w = |w_tau| >= 0`` from one
-    turning point to the other (found by Brent's method, so ``w`` is 0 at both ends), the nodes
-    dense near them; ``x = gamma3``, or the signed angle ``theta`` on a pole level."""
-    from scipy.optimize import brentq
-
-    if level.pole is None:
-        xs = np.linspace(-1.0, 1.0, SWEEP_POINTS)[1:-1]
-
-        def theta(x: np.ndarray) -> np.ndarray:
-            return LevelSet.theta_of(x)
-    else:  # a pole level: the signed angle, in which orbits pass the pole regularly
-        xs = np.linspace(*level.theta_domain, SWEEP_POINTS)[1:-1]
-
-        def theta(x: np.ndarray) -> np.ndarray:
-            return x
-
-    def gap(x: np.ndarray) -> np.ndarray:
-        with np.errstate(over="ignore", invalid="ignore"):
-            th = theta(np.asarray(x, dtype=float))
-            return np.asarray(2.0 * (h - level.U(th)) / level.rho(th))
-
-    inside = np.nan_to_num(gap(xs), nan=-1.0) >= 0.0
-    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))
-    starts = [0] * bool(inside[0]) + [int(i) + 1 for i in edges if not inside[i]]
-    stops = [int(i) for i in edges if inside[i]] + [len(xs) - 1] * bool(inside[-1])
-
-    def turning(a: float, b: float) -> float:
-        return float(brentq(lambda x: float(gap(x)), a, b, xtol=1e-14))
-
-    curves = []
-    for i0, i1 in zip(starts, stops, strict=True):
-        lo = turning(xs[i0 - 1], xs[i0]) if i0 > 0 else float(xs[i0])
-        hi = turning(xs[i1], xs[i1 + 1]) if i1 < len(xs) - 1 else float(xs[i1])
-        x = lo + (hi - lo) * (1.0 - np.cos(np.linspace(0.0, np.pi, ORBIT_POINTS))) / 2.0
-        w = np.sqrt(np.clip(gap(x), 0.0, None))
-        w[[0, -1]] = [0.0 if i0 > 0 else w[0], 0.0 if i1 < len(xs) - 1 else w[-1]]
-        curves.append((x, w))
-    return curves
 
 
 def _thumbnail(ax: Axes, diagram: BifurcationDiagram, k: int, colour: Any) -> None:
@@ -77,15 +34,15 @@ def _thumbnail(ax: Axes, diagram: BifurcationDiagram, k: int, colour: Any) -> No
     each orbit closed, the axes fitted to the orbits, on the region's colour."""
     region = diagram.regions[k]
     level = LevelSet(diagram.body, diagram.M3, diagram.C1, region.C2)
-    curves = _orbit_curves(level, region.h)
+    curves = level_curves(level, region.h)
     for x, w in curves:
-        ax.plot(np.r_[x, x[::-1]], np.r_[w, -w[::-1]], color=CENTRE_COLOUR, lw=1.3)
+        ax.plot(x, w, color=CENTRE_COLOUR, lw=1.3)
     ax.axhline(0.0, color="0.6", lw=0.5, zorder=0)
     ax.set_facecolor(colour)
     if curves:
-        lo = min(float(x[0]) for x, _ in curves)
-        hi = max(float(x[-1]) for x, _ in curves)
-        top = max(float(np.max(w)) for _, w in curves) or 1.0
+        lo = min(float(np.nanmin(x)) for x, _ in curves)
+        hi = max(float(np.nanmax(x)) for x, _ in curves)
+        top = max(float(np.nanmax(w)) for _, w in curves) or 1.0
         pad = THUMB_MARGIN * max(hi - lo, 1e-9)
         if level.pole is None:
             ax.set_xlim(max(lo - pad, -1.0), min(hi + pad, 1.0))

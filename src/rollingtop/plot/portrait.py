@@ -1,128 +1,37 @@
-"""Phase portraits of the reduced system in the plane ``(gamma3, w_tau)`` (paper Fig. 5).
-
-Each orbit is drawn from its exact parametrisation, not from a contoured grid: between its
-turning points ``theta = c + d sin(phi)`` and ``w_tau = +-sqrt(2 (h - U) / rho)``, so curves close
-exactly at the turning points and the separatrices pass exactly through the saddles. Where the
+"""Phase portraits of the reduced system in the plane ``(gamma3, w_tau)`` (paper Fig. 5), drawn
+from the curves :mod:`rollingtop.reduction.curves` computes: each orbit from its exact
+parametrisation, closed at its turning points, the separatrices through the saddles. Where the
 normal reaction of the plane would be negative (the body would jump: the model does not apply)
 the plane is shaded.
 
-In a pole case (``C1 = +-M3``) orbits pass through the pole, where the paper's ``tau`` and
-``w_tau`` change sign; there the horizontal axis is the signed nutation angle ``theta``
-(``gamma3 = cos theta``, see :mod:`rollingtop.reduction.level`), in which the flow is regular.
+In a pole case (``C1 = +-M3``) the horizontal axis is the signed nutation angle ``theta``
+(``gamma3 = cos theta``), in which the flow through the pole is regular.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
-from typing import Any, TypeAlias
+from typing import Any
 
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from numpy.typing import NDArray
 
 from rollingtop.plot._axes import axes_for
-from rollingtop.reduction import (
-    LevelSet,
-    LevelSetError,
-    Orbit,
-    SteadyMotion,
-    orbits,
-    steady_motions,
+from rollingtop.reduction import LevelSet, SteadyMotion, steady_motions
+from rollingtop.reduction.curves import (
+    abscissa,
+    default_h_levels,
+    normal_force_grid,
+    on_a_saddle,
+    portrait_curves,
 )
-from rollingtop.reduction._quadrature import energy_gap
-from rollingtop.reduction.level import Real
 
 __all__ = ["default_h_levels", "draw_portrait", "draw_potential", "phase_portrait"]
 
-FloatArray: TypeAlias = NDArray[np.float64]
 #: The abscissa's label: ``gamma3``, or the signed angle in a pole case.
 _XLABEL = {False: r"$\gamma_3$", True: r"$\theta$ (signed nutation angle, $\gamma_3 = \cos\theta$)"}
-
-
-def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
-    """``count`` energies from just above the lowest steady motion to half again past the highest
-    saddle (or, without saddles, a band above the minimum), plus the saddles' levels."""
-    motions = steady_motions(level)
-    if not motions:
-        raise LevelSetError(f"no steady motion on {level.describe()}: U has no minimum")
-    u_min = min(m.U for m in motions)
-    saddles = [m.U for m in motions if m.type == "saddle"]
-    if saddles:
-        top = max(saddles) + 0.5 * (max(saddles) - u_min)
-    else:
-        grid = np.linspace(*level.theta_domain, 2001)[200:-200]
-        top = u_min + 0.5 * (float(np.median(level.U(grid))) - u_min)
-    levels = u_min + (top - u_min) * (np.arange(1, count + 1) / count) ** 1.5
-    return sorted({*map(float, levels), *saddles})
-
-
-def _abscissa(level: LevelSet, theta: Real) -> Real:
-    """``gamma3 = cos(theta)``, or ``theta`` itself in a pole case (same shape)."""
-    if level.pole:
-        return theta
-    x: Real = np.cos(theta)
-    return x
-
-
-def _orbit_curve(
-    level: LevelSet, h: float, orbit: Orbit, n: int = 400
-) -> tuple[FloatArray, FloatArray]:
-    """The closed curve ``(abscissa, w_tau)`` of ``orbit`` at energy ``h``, each of shape
-    ``(2 n,)`` (rolling over: two branches of ``2 n`` points joined by a NaN)."""
-    t1, t2 = orbit.theta_min, orbit.theta_max
-    if orbit.rolls_over:
-        # rolling over (no spin): theta runs round the circle; draw w_tau > 0 and < 0 branches
-        # over the plotted window, separated by a NaN so that they are not joined
-        theta = np.linspace(*level.theta_domain, 2 * n)
-        w = level.w_tau(theta, h)
-        return np.concatenate([theta, [np.nan], theta]), np.concatenate([w, [np.nan], -w])
-    phi = np.linspace(-math.pi / 2, math.pi / 2, n)
-    theta = (t1 + t2) / 2 + (t2 - t1) / 2 * np.sin(phi)
-    w = level.w_tau(theta, h, gap=energy_gap(level, h, t1, t2, phi))
-    x = _abscissa(level, theta)
-    return np.concatenate([x, x[::-1]]), np.concatenate([w, -w[::-1]])
-
-
-def _normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatArray:
-    """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape (nw, ng), in
-    closed form (:meth:`rollingtop.reduction.LevelSet.normal_force`; no compiled code)."""
-    G, Wt = np.meshgrid(g3, w, indexing="ij")
-    N: FloatArray = level.normal_force(np.arccos(G), Wt).T
-    return N
-
-
-def _curves(
-    level: LevelSet, levels: Sequence[float], saddle_levels: set[float]
-) -> tuple[list[tuple[float, FloatArray, FloatArray, bool]], tuple[float, float, float]]:
-    """The closed curve of every orbit at the energies ``levels`` (steady ones left out) as
-    ``(h, x, w_tau, separatrix)``, and the window ``(x_lo, x_hi, w_top)`` that holds them: the
-    abscissa padded and clipped to the domain, ``w_top`` 10 % above the highest ``|w_tau|``."""
-    curves = []
-    g_lo, g_hi, w_top = 1.0, -1.0, 0.0
-    for h in levels:
-        try:
-            comps = orbits(level, h)
-        except LevelSetError:
-            continue
-        separatrix = any(abs(h - u) <= 1e-12 * max(1.0, abs(u)) for u in saddle_levels)
-        for o in comps:
-            if o.kind == "steady":
-                continue
-            x, y = _orbit_curve(level, h, o)
-            g_lo, g_hi = min(g_lo, np.nanmin(x)), max(g_hi, np.nanmax(x))
-            w_top = max(w_top, float(np.nanmax(np.abs(y))))
-            curves.append((h, x, y, separatrix or o.kind == "separatrix"))
-    if g_lo > g_hi:
-        raise LevelSetError(f"no motion on {level.describe()} at the requested h levels")
-    pad = 0.05 * (g_hi - g_lo) + 1e-3
-    if level.pole:
-        g_lo, g_hi = max(level.theta_domain[0], g_lo - pad), min(level.theta_domain[1], g_hi + pad)
-    else:
-        g_lo, g_hi = max(-1.0, g_lo - pad), min(1.0, g_hi + pad)
-    return curves, (float(g_lo), float(g_hi), 1.1 * w_top)
 
 
 def _colour(levels: Sequence[float], h: float) -> Any:
@@ -142,10 +51,12 @@ def _draw_orbits(
     """The upper panel of :func:`phase_portrait` on ``ax``; returns its abscissa's limits."""
     body = level.body
     saddle_levels = {m.U for m in motions if m.type == "saddle"}
-    curves, (g_lo, g_hi, w_top) = _curves(level, levels, saddle_levels)
+    found = portrait_curves(level, levels)
+    g_lo, g_hi, w_top = found.window
     drawn_sep = drawn = False
-    for h, x, y, separatrix in curves:
-        if separatrix:
+    for curve in found.curves:
+        h, x, y = curve.h, curve.x, curve.w
+        if curve.separatrix:
             ax.plot(
                 x, y, color="crimson", lw=1.8, zorder=3, label=None if drawn_sep else "separatrix"
             )
@@ -163,7 +74,7 @@ def _draw_orbits(
     if show_contact and not level.pole:
         gg = np.linspace(max(g_lo, -0.999), min(g_hi, 0.999), 90)
         ww = np.linspace(-w_top, w_top, 80)
-        N = _normal_force_grid(level, gg, ww)
+        N = normal_force_grid(level, gg, ww)
         if np.any(N < 0):
             ax.contourf(gg, ww, N, levels=[N.min() - 1, 0.0], colors=["#f4c7c3"], zorder=1)
             ax.plot([], [], color="#f4c7c3", lw=6, label="normal force < 0 (contact lost)")
@@ -213,7 +124,7 @@ def _mark_steady(
     """Each steady motion inside ``window``: a centre as a black dot, a saddle as a crimson
     cross, at ``w_tau = 0`` (the portrait) or at its ``U`` (the potential)."""
     for m in motions:
-        xm = float(_abscissa(level, m.theta))
+        xm = float(abscissa(level, m.theta))
         if not window[0] <= xm <= window[1]:
             continue
         y = m.U if on_potential else 0.0
@@ -242,7 +153,7 @@ def _draw_potential(
         U = level.U_gamma3(g)
     ax.plot(g, U, color="black", lw=1.2)
     for h in levels:
-        sep = any(abs(h - u) <= 1e-12 * max(1.0, abs(u)) for u in saddle_levels)
+        sep = on_a_saddle(h, saddle_levels)
         ax.axhline(h, color="crimson" if sep else _colour(levels, h), lw=0.8)
     hi_h = max(levels)
     u_min = min((m.U for m in motions), default=float(np.min(U)))
@@ -306,8 +217,7 @@ def draw_potential(
     levels = _levels(level, h_levels)
     motions = steady_motions(level)
     if window is None:
-        saddle_levels = {m.U for m in motions if m.type == "saddle"}
-        _, (g_lo, g_hi, _) = _curves(level, levels, saddle_levels)
+        g_lo, g_hi, _ = portrait_curves(level, levels).window
         window = (g_lo, g_hi)
     _draw_potential(ax, level, levels, motions, window)
     if mark_steady:

@@ -12,10 +12,13 @@ models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, the ro
   its turning points and :class:`~.orbits.Orbits` (the list of one energy; shared with
   :mod:`.no_spin`) the private :mod:`._orbit`.
 - In a notebook the levels, their steady motions and orbits and the bifurcation diagrams show
-  themselves as HTML tables and draw themselves (``.plot()``): the private :mod:`._display`.
+  themselves as HTML tables (the private :mod:`._display`, registered on import) and draw
+  themselves (``.plot()``, with :mod:`rollingtop.plot`, named in :mod:`rollingtop._figures`).
+- :mod:`.curves`: the curves of a phase portrait as data (what the figures draw).
 - :mod:`.no_spin`, :mod:`.near_pole`: the no-spin level and levels near a pole level.
 """
 
+from rollingtop.reduction import _display  # noqa: F401  (registers the objects' HTML views)
 from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
 from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
 from rollingtop.reduction.orbits import Orbit, Orbits, orbits

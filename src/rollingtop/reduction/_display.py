@@ -1,13 +1,13 @@
-"""The reduction's objects in a notebook: the HTML views (``_repr_html_``) and the ``.plot()``
-of a level set (:class:`~rollingtop.reduction.LevelSet`, every model's kind), of its steady
-motions (:class:`~rollingtop.reduction.SteadyMotions`) and orbits
-(:class:`~rollingtop.reduction.Orbits`), and of a bifurcation diagram
-(:class:`~rollingtop.reduction.bifurcation.BifurcationDiagram`).
+"""The reduction's objects in a notebook: the HTML views (``_repr_html_``) of a level set
+(:class:`~rollingtop.reduction.LevelSet`, every model's kind), of its steady motions
+(:class:`~rollingtop.reduction.SteadyMotions`) and orbits (:class:`~rollingtop.reduction.Orbits`),
+and of a bifurcation diagram (:class:`~rollingtop.reduction.bifurcation.BifurcationDiagram`).
 
-Each of those classes imports this module inside its two methods, never at import; the figures
-are the command line's, drawn by :mod:`rollingtop.plot`, imported here inside each ``plot_*``
-function (the numerics never import matplotlib: the import-linter contracts in
-``pyproject.toml`` name these imports as the only exceptions).
+Each view is registered for its type (:func:`rollingtop._html.register_view`) when
+:mod:`rollingtop.reduction` is imported, and each type's ``_repr_html_`` asks
+:func:`rollingtop._html.html_view` for it: the types' modules never import this one, which
+imports them. Their ``.plot()`` draws with :mod:`rollingtop.plot` by name
+(:mod:`rollingtop._figures`).
 """
 
 from __future__ import annotations
@@ -15,26 +15,18 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Sequence
 from html import escape
-from typing import TYPE_CHECKING, Any
 
-from rollingtop._html import Num, block, count, row_table, table
+from rollingtop._html import Num, block, count, register_view, row_table, table
 from rollingtop.contact import get_model
 from rollingtop.reduction._orbit import Orbits
 from rollingtop.reduction.bifurcation import BifurcationDiagram
 from rollingtop.reduction.level import LevelSet, LevelSetError
 from rollingtop.reduction.steady import SteadyMotion, SteadyMotions, steady_motions
 
-if TYPE_CHECKING:
-    from matplotlib.axes import Axes
-
 __all__ = [
     "diagram_html",
     "level_html",
     "orbits_html",
-    "plot_diagram",
-    "plot_level",
-    "plot_orbits",
-    "plot_steady",
     "steady_count",
     "steady_html",
 ]
@@ -176,29 +168,7 @@ def diagram_html(diagram: BifurcationDiagram) -> str:
     )
 
 
-def plot_level(level: LevelSet, ax: Axes | None, **kw: Any) -> Axes:
-    """:meth:`LevelSet.plot`: :func:`rollingtop.plot.portrait.draw_portrait`."""
-    from rollingtop.plot.portrait import draw_portrait
-
-    return draw_portrait(ax, level, **kw)
-
-
-def plot_steady(motions: SteadyMotions, ax: Axes | None, **kw: Any) -> Axes:
-    """:meth:`SteadyMotions.plot`: :func:`rollingtop.plot.portrait.draw_potential`."""
-    from rollingtop.plot.portrait import draw_potential
-
-    return draw_potential(ax, motions.level, **kw)
-
-
-def plot_orbits(found: Orbits, ax: Axes | None, **kw: Any) -> Axes:
-    """:meth:`Orbits.plot`: :func:`rollingtop.plot.portrait.draw_portrait` at their ``h``."""
-    from rollingtop.plot.portrait import draw_portrait
-
-    return draw_portrait(ax, found.level, [found.h], **kw)
-
-
-def plot_diagram(diagram: BifurcationDiagram, ax: Axes | None, **kw: Any) -> Axes:
-    """:meth:`BifurcationDiagram.plot`: :func:`rollingtop.plot.bifurcation.draw_bifurcation`."""
-    from rollingtop.plot.bifurcation import draw_bifurcation
-
-    return draw_bifurcation(ax, diagram, **kw)
+register_view(LevelSet, level_html)
+register_view(SteadyMotions, steady_html)
+register_view(Orbits, orbits_html)
+register_view(BifurcationDiagram, diagram_html)

@@ -10,6 +10,8 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
+from rollingtop._figures import draw
+from rollingtop._html import html_view
 from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet
@@ -102,18 +104,15 @@ class Orbits(list[Orbit]):
     def _repr_html_(self) -> str:
         """The notebook's view: the level, ``h`` and the full energy, a row per orbit (turning
         points, period, kind; ``rollingtop orbits``' table)."""
-        from rollingtop.reduction._display import orbits_html
-
-        return orbits_html(self)
+        return html_view(self)
 
     def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
         """Draw the orbits in ``(gamma3, w_tau)`` with the level's steady motions on ``ax``
         (default: a new figure's) and return ``ax``: ``rollingtop portrait --h-levels h``'s
         upper panel (:func:`rollingtop.plot.portrait.draw_portrait`, which takes ``kw``:
         ``show_contact``, ``legend``)."""
-        from rollingtop.reduction._display import plot_orbits
-
-        return plot_orbits(self, ax, **kw)
+        axes: Axes = draw("portrait", ax, self.level, [self.h], **kw)
+        return axes
 
 
 def turning_point(level: LevelSet, h: float, a: float, b: float) -> float:

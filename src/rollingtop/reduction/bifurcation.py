@@ -45,7 +45,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from rollingtop._html import count
+from rollingtop._figures import draw
+from rollingtop._html import count, html_view
 from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction._critical_curves import (
@@ -159,17 +160,14 @@ class BifurcationDiagram:
 
     def _repr_html_(self) -> str:
         """The notebook's view: body, window, the folds and the regions (their orbits)."""
-        from rollingtop.reduction._display import diagram_html
-
-        return diagram_html(self)
+        return html_view(self)
 
     def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
         """Draw the diagram of ``rollingtop bifurcation`` (its main panel, without the
         thumbnails) on ``ax`` (default: a new figure's) and return ``ax``; ``kw`` go to
         :func:`rollingtop.plot.bifurcation.draw_bifurcation` (``mark_C2``)."""
-        from rollingtop.reduction._display import plot_diagram
-
-        return plot_diagram(self, ax, **kw)
+        axes: Axes = draw("bifurcation", ax, self, **kw)
+        return axes
 
 
 def _default_c2_range(level: LevelSet, fs: Sequence[Fold]) -> tuple[float, float]:

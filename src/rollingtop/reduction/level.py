@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias, overload
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop._figures import draw
+from rollingtop._html import html_view
 from rollingtop.body import SphericalTop
 from rollingtop.contact.meridian import POLE_CASE_TOLERANCE, pole_case
 from rollingtop.reduction._services import (
@@ -373,17 +375,14 @@ class LevelSet(LevelServices):
 
     def _repr_html_(self) -> str:
         """The notebook's view: model, integrals, body, the steady motions' count."""
-        from rollingtop.reduction._display import level_html
-
-        return level_html(self)
+        return html_view(self)
 
     def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
         """Draw the phase portrait of ``rollingtop portrait`` (upper panel) on ``ax`` (default:
         a new figure's) and return ``ax``; ``kw`` go to
         :func:`rollingtop.plot.portrait.draw_portrait` (``h_levels``, ``show_contact``)."""
-        from rollingtop.reduction._display import plot_level
-
-        return plot_level(self, ax, **kw)
+        axes: Axes = draw("portrait", ax, self, **kw)
+        return axes
 
 
 def near_north(level: LevelSet) -> bool:

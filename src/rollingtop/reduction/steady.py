@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rollingtop._figures import draw
+from rollingtop._html import html_view
 from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
 from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
@@ -105,18 +107,15 @@ class SteadyMotions(list[SteadyMotion]):
     def _repr_html_(self) -> str:
         """The notebook's view: the count by type and a row per motion (``rollingtop
         equilibria``'s table)."""
-        from rollingtop.reduction._display import steady_html
-
-        return steady_html(self)
+        return html_view(self)
 
     def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
         """Draw ``U`` with each steady motion at its energy on ``ax`` (default: a new figure's)
         and return ``ax``: the lower panel of ``rollingtop portrait``
         (:func:`rollingtop.plot.portrait.draw_potential`, which takes ``kw``: ``h_levels``,
         ``window``)."""
-        from rollingtop.reduction._display import plot_steady
-
-        return plot_steady(self, ax, **kw)
+        axes: Axes = draw("potential", ax, self.level, **kw)
+        return axes
 
 
 def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
