@@ -203,6 +203,13 @@ def kernel(func: F) -> F:
     return _make(func, {**BASE_OPTIONS, "_nrt": False})
 
 
+def loop(func: F) -> F:
+    """Compile ``func`` as a stage kernel (:func:`kernel`) that Python calls to run a long loop
+    (a chunk of steps): it releases the GIL while it runs (``nogil``), so that the caller's
+    other threads go on meanwhile (the explorer's event loop while a worker integrates)."""
+    return _make(func, {**BASE_OPTIONS, "_nrt": False, "nogil": True})
+
+
 def inline(func: F) -> F:
     """Compile ``func`` as a helper inlined into every compiled caller."""
     return _make(func, {**BASE_OPTIONS, "inline": "always"})

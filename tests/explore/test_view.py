@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rollingtop import ScenarioError
-from rollingtop.explore._work import Latest
+from rollingtop.explore._work import Latest, new_executor
 from rollingtop.explore.path import path_view
 from rollingtop.explore.section import section_view
 from rollingtop.explore.view import (
@@ -28,6 +28,10 @@ from ..test_cli import run_cli
 
 FIG5 = str(EXAMPLES / "fig5.toml")
 ENERGY_RTOL = 1e-9  # the reduced energy of a reconstructed state / a trajectory (rtol 1e-10)
+
+
+#: The pool of the tests of Latest (a server has one, shared by its sessions).
+POOL = new_executor()
 
 
 @pytest.fixture(scope="module")
@@ -197,7 +201,7 @@ def test_the_newest_request_supersedes_the_older_ones():
         gate.wait(5)
         return x * 10
 
-    work = Latest(lambda fn: fn(), compute, lambda arg, res: applied.append((arg, res)))
+    work = Latest(POOL, lambda fn: fn(), compute, lambda arg, res: applied.append((arg, res)))
     work.request(1)
     time.sleep(0.05)
     for k in (2, 3, 4):
@@ -212,7 +216,7 @@ def test_the_newest_request_supersedes_the_older_ones():
 
 def test_an_error_in_the_work_is_a_message_not_a_traceback():
     applied = []
-    work = Latest(lambda fn: fn(), lambda x: 1 / x, lambda a, r: applied.append(r))
+    work = Latest(POOL, lambda fn: fn(), lambda x: 1 / x, lambda a, r: applied.append(r))
     work.request(0)
     deadline = time.time() + 5
     while not applied and time.time() < deadline:
@@ -266,6 +270,41 @@ def test_a_closed_page_is_freed(fig5):
     refs = [open_and_close() for _ in range(3)]
     gc.collect()
     assert [r() for r in refs] == [None, None, None]
+
+
+def test_a_servers_pages_share_its_pool_and_a_page_alone_owns_one(fig5):
+    """Issue 37, item 5: one executor per server, passed to each of its pages (a second server
+    in the same process has its own); a page made without one owns a pool that its close()
+    shuts down, and closing a page of a server leaves the server's pool running."""
+    from rollingtop.explore.app import ExplorePage
+
+    shared = new_executor()
+    pages = [ExplorePage(fig5, "plain", query={}, executor=shared) for _ in range(2)]
+    alone = ExplorePage(fig5, "plain", query={})
+    for page in pages:
+        assert all(w.executor is shared for w in (page.level_work, page.path_work))
+    assert alone.level_work.executor is not shared
+    for page in (*pages, alone):
+        page.close()
+    assert shared.submit(lambda: 7).result(timeout=10) == 7  # still running
+    with pytest.raises(RuntimeError, match="shutdown"):
+        alone.executor.submit(lambda: 7)
+    shared.shutdown()
+
+
+def test_the_loops_python_calls_release_the_gil():
+    """Issue 37, item 5: every compiled loop that Python calls for a long piece of work is
+    compiled ``nogil``, so the page's event loop runs while a worker integrates (measured: a
+    worker's 2000-time-unit simulate stalled the main thread 105 ms before, 7 ms after)."""
+    from rollingtop._compiled import for_model
+    from rollingtop.contact import MODELS
+
+    for name in MODELS:
+        k = for_model(name)
+        steppers = (k.stepper, k.stepper_events, k.stepper_held)
+        loops = [s.run for s in steppers] + [k.tangent.indicators_chunk, k.ensemble.batch]
+        loops.append(k.chaos.section_batch)
+        assert all(f.targetoptions.get("nogil") is True for f in loops), name
 
 
 def test_views_are_cached_on_the_state(fig5):

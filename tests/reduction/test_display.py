@@ -15,10 +15,10 @@ from matplotlib.axes import Axes
 from scipy.integrate import quad
 
 from rollingtop import SphericalTop
-from rollingtop.reduction.curves import default_h_levels
 from rollingtop.reduction import LevelSet, Orbits, SteadyMotions, orbits, steady_motions
 from rollingtop.reduction.bifurcation import bifurcation_diagram
 from rollingtop.reduction.classify import classify_models
+from rollingtop.reduction.curves import default_h_levels
 
 from ..conftest import GAMMA0, OMEGA0, PAPER_BODY
 from ..html_view import num, read

@@ -1,33 +1,44 @@
-"""The explore page's work off the server's event loop: a thread pool shared by the sessions,
-and the newest-request-wins queue of each kind of work (:class:`Latest`)."""
+"""The explore page's work off the server's event loop: the newest-request-wins queue of each
+kind of work (:class:`Latest`), run in the server's thread pool (:func:`new_executor`, one per
+:func:`rollingtop.explore.server.serve`, shared by its sessions).
+
+The compiled loops the work runs release the GIL (the stepper's chunks are compiled ``nogil``,
+:func:`rollingtop._jit.loop`), so the event loop answers the page while a worker integrates."""
 
 from __future__ import annotations
 
 import functools
 import threading
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Executor, ThreadPoolExecutor
 from typing import Any
 
 from rollingtop._errors import RollingTopError
 
-__all__ = ["Latest", "WORKERS"]
+__all__ = ["WORKER_THREADS", "Latest", "new_executor"]
 
-#: Threads shared by all sessions for the page's computations.
-WORKERS = ThreadPoolExecutor(max_workers=2, thread_name_prefix="rollingtop-explore")
+#: Threads of a server's pool for the page's computations.
+WORKER_THREADS = 2
+
+
+def new_executor() -> ThreadPoolExecutor:
+    """A pool of :data:`WORKER_THREADS` threads for the pages of one server (or one page)."""
+    return ThreadPoolExecutor(max_workers=WORKER_THREADS, thread_name_prefix="rollingtop-explore")
 
 
 class Latest:
-    """The newest request of one kind of work: runs ``compute`` in :data:`WORKERS`, at most one
-    at a time, and hands the result of the newest request to ``apply`` on the page's document.
+    """The newest request of one kind of work: runs ``compute`` in ``executor``, at most one at
+    a time, and hands the result of the newest request to ``apply`` on the page's document.
     Requests made while one runs replace each other; only the last one runs next."""
 
     def __init__(
         self,
+        executor: Executor,
         on_document: Callable[[Callable[[], None]], None],
         compute: Callable[[Any], Any],
         apply: Callable[[Any, Any], None],
     ) -> None:
+        self.executor = executor
         self.on_document, self.compute, self.apply = on_document, compute, apply
         self.lock = threading.Lock()
         self.pending: Any = None
@@ -42,7 +53,7 @@ class Latest:
             if self.running:
                 return
             self.running = True
-        WORKERS.submit(self._run)
+        self.executor.submit(self._run)
 
     def _run(self) -> None:
         while True:

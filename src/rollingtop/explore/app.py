@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import io
 from collections.abc import Callable
+from concurrent.futures import Executor
 from typing import Any
 from urllib.parse import urlencode
 
@@ -26,7 +27,7 @@ from rollingtop._errors import RollingTopError
 from rollingtop.contact import MODELS
 from rollingtop.devices import DEVICES
 from rollingtop.explore._plots import Plots
-from rollingtop.explore._work import Latest
+from rollingtop.explore._work import Latest, new_executor
 from rollingtop.explore.path import PATH_SAMPLES, PATH_T_END, path_view
 from rollingtop.explore.section import section_view
 from rollingtop.explore.view import (
@@ -74,10 +75,17 @@ class ExplorePage:
         The device look of the frame beside the path (:data:`LOOKS`).
     query : mapping, optional
         The URL's query parameters (default: the session's, from ``pn.state.location``).
+    executor : concurrent.futures.Executor, optional
+        Where the page's work runs: the server's pool, shared by its sessions (default: a pool
+        of the page's own, shut down by :meth:`close`).
     """
 
     def __init__(
-        self, base: ExploreState, look: str = "plain", query: dict[str, Any] | None = None
+        self,
+        base: ExploreState,
+        look: str = "plain",
+        query: dict[str, Any] | None = None,
+        executor: Executor | None = None,
     ) -> None:
         self.doc = pn.state.curdoc
         self.location = pn.state.location
@@ -98,10 +106,13 @@ class ExplorePage:
         self.plots.portrait.on_event(Tap, self._on_portrait_tap)
         self.plots.diagram.on_event(Tap, self._on_diagram_tap)
         self._build_widgets()
-        self.level_work = Latest(self.on_document, self._compute_level, self._apply_level)
-        self.diagram_work = Latest(self.on_document, cached_diagram_view, self._apply_diagram)
-        self.path_work = Latest(self.on_document, self._compute_path, self._apply_path)
-        self.frame_work = Latest(self.on_document, self._compute_frame, self._apply_frame)
+        self.own_executor = executor is None
+        pool = new_executor() if executor is None else executor
+        self.executor = pool
+        self.level_work = Latest(pool, self.on_document, self._compute_level, self._apply_level)
+        self.diagram_work = Latest(pool, self.on_document, cached_diagram_view, self._apply_diagram)
+        self.path_work = Latest(pool, self.on_document, self._compute_path, self._apply_path)
+        self.frame_work = Latest(pool, self.on_document, self._compute_frame, self._apply_frame)
         if query is None and self.location is not None:
             query = dict(self.location.query_params)
         if query:
@@ -131,6 +142,8 @@ class ExplorePage:
         self.last_section = None
         self.plots.clear()
         _drop_js_callbacks(self.layout)
+        if self.own_executor:
+            self.executor.shutdown(wait=False, cancel_futures=True)
 
     def _show_error(self, text: str) -> None:
         self.message.object = text

@@ -121,7 +121,7 @@ def serve(
     """
     import panel as pn
 
-    from rollingtop.explore._work import WORKERS
+    from rollingtop.explore._work import new_executor
     from rollingtop.explore.app import ExplorePage
 
     _check_address(host, port)  # before compiling: a busy port is said at once
@@ -132,9 +132,10 @@ def serve(
     # a tab closed while a result was on its way is not the user's concern
     logging.getLogger("bokeh.server.views.ws").setLevel(logging.ERROR)
     warm_up(base)
+    workers = new_executor()  # this server's, shared by its sessions
 
     def page() -> Any:  # a closed tab's session goes 5 s after it closes (Bokeh's default: 15)
-        view = ExplorePage(base, look)
+        view = ExplorePage(base, look, executor=workers)
         pn.state.on_session_destroyed(lambda _: view.close())  # its data go with the session
         return view.layout
 
@@ -183,7 +184,7 @@ def serve(
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         server.stop()
-        WORKERS.shutdown(wait=False, cancel_futures=True)
+        workers.shutdown(wait=False, cancel_futures=True)
     if caught:
         raise Interrupted(caught[0])
 

@@ -70,7 +70,7 @@ from rollingtop._compiled._template.dense import (
 from rollingtop._compiled._template.dynamics import project, rhs, rhs_inline
 from rollingtop._compiled._template.events import event_value
 from rollingtop._compiled._template.invariants import WORK_ROWS, project_integrals
-from rollingtop._jit import compiled, kernel
+from rollingtop._jit import compiled, loop
 from rollingtop._types import FloatArray, IntArray, Workspace
 
 #: Whether :func:`run` holds integrals by projection: ``True`` in the instance ``stepper_held``.
@@ -163,7 +163,7 @@ def start(
     return ctrl, counts, track
 
 
-@kernel
+@loop
 def run(
     code: int,
     p: FloatArray,

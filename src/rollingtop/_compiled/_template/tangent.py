@@ -304,7 +304,7 @@ def start_indicators(
     )
 
 
-@compiled()
+@compiled(nogil=True)
 def indicators_chunk(
     code: int,
     p: FloatArray,
