@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSetError
 from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits
 from rollingtop.reduction.rotation import rotation_number
 
@@ -54,7 +54,7 @@ class PathUnresolvedError(LevelSetError):
     """The reconstruction would need more than :data:`MAX_PATH_EVALUATIONS` evaluations."""
 
 
-def _path_rhs(level: LevelSet) -> Callable[[float, FloatArray], list[float]]:
+def _path_rhs(level: Level) -> Callable[[float, FloatArray], list[float]]:
     """The right-hand side for ``solve_ivp`` of ``z = (theta, w_tau, psi, X, Y)`` (module
     docstring): :meth:`LevelSet.flow` with the quadratures for ``psi``, ``X`` and ``Y``; raises
     :class:`PathUnresolvedError` past :data:`MAX_PATH_EVALUATIONS` calls."""
@@ -86,7 +86,7 @@ def _path_rhs(level: LevelSet) -> Callable[[float, FloatArray], list[float]]:
 
 
 def reconstruct(
-    level: LevelSet,
+    level: Level,
     t: ArrayLike,
     *,
     theta0: float,
@@ -212,7 +212,7 @@ def start_theta(orbit: Orbit) -> float:
     return orbit.start_theta
 
 
-def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodMap:
+def period_map(level: Level, h: float, orbit: Orbit | None = None) -> PeriodMap:
     """Per-period map of an orbit on ``(M3, C1, C2, h)`` (the first one if ``orbit`` is None).
 
     ``Delta psi`` comes from the quadrature of ``psi'(theta)`` over one period with the same
@@ -294,7 +294,7 @@ def period_map(level: LevelSet, h: float, orbit: Orbit | None = None) -> PeriodM
     )
 
 
-def _displacement(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, float, float, complex]:
+def _displacement(level: Level, h: float, orbit: Orbit) -> tuple[float, float, float, complex]:
     """``(Delta psi, its error, theta0, D)``: the quadrature of ``psi'`` and the CoM's
     displacement over one period from the canonical start (:func:`reconstruct`)."""
     T = orbit.period

@@ -66,7 +66,9 @@ from rollingtop.io import read_input_text
 from rollingtop.scenario_level import LevelSpec, level_from_table
 
 if TYPE_CHECKING:  # the reduction (and scipy.optimize) is imported where a level is needed
-    from rollingtop.reduction.level import LevelSet
+    from rollingtop.reduction.level import Level
+
+    pass
 
 __all__ = [
     "BYTES_PER_SAMPLE",
@@ -181,7 +183,7 @@ class Scenario:
             )
         return self.y0
 
-    def level_set(self) -> LevelSet:
+    def level_set(self) -> Level:
         """The :class:`~rollingtop.reduction.LevelSet` of ``[level]``, else of the initial state
         (:meth:`rollingtop.reduction.models.Reduction.level_of_state`), under the model's
         reduction."""
@@ -201,8 +203,8 @@ class Scenario:
             M3, C1 = self.level.M3, self.level.C1
             assert M3 is not None and C1 is not None  # the meridian model's [level] has them
             return M3, C1, self.level.C2
-        level = self.level_set()
-        return level.M3, level.C1, level.C2
+        values = self.level_set().values()
+        return values["M3"], values["C1"], values["C2"]
 
     def level_h(self) -> float:
         """The reduced energy ``h`` of ``[level]``, else of the initial state

@@ -13,7 +13,9 @@ from rollingtop.body import SphericalTop
 from rollingtop.contact import DEFAULT_MODEL, ContactModel, get_model
 
 if TYPE_CHECKING:  # the reduction (and scipy.optimize) is imported where a level is needed
-    from rollingtop.reduction.level import LevelSet
+    from rollingtop.reduction.level import Level
+
+    pass
 
 __all__ = ["LevelSpec", "level_from_table"]
 
@@ -73,7 +75,7 @@ class LevelSpec:
             raise ScenarioError(f"level.branch = {short_repr(self.branch)} must be +1 or -1")
         object.__setattr__(self, "branch", int(self.branch))
 
-    def level_set(self, body: SphericalTop, model: ContactModel | None = None) -> LevelSet:
+    def level_set(self, body: SphericalTop, model: ContactModel | None = None) -> Level:
         """The :class:`~rollingtop.reduction.LevelSet` of ``body`` under ``model``'s reduction
         (default the meridian model's, ``(M3, C1, C2)``): the integrals it names
         (:attr:`ContactModel.reduction`)."""

@@ -15,7 +15,8 @@ from typing import Any
 import numpy as np
 
 from rollingtop.absolute import PeriodMap, period_map
-from rollingtop.reduction import LevelSet, LevelSetError, Orbit, orbits, reduce_state
+from rollingtop.reduction import LevelSetError, Orbit, orbits, reduce_state
+from rollingtop.reduction.level import Level
 from rollingtop.reduction.near_pole import NearPole, near_pole
 from rollingtop.scenario import Scenario
 
@@ -71,7 +72,7 @@ class OrbitSurvey:
         return row
 
 
-def survey_orbits(level: LevelSet, h: float) -> list[OrbitSurvey]:
+def survey_orbits(level: Level, h: float) -> list[OrbitSurvey]:
     """Every orbit on ``(M3, C1, C2, h)``, sorted by ``gamma3_min``
     (:func:`rollingtop.reduction.orbits`), with its per-period map and near-pole limits.
 
@@ -84,7 +85,7 @@ def survey_orbits(level: LevelSet, h: float) -> list[OrbitSurvey]:
     return [OrbitSurvey(o, _map_or_none(level, h, o), near_pole(level, h, o)) for o in found]
 
 
-def _map_or_none(level: LevelSet, h: float, orbit: Orbit) -> PeriodMap | None:
+def _map_or_none(level: Level, h: float, orbit: Orbit) -> PeriodMap | None:
     """The orbit's per-period map, or ``None`` where there is none (not periodic) or where its
     reconstruction in space fails (a wall within round-off of the far pole: the precession rate
     there is beyond what the quadrature resolves): the orbit is still listed, without it."""

@@ -154,7 +154,9 @@ def _classify_state(
             out["n_saddles"][n] = sum(m.type == "saddle" for m in motions)
             if get_model(name).has_reduction:  # the paper's whole reduction: its fold curves
                 out["n_folds"][n] = _fold_count(
-                    *(float(getattr(body, key)) for key in BODY_KEYS), level.M3, level.C1
+                    *(float(getattr(body, key)) for key in BODY_KEYS),
+                    level.values()["M3"],
+                    level.values()["C1"],
                 )
             centres = [m for m in motions if m.type == "center"][:MAX_CENTRES]
             for c, m in enumerate(centres):

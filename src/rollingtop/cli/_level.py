@@ -16,20 +16,21 @@ from rollingtop.cli._options import figure_output, json_option, scenario_argumen
 if TYPE_CHECKING:
     from rich.table import Table
 
-    from rollingtop.reduction import LevelSet, SteadyMotion
+    from rollingtop.reduction import SteadyMotion
+    from rollingtop.reduction.level import Level
     from rollingtop.survey import OrbitSurvey
 
 __all__ = ["equilibria", "orbits", "portrait"]
 
 
-def _level_of(scenario: str) -> LevelSet:
+def _level_of(scenario: str) -> Level:
     """The level set of the scenario file: its ``[level]``, else its initial state's."""
     from rollingtop.scenario import load_scenario
 
     return load_scenario(scenario).level_set()
 
 
-def _level_json(level: LevelSet, **extra: float) -> dict[str, Any]:
+def _level_json(level: Level, **extra: float) -> dict[str, Any]:
     """The level's own integrals (:meth:`LevelSet.values`), its model and pole case."""
     return {**level.values(), "model": level.model, "pole": level.pole, **extra}
 
@@ -38,10 +39,11 @@ def _num(x: float | None) -> str:
     return "-" if x is None or x != x else f"{x:.7g}"
 
 
-def _steady_table(level: LevelSet, motions: Sequence[SteadyMotion]) -> Table:
+def _steady_table(level: Level, motions: Sequence[SteadyMotion]) -> Table:
     from rich.table import Table
 
-    spin = "" if "M3" not in level.values() else f" (spin w3 = {level.M3 / level.body.I3:.7g})"
+    M3 = level.values().get("M3")
+    spin = "" if M3 is None else f" (spin w3 = {M3 / level.body.I3:.7g})"
     table = Table(title=f"steady motions on {level.describe()}{spin}")
     cols = ("gamma3", "U", "type", "omega", "period", "psi'", "|v_CoM|", "CoM radius")
     for col in cols:
@@ -80,7 +82,7 @@ def equilibria(scenario: str, as_json: bool) -> None:
         _output.console().print(_steady_table(level, motions))
 
 
-def _orbits_table(level: LevelSet, h: float, survey: Sequence[OrbitSurvey]) -> Table:
+def _orbits_table(level: Level, h: float, survey: Sequence[OrbitSurvey]) -> Table:
     from rich.table import Table
 
     energy = level.full_energy(h)

@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from rollingtop.contact import get_model
 from rollingtop.reduction.classify import CriticalValues, ModelClassification, RotationGrid
-from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.level import Level
 
 __all__ = ["classification_figure", "critical_values_figure", "rotation_grid_figure"]
 
@@ -144,7 +144,7 @@ def _draw_critical(ax: Any, cv: CriticalValues, colour: str) -> None:
         )
 
 
-def critical_values_figure(cv: CriticalValues, level: LevelSet, mark: bool = True) -> Figure:
+def critical_values_figure(cv: CriticalValues, level: Level, mark: bool = True) -> Figure:
     """The critical values of a reduced model's energy along its axis integral
     (:func:`rollingtop.reduction.classify.critical_values`), the level's own value marked
     (unless ``mark`` is false: a level that left the axis out); below, the number of steady

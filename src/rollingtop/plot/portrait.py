@@ -19,7 +19,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from rollingtop.plot._axes import axes_for
-from rollingtop.reduction import LevelSet, SteadyMotion, steady_motions
+from rollingtop.reduction import SteadyMotion, steady_motions
 from rollingtop.reduction.curves import (
     abscissa,
     default_h_levels,
@@ -27,6 +27,7 @@ from rollingtop.reduction.curves import (
     on_a_saddle,
     portrait_curves,
 )
+from rollingtop.reduction.level import Level
 
 __all__ = ["default_h_levels", "draw_portrait", "draw_potential", "phase_portrait"]
 
@@ -43,7 +44,7 @@ def _colour(levels: Sequence[float], h: float) -> Any:
 
 def _draw_orbits(
     ax: Axes,
-    level: LevelSet,
+    level: Level,
     levels: Sequence[float],
     motions: Sequence[SteadyMotion],
     show_contact: bool,
@@ -116,7 +117,7 @@ def _draw_orbits(
 
 def _mark_steady(
     ax: Axes,
-    level: LevelSet,
+    level: Level,
     motions: Sequence[SteadyMotion],
     window: tuple[float, float],
     on_potential: bool,
@@ -136,7 +137,7 @@ def _mark_steady(
 
 def _draw_potential(
     ax: Axes,
-    level: LevelSet,
+    level: Level,
     levels: Sequence[float],
     motions: Sequence[SteadyMotion],
     window: tuple[float, float],
@@ -174,13 +175,13 @@ def _draw_potential(
     )
 
 
-def _levels(level: LevelSet, h_levels: Sequence[float] | None) -> list[float]:
+def _levels(level: Level, h_levels: Sequence[float] | None) -> list[float]:
     return default_h_levels(level) if h_levels is None else sorted(map(float, h_levels))
 
 
 def draw_portrait(
     ax: Axes | None,
-    level: LevelSet,
+    level: Level,
     h_levels: Sequence[float] | None = None,
     *,
     show_contact: bool = True,
@@ -202,7 +203,7 @@ def draw_portrait(
 
 def draw_potential(
     ax: Axes | None,
-    level: LevelSet,
+    level: Level,
     h_levels: Sequence[float] | None = None,
     *,
     window: tuple[float, float] | None = None,
@@ -227,7 +228,7 @@ def draw_potential(
 
 
 def phase_portrait(
-    level: LevelSet,
+    level: Level,
     h_levels: Sequence[float] | None = None,
     *,
     show_contact: bool = True,

@@ -4,7 +4,10 @@ models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, the ro
 
 - :mod:`.variables`: full state <-> reduced variables and integrals.
 - :mod:`.system`: the reduced system (eq. 3.3).
-- :mod:`.level`: level sets ``(M3, C1, C2)`` and the effective potential ``U``.
+- :class:`Level` (:mod:`._services`): the abstract level set every reduced model implements
+  (its potential, mass, spin, precession, poles, eigenvalues); the rest derives from them.
+- :mod:`.level`: the meridian model's level sets ``(M3, C1, C2)`` (:class:`LevelSet`) and the
+  effective potential ``U``.
 - :mod:`.steady`: steady motions (critical points of ``U``), as a list that knows its level
   (:class:`~.steady.SteadyMotions`).
 - :mod:`.orbits`: orbits on ``(M3, C1, C2, h)``, turning points, periods; the quadrature of
@@ -19,7 +22,7 @@ models that have one (:mod:`.models`: the smooth model's, :mod:`.smooth`, the ro
 """
 
 from rollingtop.reduction import _display  # noqa: F401  (registers the objects' HTML views)
-from rollingtop.reduction.level import POLE_TOLERANCE, LevelSet, LevelSetError
+from rollingtop.reduction.level import POLE_TOLERANCE, Level, LevelSet, LevelSetError
 from rollingtop.reduction.models import REDUCTIONS, Reduction, reduction_of
 from rollingtop.reduction.orbits import Orbit, Orbits, orbits
 from rollingtop.reduction.rough import RoughLevel
@@ -38,6 +41,7 @@ from rollingtop.reduction.variables import (
 
 __all__ = [
     "POLE_TOLERANCE",
+    "Level",
     "LevelSet",
     "LevelSetError",
     "Orbit",

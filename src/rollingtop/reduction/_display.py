@@ -20,7 +20,7 @@ from rollingtop._html import Num, block, count, register_view, row_table, table
 from rollingtop.contact import get_model
 from rollingtop.reduction._orbit import Orbits
 from rollingtop.reduction.bifurcation import BifurcationDiagram
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSetError
 from rollingtop.reduction.steady import SteadyMotion, SteadyMotions, steady_motions
 
 __all__ = [
@@ -52,11 +52,11 @@ def _title(obj: object) -> str:
     return f"{public.get(name, 'rollingtop.reduction')}.{name}"
 
 
-def _model(level: LevelSet) -> str:
+def _model(level: Level) -> str:
     return f"{level.model} model ({get_model(level.model).description})"
 
 
-def level_html(level: LevelSet) -> str:
+def level_html(level: Level) -> str:
     """A level set: its model, its integrals and pole case, the body, and how many steady
     motions it has (or why it has no isolated one)."""
     try:
@@ -168,7 +168,7 @@ def diagram_html(diagram: BifurcationDiagram) -> str:
     )
 
 
-register_view(LevelSet, level_html)
+register_view(Level, level_html)
 register_view(SteadyMotions, steady_html)
 register_view(Orbits, orbits_html)
 register_view(BifurcationDiagram, diagram_html)

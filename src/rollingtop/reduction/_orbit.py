@@ -14,7 +14,7 @@ from rollingtop._figures import draw
 from rollingtop._html import html_view
 from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
-from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.level import Level
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -96,7 +96,7 @@ class Orbits(list[Orbit]):
         The reduced energy.
     """
 
-    def __init__(self, found: Iterable[Orbit], level: LevelSet, h: float) -> None:
+    def __init__(self, found: Iterable[Orbit], level: Level, h: float) -> None:
         super().__init__(found)
         self.level = level
         self.h = h
@@ -115,7 +115,7 @@ class Orbits(list[Orbit]):
         return axes
 
 
-def turning_point(level: LevelSet, h: float, a: float, b: float) -> float:
+def turning_point(level: Level, h: float, a: float, b: float) -> float:
     """The root of ``h = U(theta)`` in ``[a, b]`` (``U - h`` of opposite signs at the ends)."""
     # xtol tiny: the root is found to a relative 4 ulps also next to a pole (theta ~ 1e-12)
     root: float = brentq(lambda t: h - level.U(t), a, b, xtol=1e-300, rtol=8.9e-16, maxiter=500)

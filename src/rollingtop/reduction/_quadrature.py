@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from rollingtop.reduction._gauss import PERIOD_RTOL, doubled_gauss, graded_gauss, leggauss
 from rollingtop.reduction._roots import brentq
-from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.level import Level
 
 __all__ = [
     "HalfMap",
@@ -59,7 +59,7 @@ _GAP_NODES, _GAP_WEIGHTS = leggauss(20)
 _GAP_NEAR = 0.1
 
 
-def energy_gap(level: LevelSet, h: float, t1: float, t2: float, phi: FloatArray) -> FloatArray:
+def energy_gap(level: Level, h: float, t1: float, t2: float, phi: FloatArray) -> FloatArray:
     """``h - U(theta)`` at ``theta = c + d sin(phi)`` on ``[t1, t2]`` (``phi`` of any shape; the
     result has its shape), accurate to a few ulps *relative* to itself.
 
@@ -86,7 +86,7 @@ def energy_gap(level: LevelSet, h: float, t1: float, t2: float, phi: FloatArray)
     return out.reshape(shape)
 
 
-def _gap_from_slope(level: LevelSet, end: float, half: FloatArray) -> FloatArray:
+def _gap_from_slope(level: Level, end: float, half: FloatArray) -> FloatArray:
     """``U(end) - U(theta) = integral_theta^end U'`` by a 20-point Gauss-Legendre rule, with
     ``half = (end - theta) / 2`` (signed, shape ``(n,)``) given without cancellation: the
     energy gap next to the turning point ``end`` to its full relative accuracy, shape ``(n,)``."""
@@ -96,7 +96,7 @@ def _gap_from_slope(level: LevelSet, end: float, half: FloatArray) -> FloatArray
 
 
 def time_density(
-    level: LevelSet, theta: FloatArray, gap: FloatArray, jac: float | FloatArray, weight: Weight
+    level: Level, theta: FloatArray, gap: FloatArray, jac: float | FloatArray, weight: Weight
 ) -> FloatArray:
     """``2 sqrt(rho / (2 gap)) |dtheta/du| weight(theta)``: twice ``dt/du`` (times the weight)
     in an integration variable ``u`` with Jacobian ``jac``; 0 where it is not finite (at a
@@ -113,7 +113,7 @@ def time_density(
     return density
 
 
-def _integrand(level: LevelSet, h: float, t1: float, t2: float, weight: Weight = None) -> ArrayFn:
+def _integrand(level: Level, h: float, t1: float, t2: float, weight: Weight = None) -> ArrayFn:
     """``2 weight(theta) dt/dtheta`` in the variable ``phi`` (``theta = c + d sin phi``)."""
     c, d = (t1 + t2) / 2, (t2 - t1) / 2
 
@@ -135,7 +135,7 @@ _GAP_NEAR_WALL = 0.1
 
 
 def period(
-    level: LevelSet,
+    level: Level,
     h: float,
     theta1: float,
     theta2: float,
@@ -170,7 +170,7 @@ def period(
     return fine, abs(fine - coarse)
 
 
-def _walls(level: LevelSet, theta1: float, theta2: float) -> tuple[bool, bool]:
+def _walls(level: Level, theta1: float, theta2: float) -> tuple[bool, bool]:
     """Whether each end of the orbit ``[theta1, theta2]`` sits at a thin wall next to a pole."""
     if level.pole is not None or not 0.0 < theta1 < theta2 < math.pi:
         return (False, False)
@@ -244,7 +244,7 @@ def half_map(t_end: float, mid: float, wall: bool, left: bool) -> HalfMap:
 
 
 def _half_integrand(
-    level: LevelSet, h: float, t_end: float, half: HalfMap, left: bool, weight: Weight
+    level: Level, h: float, t_end: float, half: HalfMap, left: bool, weight: Weight
 ) -> ArrayFn:
     """``2 sqrt(rho / (2 (h - U))) |dtheta/du| weight`` on one half orbit (see :func:`half_map`).
 
@@ -269,7 +269,7 @@ def _half_integrand(
 
 
 def _wall_period(
-    level: LevelSet,
+    level: Level,
     h: float,
     theta1: float,
     theta2: float,
@@ -300,9 +300,7 @@ def _wall_period(
     return total, error
 
 
-def _north_wall(
-    level: LevelSet, h: float, t_end: float, mid: float
-) -> tuple[LevelSet, float] | None:
+def _north_wall(level: Level, h: float, t_end: float, mid: float) -> tuple[Level, float] | None:
     """The mirrored level and the turning point ``pi - t_end`` found on it to full relative
     precision (the root of ``U = h`` bracketed by halving and doubling the first guess); ``None``
     when no bracket is found (the half is then integrated as it stands)."""
@@ -329,7 +327,7 @@ def _north_wall(
 
 
 def half_integral(
-    level: LevelSet,
+    level: Level,
     h: float,
     t_end: float,
     mid: float,

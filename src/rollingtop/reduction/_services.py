@@ -1,27 +1,38 @@
-"""What every model's level set provides besides its potential and mass: its integrals by
-name, the full energy and the spin, the centre of mass's velocity, the normal force and a
-uniform drift (:class:`LevelServices`, a base of :class:`~rollingtop.reduction.LevelSet`).
+"""The reduction's protocol: :class:`Level`, the abstract level set of a model reduced to one
+degree of freedom, and the checks every level runs at construction.
 
-The defaults are the meridian model's; the other models' levels
-(:mod:`rollingtop.reduction.smooth`, :mod:`rollingtop.reduction.rough`) override what differs.
+A level is a particle of mass ``rho(theta)`` in the potential ``U(theta)``, ``theta`` the
+nutation angle (``gamma3 = cos theta``): ``h = rho theta'^2 / 2 + U``, ``theta' = -w_tau``.
+Each reduced model implements the abstract methods (its integrals, ``U`` and ``dU``, ``rho``,
+the spin, ``w_n`` and ``I1 v_tau``, the precession rate, the full energy, its poles, its
+mirror image, its eigenvalues); :class:`Level` derives the rest from them (the energy and
+``w_tau``, the flow, the normal force, the centre of mass's velocity, the domain in ``theta``).
 Everything downstream (steady motions, orbits, portraits, starting a motion on a level, the
-motion in absolute space) asks the level through these, whatever the model.
+motion in absolute space) asks the level through these, whatever the model. A new reduced model
+is one module with its :class:`Level` and one entry in
+:data:`rollingtop.reduction.models.REDUCTIONS`.
 """
 
 from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from typing import Any, ClassVar, TypeAlias, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias, TypeVar, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rollingtop._errors import RollingTopError
+from rollingtop._figures import draw
+from rollingtop._html import html_view
 from rollingtop.body import SphericalTop
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
 __all__ = [
-    "LevelServices",
+    "ComplexArray",
+    "Level",
     "LevelSetError",
     "PoleLevelError",
     "Real",
@@ -30,6 +41,13 @@ __all__ = [
 ]
 
 FloatArray: TypeAlias = NDArray[np.float64]
+ComplexArray: TypeAlias = NDArray[np.complex128]
+#: ``theta`` for :meth:`Level.dU`, also complex (the complex step of ``d2U``).
+_Analytic: TypeAlias = float | FloatArray | ComplexArray
+#: What numpy's stubs make of arithmetic on ``_Analytic`` (complex of unspecified precision).
+_AnalyticResult: TypeAlias = float | FloatArray | NDArray[np.complexfloating[Any, Any]]
+#: Step of the complex-step derivative (exact to round-off for analytic functions).
+_COMPLEX_STEP = 1e-30
 #: A value or an array of values: the functions of ``theta`` are vectorised (numpy broadcasting),
 #: a float gives a float (a numpy float) and an array of shape ``(...)`` an array of that shape.
 Real = TypeVar("Real", float, FloatArray)
@@ -83,37 +101,209 @@ def check_level_size(level: Any) -> None:
         )
 
 
-class LevelServices(ABC):
-    """The services of a level set (module docstring); a level provides ``body``, ``M3``,
-    :attr:`integrals`, ``v_tau(theta)`` and ``flow(theta, w_tau)``."""
+class Level(ABC):
+    """A level set of a reduced model (module docstring): the abstract methods are the model's,
+    the others follow from them.
+
+    Attributes
+    ----------
+    body : SphericalTop
+        Dynamically symmetric.
+    scale : float
+        The size of the terms the level's values were computed from (``|I w|`` of a state; 0
+        for given values): round-off of that size counts as zero in the pole decision.
+    pole : {None, "south", "north", "both"}
+        The poles a motion of the level can pass (``theta`` is then signed, see
+        :attr:`theta_domain`); set at construction.
+    """
 
     body: SphericalTop
-    M3: float
+    scale: float
+    pole: str | None
+    #: The contact model whose reduction this is (:mod:`rollingtop.reduction.models`).
+    model: ClassVar[str]
     #: The integrals that name the level, in order (:attr:`ContactModel.reduction`): the keys
     #: of a ``[level]`` table and of the level in JSON output (:meth:`values`).
-    integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "C2")
-
-    @abstractmethod
-    def v_tau(self, theta: Any) -> Any:
-        """``v_tau`` at ``theta`` (the level's own)."""
-
-    @abstractmethod
-    def flow(self, theta: Any, w_tau: Any) -> tuple[Any, Any]:
-        """``(theta', w_tau')`` (the level's own)."""
-
+    integrals: ClassVar[tuple[str, ...]]
     #: :meth:`full_energy` in words.
-    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
+    energy_formula: ClassVar[str]
+    #: What to do about a wall of ``U`` too thin for doubles next to a pole (a level within
+    #: round-off of a pole level): :func:`rollingtop.reduction.orbits.orbits`' refusal says it.
+    pole_advice: ClassVar[str] = "rescale the level's integrals"
+    #: Whether :func:`rollingtop.reduction.near_pole.near_pole` knows this model's limits on
+    #: its pole levels (the meridian model's only, so far).
+    near_pole_limits: ClassVar[bool] = False
 
-    def full_energy(self, h: float) -> float:
-        """The energy ``E`` of the full system on this level at reduced energy ``h``:
-        ``h + M3^2 / (2 I3) + m g R`` (:func:`rollingtop.reduction.start.level_energy`)."""
-        b = self.body
-        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
+    # ---- the model's own ------------------------------------------------------------------
+    @abstractmethod
+    def U(self, theta: Real) -> Real:
+        """The effective potential at ``theta``."""
 
+    @overload
+    def dU(self, theta: Real) -> Real: ...
+    @overload
+    def dU(self, theta: ComplexArray) -> ComplexArray: ...
+    @abstractmethod
+    def dU(self, theta: _Analytic) -> _AnalyticResult:
+        """``dU/dtheta``, analytic (a complex ``theta`` gives the complex step of :meth:`d2U`)."""
+
+    @abstractmethod
+    def rho(self, theta: Real) -> Real:
+        """The reduced motion's mass, also the density of its invariant measure."""
+
+    @abstractmethod
+    def drho(self, theta: Real) -> Real:
+        """``d rho / dtheta``."""
+
+    @abstractmethod
+    def P(self, theta: Real) -> Real:
+        """``I1 v_tau`` at ``theta``."""
+
+    @abstractmethod
+    def w_n(self, theta: Real) -> Real:
+        """The angular velocity's component along ``n`` at ``theta``."""
+
+    @abstractmethod
     def spin(self, theta: Real) -> Real:
-        """The spin ``w3`` at ``theta``: ``M3 / I3``, constant (Lagrange's integral)."""
-        out: Real = self.M3 / self.body.I3 + 0.0 * theta
-        return out
+        """The spin ``w3`` at ``theta``."""
+
+    @abstractmethod
+    def psi_dot(self, theta: Any) -> Any:
+        """The precession rate ``psi' = -w_n / s`` (finite at a pole the level passes)."""
+
+    @abstractmethod
+    def full_energy(self, h: float) -> float:
+        """The energy ``E`` of the full system on this level at reduced energy ``h``
+        (:attr:`energy_formula`)."""
+
+    @abstractmethod
+    def pole_offsets(self) -> tuple[float, float]:
+        """How far the level is from its south and north pole levels, in the model's own
+        measure (0 on a pole level; :func:`rollingtop.reduction.level.near_north`)."""
+
+    @abstractmethod
+    def mirrored(self) -> Level:
+        """The same motions seen with the body axis reversed: ``theta -> pi - theta``,
+        ``a3 -> -a3``; ``U``, ``rho`` and ``psi'`` at ``pi - theta`` there equal those at
+        ``theta`` here."""
+
+    @abstractmethod
+    def linearised_eigenvalues(self, gamma3: float) -> ComplexArray:
+        """Eigenvalues of the motion linearised at the steady motion at ``gamma3`` (a model
+        without reduced equations of its own: :meth:`curvature_eigenvalues`)."""
+
+    @abstractmethod
+    def describe(self) -> str:
+        """One line naming the level set."""
+
+    # ---- derived ----------------------------------------------------------------------------
+    @property
+    def theta_domain(self) -> tuple[float, float]:
+        """Open interval of ``theta`` the motion lives in: ``(0, pi)``; ``(-pi, pi)`` for a south
+        pole case, ``(0, 2 pi)`` for a north pole case (the potential is finite at the pole),
+        the whole circle for both."""
+        if self.pole == "south":
+            return (-math.pi, math.pi)
+        if self.pole == "north":
+            return (0.0, 2 * math.pi)
+        if self.pole == "both":
+            return (-math.pi / 2, 3 * math.pi / 2)  # the whole circle, both poles inside
+        return (0.0, math.pi)
+
+    @property
+    def pole_theta(self) -> float | None:
+        """``theta`` of the pole the motion can pass (0 or pi), or ``None`` (also for ``"both"``:
+        see :attr:`pole_thetas`)."""
+        return None if self.pole is None else {"south": 0.0, "north": math.pi}.get(self.pole)
+
+    @property
+    def pole_thetas(self) -> tuple[float, ...]:
+        """``theta`` of every pole the motion can pass: ``()``, ``(0,)``, ``(pi,)`` or both."""
+        poles = {"south": (0.0,), "north": (math.pi,), "both": (0.0, math.pi)}
+        return () if self.pole is None else poles.get(self.pole, ())
+
+    @overload
+    def d2U(self, theta: float) -> float: ...
+    @overload
+    def d2U(self, theta: FloatArray) -> FloatArray: ...
+    def d2U(self, theta: float | FloatArray) -> float | FloatArray:
+        """``d^2U/dtheta^2`` by the complex step ``Im dU(theta + i h)/h`` (exact to round-off)."""
+        z: ComplexArray = np.asarray(theta, dtype=float) + 1j * _COMPLEX_STEP
+        return np.imag(self.dU(z)) / _COMPLEX_STEP  # a numpy float for a float theta
+
+    def v_tau(self, theta: Real) -> Real:
+        """``v_tau = P / I1`` (:meth:`P`)."""
+        return self.P(theta) / self.body.I1
+
+    @overload
+    @staticmethod
+    def theta_of(gamma3: float) -> float: ...
+    @overload
+    @staticmethod
+    def theta_of(gamma3: FloatArray) -> FloatArray: ...
+    @staticmethod
+    def theta_of(gamma3: float | FloatArray) -> float | FloatArray:
+        """``theta = arccos(gamma3)`` in ``[0, pi]`` (unsigned, the paper's branch)."""
+        g = np.asarray(gamma3, dtype=float)
+        theta: float | FloatArray = np.arccos(np.clip(g, -1.0, 1.0))  # numpy float for a float
+        return theta
+
+    def U_gamma3(self, gamma3: Real) -> Real:
+        """``U(gamma3)``, for ``gamma3`` in ``(-1, 1)`` (and at the pole of a pole case)."""
+        return self.U(self.theta_of(gamma3))
+
+    def energy(self, theta: Real, w_tau: Real) -> Real:
+        """Reduced energy ``h = rho w_tau^2 / 2 + U`` at ``(theta, w_tau)`` (arrays broadcast)."""
+        return self.U(theta) + 0.5 * self.rho(theta) * w_tau * w_tau
+
+    def w_tau(self, theta: Real, h: float, gap: Real | None = None) -> Real:
+        """``|w_tau| = sqrt(2 (h - U) / rho)`` at ``theta`` on the orbit of reduced energy ``h``
+        (:meth:`energy` solved for ``w_tau``; the sign is the branch), 0 where ``h < U``.
+
+        ``gap`` replaces ``h - U(theta)`` where it is known more accurately (next to a turning
+        point, :func:`rollingtop.reduction._quadrature.energy_gap`).
+        """
+        if gap is None:
+            gap = h - self.U(theta)
+        w_tau: Real = np.sqrt(np.maximum(2 * gap / self.rho(theta), 0.0))
+        return w_tau
+
+    def flow(self, theta: Real, w_tau: Real) -> tuple[Real, Real]:
+        """The equations of motion ``(theta', w_tau')`` on the level set:
+
+            theta' = -w_tau,    w_tau' = (U'(theta) + rho'(theta) w_tau^2 / 2) / rho,
+
+        from ``h = rho theta'^2 / 2 + U`` conserved; regular through the pole of a pole case.
+        """
+        w_tau_dot: Real = (self.dU(theta) + 0.5 * self.drho(theta) * w_tau**2) / self.rho(theta)
+        return -w_tau, w_tau_dot
+
+    def curvature_eigenvalues(self, gamma3: float) -> ComplexArray:
+        """``+-sqrt(-U''/rho)`` and 0 at the steady motion at ``gamma3``: the one degree of
+        freedom ``(theta, w_tau)`` linearised, the level's integrals held."""
+        theta = math.acos(gamma3)
+        root = np.sqrt(complex(-float(self.d2U(theta)) / float(self.rho(theta))))
+        return np.array([root, -root, 0.0], dtype=complex)
+
+    def pole_label(self) -> str:
+        """The pole case in words, for :meth:`describe` (empty for no pole case)."""
+        return {
+            None: "",
+            "south": " (south pole case)",
+            "north": " (north pole case)",
+            "both": " (no spin: both poles)",
+        }[self.pole]
+
+    def _repr_html_(self) -> str:
+        """The notebook's view: model, integrals, body, the steady motions' count."""
+        return html_view(self)
+
+    def plot(self, ax: Axes | None = None, **kw: Any) -> Axes:
+        """Draw the phase portrait of ``rollingtop portrait`` (upper panel) on ``ax`` (default:
+        a new figure's) and return ``ax``; ``kw`` go to
+        :func:`rollingtop.plot.portrait.draw_portrait` (``h_levels``, ``show_contact``)."""
+        axes: Axes = draw("portrait", ax, self, **kw)
+        return axes
 
     def normal_force(self, theta: Real, w_tau: Real) -> Real:
         """The plane's normal force at ``(theta, w_tau)`` on the level: the centre of mass is at

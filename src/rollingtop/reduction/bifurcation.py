@@ -74,7 +74,7 @@ from rollingtop.reduction._regions import (
     region_signature,
 )
 from rollingtop.reduction._steady_map import SteadyCountMap, steady_count_map
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSet, LevelSetError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -170,7 +170,7 @@ class BifurcationDiagram:
         return axes
 
 
-def _default_c2_range(level: LevelSet, fs: Sequence[Fold]) -> tuple[float, float]:
+def _default_c2_range(level: Level, fs: Sequence[Fold]) -> tuple[float, float]:
     if fs:
         lo, hi = min(f.C2 for f in fs), max(f.C2 for f in fs)
     else:

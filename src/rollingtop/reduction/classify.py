@@ -25,7 +25,7 @@ from rollingtop._errors import RollingTopError, ScenarioError
 from rollingtop._json import finite_or_none, json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSetError
 from rollingtop.reduction.models import REDUCTIONS, reduction_of
 from rollingtop.reduction.orbits import Orbit, orbits
 from rollingtop.reduction.steady import SteadyMotion, steady_motions
@@ -102,7 +102,7 @@ def _plain(a: NDArray[Any]) -> list[Any]:
 
 
 def critical_values(
-    level: LevelSet,
+    level: Level,
     *,
     axis: str | None = None,
     window: tuple[float, float] | None = None,
@@ -159,7 +159,7 @@ class ModelClassification:
     steady motions and its critical values (:func:`critical_values`)."""
 
     model: str
-    level: LevelSet
+    level: Level
     h: float
     state: FloatArray
     orbit: Orbit | None
@@ -343,7 +343,7 @@ class RotationGrid:
 
 
 def rotation_grid(
-    level: LevelSet,
+    level: Level,
     *,
     window: tuple[float, float] | None = None,
     h_range: tuple[float, float] | None = None,

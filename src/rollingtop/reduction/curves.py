@@ -25,7 +25,7 @@ import numpy as np
 from rollingtop._types import FloatArray
 from rollingtop.reduction._orbit import Orbit
 from rollingtop.reduction._quadrature import energy_gap
-from rollingtop.reduction.level import LevelSet, LevelSetError, Real
+from rollingtop.reduction.level import Level, LevelSetError, Real
 from rollingtop.reduction.orbits import orbits
 from rollingtop.reduction.steady import steady_motions
 
@@ -48,7 +48,7 @@ ORBIT_POINTS = 400
 SAME_LEVEL_RTOL = 1e-12
 
 
-def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
+def default_h_levels(level: Level, count: int = 10) -> list[float]:
     """``count`` energies from just above the lowest steady motion to half again past the highest
     saddle (or, without saddles, a band above the minimum), plus the saddles' levels.
 
@@ -71,7 +71,7 @@ def default_h_levels(level: LevelSet, count: int = 10) -> list[float]:
     return sorted({*map(float, levels), *saddles})
 
 
-def abscissa(level: LevelSet, theta: Real) -> Real:
+def abscissa(level: Level, theta: Real) -> Real:
     """The portrait's abscissa at ``theta``: ``gamma3 = cos(theta)``, or ``theta`` itself in a
     pole case (same shape)."""
     if level.pole:
@@ -81,7 +81,7 @@ def abscissa(level: LevelSet, theta: Real) -> Real:
 
 
 def orbit_curve(
-    level: LevelSet, h: float, orbit: Orbit, n: int = ORBIT_POINTS
+    level: Level, h: float, orbit: Orbit, n: int = ORBIT_POINTS
 ) -> tuple[FloatArray, FloatArray]:
     """The closed curve ``(abscissa, w_tau)`` of ``orbit`` at energy ``h``.
 
@@ -105,7 +105,7 @@ def orbit_curve(
 
 
 def level_curves(
-    level: LevelSet, h: float, n: int = ORBIT_POINTS
+    level: Level, h: float, n: int = ORBIT_POINTS
 ) -> list[tuple[FloatArray, FloatArray]]:
     """The closed curve (:func:`orbit_curve`) of every orbit of ``level`` at energy ``h`` that
     is not a steady motion; none where ``h`` has no motion."""
@@ -116,7 +116,7 @@ def level_curves(
     return [orbit_curve(level, h, o, n) for o in found if o.kind != "steady"]
 
 
-def normal_force_grid(level: LevelSet, g3: FloatArray, w: FloatArray) -> FloatArray:
+def normal_force_grid(level: Level, g3: FloatArray, w: FloatArray) -> FloatArray:
     """Normal reaction at the states ``(gamma3, w_tau)`` of the level set, shape
     ``(len(w), len(g3))``, in closed form (:meth:`rollingtop.reduction.LevelSet.normal_force`;
     no compiled code)."""
@@ -169,7 +169,7 @@ def on_a_saddle(h: float, saddle_levels: set[float]) -> bool:
     return any(abs(h - u) <= SAME_LEVEL_RTOL * max(1.0, abs(u)) for u in saddle_levels)
 
 
-def portrait_curves(level: LevelSet, levels: Sequence[float]) -> PortraitCurves:
+def portrait_curves(level: Level, levels: Sequence[float]) -> PortraitCurves:
     """The closed curve of every orbit at the energies ``levels`` and their window.
 
     Raises

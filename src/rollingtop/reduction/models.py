@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,7 +34,7 @@ from rollingtop._errors import ScenarioError
 from rollingtop._layout import W
 from rollingtop.body import SphericalTop
 from rollingtop.contact import MODELS, ContactModel, get_model
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSet, LevelSetError
 from rollingtop.reduction.rough import RoughLevel, rough_integrals
 from rollingtop.reduction.rubber import RubberLevel, rubber_integrals
 from rollingtop.reduction.shell_rotor import ShellRotorLevel, shell_rotor_integrals
@@ -65,7 +66,7 @@ class Reduction:
     """
 
     model: str
-    level_type: type[LevelSet]
+    level_type: type[Level]
     integrals: Callable[[SphericalTop, ArrayLike], dict[str, NDArray[np.float64]]]
     energy: str
     sources: str
@@ -75,9 +76,7 @@ class Reduction:
         """The names of the integrals that fix a level."""
         return self.level_type.integrals
 
-    def level(
-        self, body: SphericalTop, values: Mapping[str, float], scale: float = 0.0
-    ) -> LevelSet:
+    def level(self, body: SphericalTop, values: Mapping[str, float], scale: float = 0.0) -> Level:
         """The level set of ``body`` with the integrals ``values`` (every name of
         :attr:`names`; a missing or unknown one is a :class:`ScenarioError` listing them)."""
         missing = [n for n in self.names if n not in values]
@@ -89,9 +88,10 @@ class Reduction:
                 f"{', '.join(self.names)} ({what})"
             )
         given = {n: float(values[n]) for n in self.names}
-        return self.level_type(body, **given, scale=scale)
+        make = cast("Callable[..., Level]", self.level_type)  # a concrete kind, not Level
+        return make(body, **given, scale=scale)
 
-    def level_of_state(self, body: SphericalTop, y: ArrayLike) -> LevelSet:
+    def level_of_state(self, body: SphericalTop, y: ArrayLike) -> Level:
         """The level set the state ``y`` (shape (18,)) lies on; ``|I w|`` is the round-off scale
         of ``M3`` and ``C1`` in the pole decision (:class:`~rollingtop.reduction.LevelSet`)."""
         y = np.asarray(y, dtype=float)

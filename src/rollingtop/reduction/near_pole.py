@@ -34,7 +34,7 @@ import numpy as np
 
 from rollingtop._json import json_ready
 from rollingtop.reduction._quadrature import WALL_RATIO, half_integral, half_map, period
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSet, LevelSetError
 from rollingtop.reduction.orbits import Orbit, canonical_orbit, near_north, orbits
 
 __all__ = ["NEAR_POLE", "NearPole", "near_pole", "friction_needed"]
@@ -94,7 +94,7 @@ class NearPole:
 
 
 def friction_needed(
-    level: LevelSet, h: float, orbit: Orbit, samples: int = 400
+    level: Level, h: float, orbit: Orbit, samples: int = 400
 ) -> tuple[float, float]:
     """``(max |F_t| / N, min N)`` over the orbit: the friction coefficient the meridian
     constraint needs and the smallest normal force, from the contact reaction of the full
@@ -107,7 +107,7 @@ def friction_needed(
     return _friction(lv, h, o, samples)
 
 
-def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[float, float]:
+def _friction(lv: Level, h: float, o: Orbit, samples: int = 400) -> tuple[float, float]:
     """:func:`friction_needed` on the canonical level and orbit (``canonical_orbit``)."""
     from rollingtop._compiled import compiling, for_model
     from rollingtop._jit import call
@@ -139,19 +139,21 @@ def _friction(lv: LevelSet, h: float, o: Orbit, samples: int = 400) -> tuple[flo
     return float(np.max(ratio)), float(np.min(N))
 
 
-def near_pole(level: LevelSet, h: float, orbit: Orbit) -> NearPole | None:
+def near_pole(level: Level, h: float, orbit: Orbit) -> NearPole | None:
     """The limits of ``orbit`` on the pole level it is near (module docstring), or ``None``:
     for another model's level (its own limits are not derived), when the level is not within
     :data:`NEAR_POLE` of a pole level, or when the orbit does not reach the wall (its end is
     not within ``WALL_RATIO`` of its width from the pole)."""
     if level.pole is not None or orbit.kind != "periodic" or not level.near_pole_limits:
         return None  # the limits are the meridian model's (its pole levels, its reactions)
+    assert isinstance(level, LevelSet)  # the one kind with near_pole_limits
     M3, C1 = level.M3, level.C1
     north = near_north(level)
     offset = C1 + M3 if north else C1 - M3
     if abs(offset) > NEAR_POLE * max(abs(M3), abs(C1)):
         return None
     lv, o = canonical_orbit(level, h, orbit)  # the pole at theta = 0
+    assert isinstance(lv, LevelSet)  # the mirror image of a meridian level is one
     if not o.theta_min < WALL_RATIO * (o.theta_max - o.theta_min):
         return None
     pole_level = LevelSet(lv.body, lv.M3, lv.M3, lv.C2)

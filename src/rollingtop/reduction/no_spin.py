@@ -39,13 +39,13 @@ from rollingtop.reduction._quadrature import (
     period,
     time_density,
 )
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSetError
 from rollingtop.reduction.steady import steady_motion
 
 __all__ = ["no_spin_orbits", "rolling_over_period"]
 
 
-def _poles(level: LevelSet) -> tuple[float, float] | None:
+def _poles(level: Level) -> tuple[float, float] | None:
     """``(theta of the centre, theta of the saddle)``, or ``None`` when ``U`` is constant."""
     b = level.body
     k = b.m * b.g * b.a3
@@ -54,7 +54,7 @@ def _poles(level: LevelSet) -> tuple[float, float] | None:
     return (math.pi, 0.0) if k > 0 else (0.0, math.pi)
 
 
-def rolling_over_period(level: LevelSet, h: float, weight: Weight = None) -> tuple[float, float]:
+def rolling_over_period(level: Level, h: float, weight: Weight = None) -> tuple[float, float]:
     """Period of a rolling-over motion: ``integral over theta in [t_s, t_s + 2 pi]`` of
     ``sqrt(rho / (2 (h - U)))`` (``t_s`` the saddle, where the integrand peaks). Returns
     ``(value, estimated absolute error)``."""
@@ -77,7 +77,7 @@ def rolling_over_period(level: LevelSet, h: float, weight: Weight = None) -> tup
     return fine, abs(fine - coarse)
 
 
-def no_spin_orbits(level: LevelSet, h: float) -> list[Orbit]:
+def no_spin_orbits(level: Level, h: float) -> list[Orbit]:
     """The orbits on the no-spin level at reduced energy ``h`` (module docstring): one rocking,
     rolling-over, separatrix or steady motion.
 

@@ -32,7 +32,7 @@ from rollingtop.reduction._orbit import (
     turning_point,
 )
 from rollingtop.reduction._quadrature import PERIOD_RTOL, WALL_RATIO, half_integral, period
-from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
+from rollingtop.reduction.level import Level, LevelSetError, near_north
 from rollingtop.reduction.no_spin import no_spin_orbits
 from rollingtop.reduction.steady import SteadyMotion, critical_points, steady_motion
 
@@ -41,7 +41,7 @@ __all__ += ["PERIOD_RTOL", "WALL_RATIO", "SEPARATRIX_TOLERANCE", "STEADY_TOLERAN
 
 
 def _barrier_end(
-    level: LevelSet, h: float, end: float, inward: float, crit: Sequence[float], named: str
+    level: Level, h: float, end: float, inward: float, crit: Sequence[float], named: str
 ) -> float:
     """A point near a domain end where ``U > h`` (the potential's barrier), nearer the end than
     every critical point ``crit`` of ``U`` (a motion within 1e-7 of a pole has its centre
@@ -63,7 +63,7 @@ def _barrier_end(
     )
 
 
-def orbits(level: LevelSet, h: float) -> Orbits:
+def orbits(level: Level, h: float) -> Orbits:
     """All connected components of the level set ``(M3, C1, C2, h)``, sorted by ``gamma3_min``
     (a list that knows ``level`` and ``h``: :class:`Orbits`).
 
@@ -98,7 +98,7 @@ def _mirror(o: Orbit) -> Orbit:
     )
 
 
-def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, Orbit]:
+def canonical_orbit(level: Level, h: float, orbit: Orbit) -> tuple[Level, Orbit]:
     """The level and orbit on which quadratures of ``orbit`` are most accurate: the mirror image
     for a level near the north pole (:func:`near_north`), where the turning point next to the
     pole is known to its full relative precision; else ``(level, orbit)``."""
@@ -116,7 +116,7 @@ def canonical_orbit(level: LevelSet, h: float, orbit: Orbit) -> tuple[LevelSet, 
     return mirrored, best
 
 
-def _orbits(level: LevelSet, h: float, named: str | None = None) -> list[Orbit]:
+def _orbits(level: Level, h: float, named: str | None = None) -> list[Orbit]:
     """The orbits of ``level`` at ``h``; ``named``: the level as messages name it (default
     ``level.describe()``; the user's level where ``level`` is its mirror image)."""
     found = _components(level, h, level.describe() if named is None else named)
@@ -125,7 +125,7 @@ def _orbits(level: LevelSet, h: float, named: str | None = None) -> list[Orbit]:
     return found
 
 
-def _components(level: LevelSet, h: float, named: str) -> list[Orbit]:
+def _components(level: Level, h: float, named: str) -> list[Orbit]:
     lo_end, hi_end = level.theta_domain
     inside = [t for t in critical_points(level) if lo_end < t < hi_end]
     lo = _barrier_end(level, h, lo_end, +1, inside, named)
@@ -167,7 +167,7 @@ def _components(level: LevelSet, h: float, named: str) -> list[Orbit]:
 
 
 def _make_orbit(
-    level: LevelSet,
+    level: Level,
     h: float,
     t1: float,
     t2: float,

@@ -34,7 +34,7 @@ from rollingtop._json import json_ready
 from rollingtop.body import SphericalTop
 from rollingtop.reduction._quadrature import period
 from rollingtop.reduction._roots import brentq
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSet, LevelSetError
 from rollingtop.reduction.orbits import Orbit, canonical_orbit, orbits
 from rollingtop.reduction.steady import SteadyMotion, critical_points
 
@@ -58,7 +58,7 @@ MAX_DENOMINATOR = 12
 CURVE_DENOMINATOR = 3
 
 
-def rotation_number(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, float]:
+def rotation_number(level: Level, h: float, orbit: Orbit) -> tuple[float, float]:
     """``N = Delta psi / (2 pi)`` of a periodic orbit on ``level`` at energy ``h``, with its
     estimated absolute error (the quadrature of ``psi'`` over a period, as for the period)."""
     if orbit.kind != "periodic":
@@ -77,7 +77,7 @@ def rotation_number(level: LevelSet, h: float, orbit: Orbit) -> tuple[float, flo
     return dpsi / (2 * math.pi), err / (2 * math.pi)
 
 
-def rotation_numbers(level: LevelSet, h: float) -> list[float]:
+def rotation_numbers(level: Level, h: float) -> list[float]:
     """``N`` of each periodic orbit of the level ``h`` (in order of increasing ``gamma3``)."""
     return [rotation_number(level, h, o)[0] for o in orbits(level, h) if o.kind == "periodic"]
 
@@ -164,7 +164,7 @@ def _fractions_between(a: float, b: float, max_q: int) -> list[Fraction]:
     return sorted(out)
 
 
-def _offset(h: float, level: LevelSet, k: int, count: int, target: float) -> float:
+def _offset(h: float, level: Level, k: int, count: int, target: float) -> float:
     """``N - target`` of the ``k``-th of ``count`` orbits at ``h`` (for Brent's method)."""
     return _family_n(level, h, k, count) - target
 
@@ -185,7 +185,7 @@ def _family_steps(
 
 
 def _solve_level(
-    level: LevelSet,
+    level: Level,
     bracket: tuple[float, float],
     k: int,
     count: int,
@@ -201,7 +201,7 @@ def _solve_level(
     return h
 
 
-def _family_n(level: LevelSet, h: float, k: int, count: int) -> float:
+def _family_n(level: Level, h: float, k: int, count: int) -> float:
     """``N`` of the ``k``-th of ``count`` periodic orbits at ``h`` (NaN if the count differs)."""
     periodic = [o for o in orbits(level, h) if o.kind == "periodic"]
     if len(periodic) != count:

@@ -53,12 +53,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
-from rollingtop.reduction._services import check_level_size, check_level_values
-from rollingtop.reduction.level import (
-    LevelSet,
-    Real,
+from rollingtop.reduction._services import (
     _Analytic,
     _AnalyticResult,
+    check_level_size,
+    check_level_values,
+)
+from rollingtop.reduction.level import (
+    Level,
+    Real,
+    RollingMass,
 )
 
 __all__ = ["RoughLevel", "rough_integrals"]
@@ -69,10 +73,10 @@ POLE_LEVEL_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True, kw_only=True)
-class RoughLevel(LevelSet):
-    """A level set ``(jellett, routh)`` of Routh's sphere (module docstring): the methods of
-    :class:`~rollingtop.reduction.LevelSet` with the rough model's potential, spin and
-    centre-of-mass velocity. ``M3, C1, C2`` are not integrals of this model (0)."""
+class RoughLevel(RollingMass, Level):
+    """A level set ``(jellett, routh)`` of Routh's sphere (module docstring): the rough model's
+    potential, spin and centre-of-mass velocity, with the rolling body's mass
+    (:class:`~rollingtop.reduction.level.RollingMass`)."""
 
     integrals: ClassVar[tuple[str, ...]] = ("jellett", "routh")
     model: ClassVar[str] = "rough"
@@ -81,18 +85,16 @@ class RoughLevel(LevelSet):
     pole_advice: ClassVar[str] = "for the pole level set jellett = -I3 (R +- a3) w3 exactly"
 
     #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
-    #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
-    M3: float = field(default=0.0, init=False)
-    C1: float = field(default=0.0, init=False)
-    C2: float = field(default=0.0, init=False)
+    #: order (``M3, C1, C2``) is refused.
+    body: SphericalTop = field(kw_only=False)
     scale: float = 0.0
+    #: Set at construction: the pole levels (module docstring).
+    pole: str | None = field(init=False, repr=False, compare=False)
     jellett: float
     routh: float
 
     def __post_init__(self) -> None:
         check_level_values(self, ("jellett", "routh"))
-        for name in ("M3", "C1", "C2"):
-            object.__setattr__(self, name, 0.0)
         # values read from a state: round-off of |I w| |r| (scale) counts as zero
         size = max(
             abs(self.jellett),
@@ -223,7 +225,7 @@ class RoughLevel(LevelSet):
         )
         return out
 
-    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
+    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:
         """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model); on a pole level
         finite at the pole (``w_n ~ s``): its limit there."""
         parts = self._parts(theta)  # s of the mirror image (pi - theta) for the north pole
@@ -252,12 +254,18 @@ class RoughLevel(LevelSet):
             "both": " (no spin: both poles)",
         }[self.pole]
 
-    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here (``M3 = 0``).
+    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here.
     energy_formula: ClassVar[str] = "h + m g R"
 
+    def full_energy(self, h: float) -> float:
+        """The energy ``E = h + m g R`` of the full system at reduced energy ``h`` (the spin's
+        energy is in ``U``)."""
+        b = self.body
+        return h + b.m * b.g * b.R
+
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
-    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
-    linearised_eigenvalues = LevelSet.curvature_eigenvalues
+    #: own linearisation (:meth:`~rollingtop.reduction.Level.curvature_eigenvalues`).
+    linearised_eigenvalues = Level.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -51,13 +51,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
-from rollingtop.reduction._services import check_level_size, check_level_values
-from rollingtop.reduction.level import (
-    POLE_TOLERANCE,
-    LevelSet,
-    Real,
+from rollingtop.reduction._services import (
     _Analytic,
     _AnalyticResult,
+    check_level_size,
+    check_level_values,
+)
+from rollingtop.reduction.level import (
+    POLE_TOLERANCE,
+    Level,
+    Real,
+    RollingMass,
 )
 
 __all__ = ["RubberLevel", "rubber_integrals"]
@@ -66,12 +70,12 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True, kw_only=True)
-class RubberLevel(LevelSet):
+class RubberLevel(RollingMass, Level):
     """A level set ``rubber_spin = F`` of a body of revolution rolling without slipping or
-    spinning (module docstring): the methods of :class:`~rollingtop.reduction.LevelSet` with the
-    rubber model's potential, spin and centre-of-mass velocity. ``M3, C1, C2`` are not integrals
-    of this model (0). ``F`` within :data:`~rollingtop.reduction.level.POLE_TOLERANCE` of the
-    level's ``scale`` (``|I w|`` of a state) is the pole level ``F = 0`` (``pole = "both"``)."""
+    spinning (module docstring): the rubber model's potential, spin and centre-of-mass velocity,
+    with the rolling body's mass (:class:`~rollingtop.reduction.level.RollingMass`). ``F``
+    within :data:`~rollingtop.reduction.level.POLE_TOLERANCE` of the level's ``scale`` (``|I w|``
+    of a state) is the pole level ``F = 0`` (``pole = "both"``)."""
 
     integrals: ClassVar[tuple[str, ...]] = ("rubber_spin",)
     model: ClassVar[str] = "rubber"
@@ -80,18 +84,16 @@ class RubberLevel(LevelSet):
     pole_advice: ClassVar[str] = "for the pole level set rubber_spin = 0 exactly"
 
     #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
-    #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
-    M3: float = field(default=0.0, init=False)
-    C1: float = field(default=0.0, init=False)
-    C2: float = field(default=0.0, init=False)
+    #: order (``M3, C1, C2``) is refused.
+    body: SphericalTop = field(kw_only=False)
     scale: float = 0.0
+    #: Set at construction: the pole levels (module docstring).
+    pole: str | None = field(init=False, repr=False, compare=False)
     rubber_spin: float
 
     def __post_init__(self) -> None:
         check_level_values(self, ("rubber_spin",))
         F = self.rubber_spin
-        for name in ("M3", "C1", "C2"):
-            object.__setattr__(self, name, 0.0)
         # the round-off of a value read from a state: |F| <~ |w| sqrt(I3 J) <~ |I w| * O(1)
         scale = abs(float(self.scale)) * math.sqrt(
             1.0 + self.body.m * self.body.R**2 / min(self.body.I1, self.body.I3)
@@ -165,7 +167,7 @@ class RubberLevel(LevelSet):
         out: _AnalyticResult = -(F * F) * np.cos(theta) / (b.I3 * np.sin(theta) ** 3) + gravity
         return out
 
-    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
+    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:
         """Precession rate ``psi' = -w_n / s = -Omega cos / sin`` (kinematics; 0 on
         ``F = 0``)."""
         if self.pole == "both":
@@ -174,12 +176,18 @@ class RubberLevel(LevelSet):
         rate: float | FloatArray = -self.w_n(t) / np.sin(t)
         return rate
 
-    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here (``M3 = 0``).
+    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here.
     energy_formula: ClassVar[str] = "h + m g R"
 
+    def full_energy(self, h: float) -> float:
+        """The energy ``E = h + m g R`` of the full system at reduced energy ``h`` (the spin's
+        energy is in ``U``)."""
+        b = self.body
+        return h + b.m * b.g * b.R
+
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
-    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
-    linearised_eigenvalues = LevelSet.curvature_eigenvalues
+    #: own linearisation (:meth:`~rollingtop.reduction.Level.curvature_eigenvalues`).
+    linearised_eigenvalues = Level.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""

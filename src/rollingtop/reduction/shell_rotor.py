@@ -56,14 +56,17 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import pair_weight
-from rollingtop.reduction._services import check_level_size, check_level_values
+from rollingtop.reduction._services import (
+    _Analytic,
+    _AnalyticResult,
+    check_level_size,
+    check_level_values,
+)
 from rollingtop.reduction.level import (
-    LevelSet,
+    Level,
     LevelSetError,
     PoleLevelError,
     Real,
-    _Analytic,
-    _AnalyticResult,
 )
 
 __all__ = ["ShellRotorLevel", "shell_rotor_integrals"]
@@ -74,9 +77,8 @@ POLE_LEVEL_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True, kw_only=True)
-class ShellRotorLevel(LevelSet):
-    """A level set ``(M3, jellett, C2)`` of the shell-rotor pair (module docstring); ``C1`` is
-    not an integral of the pair (0)."""
+class ShellRotorLevel(Level):
+    """A level set ``(M3, jellett, C2)`` of the shell-rotor pair (module docstring)."""
 
     integrals: ClassVar[tuple[str, ...]] = ("M3", "jellett", "C2")
     model: ClassVar[str] = "shell-rotor"
@@ -87,16 +89,19 @@ class ShellRotorLevel(LevelSet):
     )
 
     #: Keyword-only: only ``body`` is positional, so a value given in the meridian model's
-    #: order (``M3, C1, C2``) is refused instead of landing in a field this model ignores.
+    #: order (``M3, C1, C2``) is refused.
+    body: SphericalTop = field(kw_only=False)
     M3: float
-    C1: float = field(default=0.0, init=False)
     C2: float
     scale: float = 0.0
     jellett: float
+    #: Set at construction: the pole levels (module docstring).
+    pole: str | None = field(init=False, repr=False, compare=False)
+    #: :meth:`full_energy` in words.
+    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
 
     def __post_init__(self) -> None:
         check_level_values(self, ("M3", "jellett", "C2"))
-        object.__setattr__(self, "C1", 0.0)
         b = self.body
         if not b.has_shell:
             raise LevelSetError(
@@ -238,6 +243,16 @@ class ShellRotorLevel(LevelSet):
             jellett=self.jellett,
         )
 
+    def spin(self, theta: Real) -> Real:
+        """The rotor's spin ``w3 = M3 / I3``, constant (its Lagrange integral)."""
+        out: Real = self.M3 / self.body.I3 + 0.0 * theta
+        return out
+
+    def full_energy(self, h: float) -> float:
+        """The pair's energy ``E = h + M3^2 / (2 I3) + m g R`` at reduced energy ``h``."""
+        b = self.body
+        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
+
     def omega3(self, theta: Real) -> Real:
         """The shell's spin about the axis, ``Omega3 = (C2 - R M3 Phi) / sqrt(N)``."""
         out: Real = self._parts(theta)[3]
@@ -301,7 +316,13 @@ class ShellRotorLevel(LevelSet):
         out: Real = b.rho(np.cos(theta)) + b.shell_inertia + b.shell_mass * b.R**2
         return out
 
-    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:  # type: ignore[override]
+    def drho(self, theta: Real) -> Real:
+        """``d rho_p / dtheta = -2 m a3 R sin(theta)`` (the shell's terms are constant)."""
+        b = self.body
+        out: Real = -2 * b.m * b.a3 * b.R * np.sin(theta)
+        return out
+
+    def psi_dot(self, theta: float | FloatArray) -> float | FloatArray:
         """Precession rate ``psi' = -w_n / s`` (kinematics, as for every model); on a pole level
         finite at the pole (:meth:`_w_n_over_s`)."""
         if self.pole == "north":  # w_n kept, s the mirror's
@@ -332,8 +353,8 @@ class ShellRotorLevel(LevelSet):
         return N
 
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
-    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
-    linearised_eigenvalues = LevelSet.curvature_eigenvalues
+    #: own linearisation (:meth:`~rollingtop.reduction.Level.curvature_eigenvalues`).
+    linearised_eigenvalues = Level.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""

@@ -26,19 +26,24 @@ is 0.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
-from rollingtop.reduction.level import (
-    LevelSet,
-    LevelSetError,
-    Real,
+from rollingtop.reduction._services import (
     _Analytic,
     _AnalyticResult,
+    check_level_size,
+    check_level_values,
+)
+from rollingtop.reduction.level import (
+    Level,
+    LevelSetError,
+    Real,
+    SpinAndArea,
 )
 
 __all__ = ["SmoothLevel", "smooth_integrals"]
@@ -47,21 +52,27 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class SmoothLevel(LevelSet):
-    """A level set ``(M3, C1)`` of the Lagrange and area integrals on a smooth plane (module
-    docstring); the methods of :class:`~rollingtop.reduction.LevelSet` with the smooth model's
-    potential and mass. ``C2`` is not an integral of this model: it is 0."""
+class SmoothLevel(SpinAndArea, Level):
+    """A level set ``(M3, C1, p_horizontal)`` of the Lagrange and area integrals and the size of
+    the horizontal momentum on a smooth plane (module docstring): the spin, ``w_n``, the
+    precession and the pole cases ``C1 = +-M3`` of the meridian model's
+    (:class:`~rollingtop.reduction.level.SpinAndArea`), with the smooth model's potential and
+    mass."""
 
     integrals: ClassVar[tuple[str, ...]] = ("M3", "C1", "p_horizontal")
     model: ClassVar[str] = "smooth"
-    near_pole_limits: ClassVar[bool] = False
+    pole_advice: ClassVar[str] = "for the pole case set C1 = +-M3 exactly; or rescale M3, C1"
 
-    C2: float = 0.0
+    body: SphericalTop
+    M3: float
+    C1: float
     #: The size ``m |v_horizontal|`` of the horizontal momentum (its direction is free).
-    p_horizontal: float = 0.0
+    p_horizontal: float = field(default=0.0, kw_only=True)
+    scale: float = field(default=0.0, kw_only=True)
+    #: Set from ``(M3, C1)`` at construction (:class:`~rollingtop.reduction.LevelSet`'s).
+    pole: str | None = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "C2", 0.0)
         p = self.p_horizontal
         if isinstance(p, bool) or not isinstance(p, int | float | np.floating | np.integer):
             raise LevelSetError(f"level p_horizontal = {p!r} must be a number")
@@ -71,7 +82,9 @@ class SmoothLevel(LevelSet):
                 "of the horizontal momentum)"
             )
         object.__setattr__(self, "p_horizontal", float(p))
-        super().__post_init__()
+        check_level_values(self, ("M3", "C1"))
+        self._decide_pole()
+        check_level_size(self)
 
     def mirrored(self) -> SmoothLevel:
         """The same motions with the body axis reversed: ``theta -> pi - theta``, ``a3 -> -a3``,
@@ -129,8 +142,8 @@ class SmoothLevel(LevelSet):
         return self.p_horizontal / self.body.m
 
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
-    #: own linearisation (:meth:`~rollingtop.reduction.LevelSet.curvature_eigenvalues`).
-    linearised_eigenvalues = LevelSet.curvature_eigenvalues
+    #: own linearisation (:meth:`~rollingtop.reduction.Level.curvature_eigenvalues`).
+    linearised_eigenvalues = Level.curvature_eigenvalues
 
     def describe(self) -> str:
         """One line naming the level set."""

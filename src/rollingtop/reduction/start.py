@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._layout import W
 from rollingtop.body import SphericalTop
-from rollingtop.reduction.level import LevelSet
+from rollingtop.reduction.level import Level, LevelSet
 from rollingtop.reduction.orbits import orbits
 from rollingtop.reduction.variables import reduced_integrals, state_from_level
 
@@ -34,7 +34,7 @@ def _meridian_default(name: str) -> None:
     )
 
 
-def level_of_state(body: SphericalTop, y: ArrayLike, model: str | None = None) -> LevelSet:
+def level_of_state(body: SphericalTop, y: ArrayLike, model: str | None = None) -> Level:
     """The level set of the state ``y`` under ``model``
     (:meth:`rollingtop.reduction.models.Reduction.level_of_state`); for the meridian model
     ``(M3, C1, C2)`` with ``y`` of shape (18,).
@@ -99,7 +99,7 @@ def level_energy(body: SphericalTop, M3: float, h: float) -> float:
 
 
 def start_on_level(
-    level: LevelSet,
+    level: Level,
     h: float,
     *,
     gamma3: float | None = None,

@@ -22,7 +22,7 @@ from rollingtop._figures import draw
 from rollingtop._html import html_view
 from rollingtop._json import json_ready
 from rollingtop.reduction._roots import brentq
-from rollingtop.reduction.level import LevelSet, LevelSetError, near_north
+from rollingtop.reduction.level import Level, LevelSetError, near_north
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -100,7 +100,7 @@ class SteadyMotions(list[SteadyMotion]):
     level : LevelSet
     """
 
-    def __init__(self, motions: Iterable[SteadyMotion], level: LevelSet) -> None:
+    def __init__(self, motions: Iterable[SteadyMotion], level: Level) -> None:
         super().__init__(motions)
         self.level = level
 
@@ -118,7 +118,7 @@ class SteadyMotions(list[SteadyMotion]):
         return axes
 
 
-def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
+def _grid(level: Level, points: int = GRID_POINTS) -> NDArray[np.float64]:
     lo, hi = level.theta_domain
     # Chebyshev-like spacing clusters points near the barriers, where U varies fastest.
     x = np.cos(np.linspace(math.pi, 0.0, points))
@@ -134,7 +134,7 @@ def _grid(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
     return grid
 
 
-def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.float64]:
+def critical_points(level: Level, points: int = GRID_POINTS) -> NDArray[np.float64]:
     """All zeros of ``dU/dtheta`` inside the theta domain, increasing (read-only: the last
     levels' are kept, as every orbit of a level asks for them again; a level is a frozen value).
 
@@ -149,7 +149,7 @@ def critical_points(level: LevelSet, points: int = GRID_POINTS) -> NDArray[np.fl
 
 
 @functools.lru_cache(maxsize=128)
-def _critical_points(level: LevelSet, points: int) -> NDArray[np.float64]:
+def _critical_points(level: Level, points: int) -> NDArray[np.float64]:
     grid = _grid(level, points)[1:-1]
     with np.errstate(all="ignore"):
         d = level.dU(grid)
@@ -175,7 +175,7 @@ def _critical_points(level: LevelSet, points: int) -> NDArray[np.float64]:
 STABLE_TOLERANCE = 1e-6
 
 
-def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex128]:
+def linearised_eigenvalues(level: Level, gamma3: float) -> NDArray[np.complex128]:
     """Eigenvalues of the full equations linearised at the steady rolling at ``gamma3``.
 
     A steady rolling of the symmetric body is a relative equilibrium: in the body frame ``gamma``
@@ -189,7 +189,7 @@ def linearised_eigenvalues(level: LevelSet, gamma3: float) -> NDArray[np.complex
     return level.linearised_eigenvalues(gamma3)
 
 
-def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
+def steady_motion(level: Level, theta: float) -> SteadyMotion:
     """Describe the steady motion at the critical point ``theta``."""
     U2t = float(level.d2U(theta))
     rho = float(level.rho(theta))
@@ -234,7 +234,7 @@ def steady_motion(level: LevelSet, theta: float) -> SteadyMotion:
     )
 
 
-def flat_potential(level: LevelSet) -> bool:
+def flat_potential(level: Level) -> bool:
     """Whether ``U`` is constant on the level: ``dU/dtheta`` exactly 0 on the grid of
     :func:`critical_points`, as on a no-spin level of a balanced body (``a3 = 0``) or without
     gravity (``g = 0``), where ``U`` reduces to a constant term."""
@@ -243,7 +243,7 @@ def flat_potential(level: LevelSet) -> bool:
     return bool(np.all(d == 0.0))
 
 
-def steady_motions(level: LevelSet) -> SteadyMotions:
+def steady_motions(level: Level) -> SteadyMotions:
     """Every steady motion on the level set, sorted by ``gamma3`` (a list that knows
     ``level``: :class:`SteadyMotions`).
 

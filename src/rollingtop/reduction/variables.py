@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.dynamics.integrals import F6, area, energy, lagrange, reduced_components
-from rollingtop.reduction.level import LevelSet, LevelSetError
+from rollingtop.reduction.level import Level, LevelSetError
 
 __all__ = [
     "reduce_state",
@@ -74,7 +74,7 @@ def euler_angles(Y: ArrayLike) -> dict[str, FloatArray]:
 
 
 def state_from_level(
-    level: LevelSet,
+    level: Level,
     h: float,
     gamma3: float,
     *,
@@ -145,7 +145,7 @@ def state_from_level(
     return y
 
 
-def states_on_level(level: LevelSet, gamma3: ArrayLike, w_tau: ArrayLike) -> FloatArray:
+def states_on_level(level: Level, gamma3: ArrayLike, w_tau: ArrayLike) -> FloatArray:
     """Full states on the level set at the points ``(gamma3, w_tau)`` of its phase plane, all at
     once: :func:`state_from_level` (``phi = psi = 0``, at the origin) for arrays.
 
