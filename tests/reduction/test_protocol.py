@@ -17,9 +17,11 @@ import numpy as np
 import pytest
 
 from rollingtop import SphericalTop
+from rollingtop.contact import MODELS
 from rollingtop.reduction import Level, orbits, steady_motions
+from rollingtop.reduction.classify import AXES
 from rollingtop.reduction.curves import default_h_levels, portrait_curves
-from rollingtop.reduction.models import Reduction
+from rollingtop.reduction.models import ATLAS_MODELS, REDUCTIONS, Reduction
 
 from ..conftest import PAPER_BODY
 
@@ -115,7 +117,9 @@ def test_a_level_without_one_of_its_methods_cannot_be_made():
 
 
 def test_a_reduction_of_the_toy_builds_its_levels_by_name():
-    toy = Reduction("toy", LagrangeTopLevel, lambda body, Y: {}, "E - I3 w3^2/2", "Goldstein")
+    toy = Reduction(
+        "toy", LagrangeTopLevel, lambda body, Y: {}, "E - I3 w3^2/2", "Goldstein", axis="C1"
+    )
     level = toy.level(BODY, {"M3": 2.0, "C1": 0.5})
     assert isinstance(level, LagrangeTopLevel) and level.values() == {"M3": 2.0, "C1": 0.5}
     with pytest.raises(Exception, match="fixed by M3, C1"):
@@ -146,3 +150,13 @@ def test_the_toys_steady_motions_orbits_and_curves_come_from_its_level_alone():
         np.testing.assert_allclose(h_on, c.h, rtol=ENERGY_RTOL)
     assert level.full_energy(h) == pytest.approx(h + M3**2 / (2 * BODY.I3), rel=1e-15)
     assert math.isclose(float(level.v_tau(1.0)), 0.0, abs_tol=0.0)
+
+
+def test_the_model_tables_come_from_the_registry():
+    """Issue 37, item 2: each model's classification axis and atlas support are its Reduction's;
+    the atlas classifies every reduced model whose body needs no shell, in registry order."""
+    assert ATLAS_MODELS == tuple(
+        m.name for m in MODELS.values() if m.reduction and not m.own_inertia
+    )
+    for name, reduction in REDUCTIONS.items():
+        assert AXES[name] == reduction.axis and reduction.axis in reduction.names

@@ -11,13 +11,14 @@ import numpy as np
 from rollingtop._errors import BodyError, RollingTopError
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
+from rollingtop.reduction.models import ATLAS_MODELS as _ATLAS_MODELS
 
 BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3")
 LEVEL_KEYS = ("M3", "C1", "C2")
-#: The models an atlas classifies (those with a reduction, :mod:`rollingtop.reduction.models`,
-#: for a body without a shell: the shell-rotor pair's shell is not among the axes): a ``model``
-#: axis holds indices into this tuple (its coordinate in the Dataset: the names).
-ATLAS_MODELS = ("meridian", "smooth", "rough", "rubber")
+#: The models an atlas classifies (:data:`rollingtop.reduction.models.ATLAS_MODELS`, from the
+#: registry): a ``model`` axis holds indices into this tuple (its coordinate in the Dataset: the
+#: names).
+ATLAS_MODELS = _ATLAS_MODELS
 #: The initial state a cell's level is read from under each model (a ``model`` axis, or a model
 #: other than the meridian one): the attitude and the angular velocity.
 STATE_KEYS = ("gamma1", "gamma2", "gamma3", "omega1", "omega2", "omega3")

@@ -46,13 +46,7 @@ FloatArray = NDArray[np.float64]
 #: The integral each model's critical values are drawn against: the one that does not fix the
 #: spin (the meridian model's ``C2``, as in its bifurcation diagram; the smooth plane's area
 #: integral; Routh's sphere's Jellett integral; rubber rolling's only one).
-AXES = {
-    "meridian": "C2",
-    "smooth": "C1",
-    "rough": "jellett",
-    "rubber": "rubber_spin",
-    "shell-rotor": "C2",
-}
+AXES: dict[str, str] = {r.model: r.axis for r in REDUCTIONS.values()}
 
 
 @dataclass(frozen=True)

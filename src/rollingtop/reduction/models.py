@@ -41,7 +41,7 @@ from rollingtop.reduction.shell_rotor import ShellRotorLevel, shell_rotor_integr
 from rollingtop.reduction.smooth import SmoothLevel, smooth_integrals
 from rollingtop.reduction.variables import reduced_integrals
 
-__all__ = ["REDUCTIONS", "Reduction", "reduction_of"]
+__all__ = ["ATLAS_MODELS", "REDUCTIONS", "Reduction", "reduction_of"]
 
 
 @dataclass(frozen=True)
@@ -63,6 +63,13 @@ class Reduction:
         What ``h`` is, in terms of the full energy ``E``.
     sources : str
         Where the reduction comes from.
+    axis : str
+        The integral of the level its classification varies
+        (:func:`rollingtop.reduction.classify.critical_values`, ``rollingtop bifurcation``): the
+        one that shapes ``U`` most.
+    atlas : bool
+        Whether a parameter atlas classifies this model's levels (``rollingtop atlas``: a body
+        without a shell, so not the shell-rotor pair's).
     """
 
     model: str
@@ -70,6 +77,8 @@ class Reduction:
     integrals: Callable[[SphericalTop, ArrayLike], dict[str, NDArray[np.float64]]]
     energy: str
     sources: str
+    axis: str
+    atlas: bool = True
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -138,6 +147,7 @@ REDUCTIONS: dict[str, Reduction] = {
             reduced_integrals,
             "E - I3 w3^2/2 - m g R",
             "Kilin and Ivanova 2023, Sec. 3 (eqs. 3.8-3.11)",
+            axis="C2",
         ),
         Reduction(
             "smooth",
@@ -146,6 +156,7 @@ REDUCTIONS: dict[str, Reduction] = {
             "E - I3 w3^2/2 - m g R",
             "Lagrange's top about its centre of mass with the vertical motion's mass "
             "(Routh, Advanced Rigid Dynamics, Sec. 242)",
+            axis="C1",
         ),
         Reduction(
             "rough",
@@ -154,6 +165,7 @@ REDUCTIONS: dict[str, Reduction] = {
             "E - m g R",
             "Routh's sphere: Jellett's and Routh's integrals (Routh, Advanced Rigid "
             "Dynamics, Sec. 243; Borisov and Mamaev, Rigid Body Dynamics)",
+            axis="jellett",
         ),
         Reduction(
             "rubber",
@@ -162,6 +174,7 @@ REDUCTIONS: dict[str, Reduction] = {
             "E - m g R",
             "rolling without slipping or spinning: the integral linear in w "
             "(Borisov, Mamaev and Bizyaev 2013; rollingtop.reduction.rubber)",
+            axis="rubber_spin",
         ),
         Reduction(
             "shell-rotor",
@@ -170,9 +183,16 @@ REDUCTIONS: dict[str, Reduction] = {
             "E - I3 w3^2/2 - m g R",
             "the pair's Lagrange, Jellett and F6 integrals (rollingtop.symbolic.shell_rotor;"
             " the meridian model's reduction as the shell's mass and inertia vanish)",
+            axis="C2",
+            atlas=False,  # the pair's shell is not among an atlas's axes
         ),
     )
 }
+
+
+#: The models a parameter atlas classifies (:attr:`Reduction.atlas`), in registry order: an
+#: atlas's ``model`` axis holds indices into this tuple.
+ATLAS_MODELS: tuple[str, ...] = tuple(r.model for r in REDUCTIONS.values() if r.atlas)
 
 
 def reduction_of(model: str | ContactModel) -> Reduction:
