@@ -163,11 +163,14 @@ class Scenario:
 
     def _require_full_reduction(self, what: str) -> None:
         """A :class:`ScenarioError` for ``what`` unless the whole of the paper's reduction
-        applies (:attr:`ContactModel.has_reduction`: the bifurcation diagrams, rotation numbers,
+        applies (:attr:`rollingtop.reduction.Reduction.closed_form_diagram`: the bifurcation
+        diagrams, rotation numbers,
         atlas)."""
-        if not self.model.has_reduction:
+        from rollingtop.reduction.models import closed_form_diagram
+
+        if not closed_form_diagram(self.model):
             self._require_reduction(what)  # no reduction at all: what serves such a model
-            names = " or ".join(m.name for m in MODELS.values() if m.has_reduction)
+            names = " or ".join(m for m in MODELS if closed_form_diagram(m))
             reduced = ", ".join(m.name for m in MODELS.values() if m.reduction)
             raise ScenarioError(
                 f"{what} needs the {names} model so far, not {self.model.name!r} (every model "

@@ -105,7 +105,9 @@ def motion_period_map(scenario: Scenario) -> PeriodMap | None:
     ``None`` where there is none: a model without a reduction, a body that is not dynamically
     symmetric, a level without motion, a state on a steady motion or a separatrix.
     """
-    if not scenario.model.has_reduction or not scenario.body.symmetric:
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if not closed_form_diagram(scenario.model) or not scenario.body.symmetric:
         return None
     try:
         level, h = scenario.level_set(), scenario.level_h()

@@ -12,6 +12,7 @@ from rollingtop._errors import BodyError, RollingTopError
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.reduction.models import ATLAS_MODELS as _ATLAS_MODELS
+from rollingtop.reduction.models import closed_form_diagram
 
 BODY_KEYS = ("R", "m", "g", "a3", "I1", "I3")
 LEVEL_KEYS = ("M3", "C1", "C2")
@@ -120,7 +121,6 @@ def _classify_state(
     builds it: the centre of mass's velocity from the model's constraints, ``omega``'s part
     along a constraint on the angular velocity dropped), classified by the model's own
     reduction. ``n_folds`` is the meridian model's alone (-1 for the others)."""
-    from rollingtop.contact import get_model
     from rollingtop.dynamics.state import initial_state
     from rollingtop.reduction.classify import admissible_omega
     from rollingtop.reduction.level import LevelSetError, PoleLevelError
@@ -153,7 +153,8 @@ def _classify_state(
             out["n_steady"][n] = len(motions)
             out["n_centres"][n] = sum(m.type == "center" for m in motions)
             out["n_saddles"][n] = sum(m.type == "saddle" for m in motions)
-            if get_model(name).has_reduction:  # the paper's whole reduction: its fold curves
+
+            if closed_form_diagram(name):  # the paper's whole reduction: its fold curves
                 out["n_folds"][n] = _fold_count(
                     *(float(getattr(body, key)) for key in BODY_KEYS),
                     level.values()["M3"],

@@ -19,7 +19,7 @@ from rollingtop._checks import short_repr
 from rollingtop._errors import BodyError, RollingTopError, ScenarioError
 from rollingtop._types import FloatArray
 from rollingtop.atlas._cells import ATLAS_MODELS, BODY_KEYS, LEVEL_KEYS, STATE_KEYS
-from rollingtop.contact import MODELS, get_model
+from rollingtop.contact import MODELS
 from rollingtop.io import read_input_text
 
 __all__ = ["AtlasError", "AtlasSpec", "atlas_spec_from_dict", "load_atlas_spec"]
@@ -156,7 +156,9 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
     model = contact.get("model", "meridian") if isinstance(contact, dict) else "meridian"
     if not isinstance(model, str):
         raise AtlasError(f"contact.model = {short_repr(model)} must be a model name")
-    if "model" in axes or not (model in MODELS and get_model(model).has_reduction):
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if "model" in axes or not (model in MODELS and closed_form_diagram(model)):
         return _state_spec(data, axes, model)
     # the fixed values: the scenario's, with each axis at its first value
     level_t = dict(data.get("level", {})) if isinstance(data.get("level", {}), dict) else {}
@@ -182,7 +184,9 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
         if not any(key in axes for key in BODY_KEYS):
             raise
         sc = Scenario.from_dict({**data, "body": given})
-    if not sc.model.has_reduction:
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if not closed_form_diagram(sc.model):
         raise AtlasError(
             f"the atlas classifies the reduction of the meridian model, not model {sc.model.name!r}"
         )

@@ -121,7 +121,9 @@ def bifurcation(
 
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
-    if sc.model.reduction and not sc.model.has_reduction:
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if sc.model.reduction and not closed_form_diagram(sc.model):
         given = [
             f
             for f, v in (("--c2-range", c2_range), ("--h-range", h_range), ("--c1-range", c1_range))

@@ -81,7 +81,9 @@ def rotation(
 
         check_output_path(output, FIGURE_SUFFIXES)
     sc = load_scenario(scenario)
-    if sc.model.reduction and not sc.model.has_reduction:
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if sc.model.reduction and not closed_form_diagram(sc.model):
         if c2_range is not None:
             raise BadInput(
                 f"--c2-range: the paper's model's window; the {sc.model.name} "

@@ -141,8 +141,8 @@ class ContactModel:
         generic linearisation in ``(v, w, gamma)`` on the constraint manifold applies.
     vertical_through_reduction : bool
         Whether the vertical spin is analysed through the reduction instead (the meridian
-        model, singular at the vertical, with :attr:`has_reduction`): the eigenvalues are those
-        of the reduced motion at the pole of the pole level
+        model, singular at the vertical, with the paper's whole reduction): the eigenvalues are
+        those of the reduced motion at the pole of the pole level
         (:func:`rollingtop.stability.pole_eigenvalues`), which
         :mod:`rollingtop.stability` computes. A declaration only: the contact package
         never imports the reduction.
@@ -168,11 +168,6 @@ class ContactModel:
         constraints :attr:`spin_directions`, in terms of the two sympy symbols ``spin`` and the
         unit vector ``tau = e3 x gamma / s`` (the symbolic layer's parametrisation, rational in
         ``gamma``); ``None`` with no such constraints.
-    has_reduction : bool
-        Whether the whole of the paper's reduction applies (:mod:`rollingtop.reduction`, Sec. 3):
-        besides the level sets, orbits and portraits of :attr:`reduction`, the bifurcation
-        diagrams, rotation numbers, the atlas and the symbolic claims of the reduction. The
-        meridian model only, so far.
     reduction : tuple of str
         The names of the integrals that fix a level set of the model's reduction to one degree
         of freedom (a dynamically symmetric body), in order: ``("M3", "C1", "C2")`` for the
@@ -235,7 +230,6 @@ class ContactModel:
     determined_through_vertical: bool = True
     spin_directions: Callable[[Any], dict[str, Any]] | None = None
     symbolic_omega: Callable[[Any, Any, Any], Any] | None = None
-    has_reduction: bool = False
     reduction: tuple[str, ...] = ()
     colour: str = "#7f7f7f"
     particular_integrals: Callable[[SphericalTop], tuple[str, ...]] | None = None

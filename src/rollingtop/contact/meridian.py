@@ -373,7 +373,6 @@ MODEL = ContactModel(
     select_variant=select_variant,
     vertical_spin=_vertical_spin,
     vertical_through_reduction=True,
-    has_reduction=True,
     reduction=("M3", "C1", "C2"),
     colour="#1f77b4",
     devices=("roller", "shell", "skates"),

@@ -338,7 +338,9 @@ def diagram_view(state: ExploreState) -> DiagramView:
     level = state.level_set()
     axis = AXES[state.model]
     x0 = float(state.level[axis])
-    if get_model(state.model).has_reduction:  # the paper's whole reduction: its (C2, h) plane
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if closed_form_diagram(state.model):  # the paper's whole reduction: its (C2, h) plane
         from rollingtop.reduction.bifurcation import bifurcation_diagram
 
         d = bifurcation_diagram(state.body, level.M3, level.C1, resolution=(161, 3))

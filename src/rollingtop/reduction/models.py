@@ -41,7 +41,7 @@ from rollingtop.reduction.shell_rotor import ShellRotorLevel, shell_rotor_integr
 from rollingtop.reduction.smooth import SmoothLevel, smooth_integrals
 from rollingtop.reduction.variables import reduced_integrals
 
-__all__ = ["ATLAS_MODELS", "REDUCTIONS", "Reduction", "reduction_of"]
+__all__ = ["ATLAS_MODELS", "REDUCTIONS", "Reduction", "closed_form_diagram", "reduction_of"]
 
 
 @dataclass(frozen=True)
@@ -70,6 +70,13 @@ class Reduction:
     atlas : bool
         Whether a parameter atlas classifies this model's levels (``rollingtop atlas``: a body
         without a shell, so not the shell-rotor pair's).
+    closed_form_diagram : bool
+        Whether the whole of the paper's reduction applies (Sec. 3): the closed-form bifurcation
+        diagram in ``(C2, h)`` with its folds and regions, rotation numbers over it, the
+        ``[level]`` atlas, and the reduction's symbolic claims (the identity of its integrals,
+        its invariant measure). The others classify along :attr:`axis` by the numerical
+        critical values (:mod:`rollingtop.reduction.classify`). The meridian model's only, so
+        far.
     """
 
     model: str
@@ -79,6 +86,7 @@ class Reduction:
     sources: str
     axis: str
     atlas: bool = True
+    closed_form_diagram: bool = False
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -148,6 +156,7 @@ REDUCTIONS: dict[str, Reduction] = {
             "E - I3 w3^2/2 - m g R",
             "Kilin and Ivanova 2023, Sec. 3 (eqs. 3.8-3.11)",
             axis="C2",
+            closed_form_diagram=True,
         ),
         Reduction(
             "smooth",
@@ -207,3 +216,11 @@ def reduction_of(model: str | ContactModel) -> Reduction:
         f"the {model.name} model has no reduction to one degree of freedom (models with one: "
         f"{names}); explore its motions with `rollingtop simulate`, `section` and `chaos`"
     )
+
+
+def closed_form_diagram(model: str | ContactModel) -> bool:
+    """Whether ``model`` has the whole of the paper's reduction
+    (:attr:`Reduction.closed_form_diagram`); ``False`` for a model without a reduction."""
+    model = get_model(model)
+    reduction = REDUCTIONS.get(model.name) if model.reduction else None
+    return reduction is not None and reduction.closed_form_diagram

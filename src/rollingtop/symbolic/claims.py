@@ -370,7 +370,9 @@ def claims_for(model: str) -> list[Claim]:
     for name in LOST_CANDIDATES:
         if name not in get_model(model).integrals_symmetric:
             out.append(Claim(f"{name} integral not conserved", model, F[name], vanishes=False))
-    if get_model(model).has_reduction:
+    from rollingtop.reduction.models import closed_form_diagram
+
+    if closed_form_diagram(model):
         out.append(
             Claim(
                 "identity jellett + a3 lagrange + R area = 0",
@@ -434,7 +436,9 @@ def verify(
     list of ClaimResult
         In order: each model's claims (:func:`claims_for`), then its invariant measure.
     """
-    plan = [(model, claims_for(model), get_model(model).has_reduction) for model in models]
+    from rollingtop.reduction.models import closed_form_diagram
+
+    plan = [(model, claims_for(model), closed_form_diagram(model)) for model in models]
     total = sum(len(claims) + measure for _, claims, measure in plan)
     results: list[ClaimResult] = []
 
