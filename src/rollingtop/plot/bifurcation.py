@@ -49,6 +49,8 @@ def _thumbnail(ax: Axes, diagram: BifurcationDiagram, k: int, colour: Any) -> No
         else:
             ax.set_xlim(lo - pad, hi + pad)
         ax.set_ylim(-(1.0 + 2 * THUMB_MARGIN) * top, (1.0 + 2 * THUMB_MARGIN) * top)
+    else:  # the reduction found no orbit to draw (a wall too thin for doubles, say): said
+        ax.text(0.5, 0.5, "no orbit drawn", transform=ax.transAxes, ha="center", fontsize=7)
     ax.xaxis.set_major_locator(MaxNLocator(3))
     ax.yaxis.set_major_locator(MaxNLocator(3, symmetric=True))
     ax.tick_params(labelsize=7, length=2, pad=1)
