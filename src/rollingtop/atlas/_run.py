@@ -144,24 +144,34 @@ def _client(
         )
         try:
             local = Client(cluster)
-            from rollingtop.atlas._quiet import QuietWorker
-
-            local.register_plugin(QuietWorker(), name="rollingtop-quiet-worker")
-            # the workers' processes, asked while they are idle: a worker running a compiled
-            # chunk holds its GIL and answers no one, so a stopped run kills them (its chunks
-            # are saved by this process) instead of waiting seconds for the chunk to end
-            pids = list(local.run(os.getpid).values())
             try:
+                from rollingtop.atlas._quiet import QuietWorker
+
+                local.register_plugin(QuietWorker(), name="rollingtop-quiet-worker")
                 yield local
-            except BaseException:
-                for pid in pids:
-                    with contextlib.suppress(OSError):
-                        os.kill(pid, getattr(signal, "SIGKILL", signal.SIGTERM))
-                raise
             finally:
                 local.close()
+        except BaseException:
+            _kill_workers(cluster)
+            raise
         finally:
             cluster.close()
+
+
+def _kill_workers(cluster: Any) -> None:
+    """Kill the worker processes of a local cluster whose run stopped (a signal, an error),
+    whether they are still starting or running a chunk. A worker running a compiled chunk
+    holds its GIL and answers no one, and a starting one is importing: the cluster's close
+    would wait for either (seconds). Its finished chunks are saved by this process. Each
+    nanny is first told not to start a new worker when its worker dies (Dask's own signal for
+    a cluster that shuts down, ``Nanny.close_gracefully``)."""
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(AttributeError):
+            nanny.close_gracefully(reason="rollingtop: the run stopped")
+        pid = getattr(nanny, "pid", None)
+        if pid is not None:
+            with contextlib.suppress(OSError):
+                os.kill(pid, getattr(signal, "SIGKILL", signal.SIGTERM))
 
 
 def atlas(
