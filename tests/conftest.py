@@ -83,6 +83,14 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20231205)
 
 
+def quoted_path(path) -> str:
+    """``path`` as an error message quotes it, written plainly: its ``repr`` when that is at most
+    80 characters, else an ellipsis and its last 77 characters in quotes, the file's name kept
+    (ASCII paths; ``rollingtop._errors.short_path``)."""
+    text = str(path)
+    return repr(text) if len(repr(text)) <= 80 else "'…" + text[-77:] + "'"
+
+
 def scenario_text(model: str = "meridian", **sections) -> str:
     """TOML text of a scenario on the paper's body; ``sections`` replace whole tables."""
     free = {"meridian": "v_tau = 0.25", "smooth": "v_horizontal = [0.3, -0.2]", "rough": "",

@@ -12,6 +12,8 @@ import pytest
 from rollingtop import io as rio
 from rollingtop.io import WriteFailed, atomic_write, read_input_text, write_bytes_atomic
 
+from .conftest import quoted_path
+
 
 def listing(folder):
     return sorted(p.name for p in folder.iterdir())
@@ -49,7 +51,7 @@ def test_failed_write_is_one_error_and_leaves_nothing(tmp_path, monkeypatch, cod
     with pytest.raises(WriteFailed) as exc:
         write_bytes_atomic(target, b"new content")
     assert str(exc.value) == (
-        f"cannot write {str(target)!r}: {os.strerror(code)}; no output was written"
+        f"cannot write {quoted_path(target)}: {os.strerror(code)}; no output was written"
     )
     assert exc.value.errno == code and exc.value.filename == str(target)
     assert target.read_bytes() == b"previous"
@@ -145,7 +147,7 @@ def test_refused_content(tmp_path, content, message):
     (tmp_path / "s.toml").write_bytes(content)
     with pytest.raises(ValueError, match=message) as exc:
         read(tmp_path / "s.toml", limit=1000)
-    assert str(exc.value).startswith(f"cannot read scenario {str(tmp_path / 's.toml')!r}: ")
+    assert str(exc.value).startswith(f"cannot read scenario {quoted_path(tmp_path / 's.toml')}: ")
 
 
 def test_fifo_device_and_folder_refused_without_blocking(tmp_path):

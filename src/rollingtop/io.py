@@ -67,7 +67,7 @@ class WriteFailed(OSError):
         super().__init__(errno, reason, os.fspath(path))
 
     def __str__(self) -> str:
-        return f"cannot write {self.filename!r}: {self.strerror}; no output was written"
+        return f"cannot write {short_path(self.filename)}: {self.strerror}; no output was written"
 
 
 def _reason(exc: BaseException) -> tuple[int | None, str]:
@@ -355,7 +355,7 @@ def read_input_text(
     plain UTF-8). Every refusal raises ``error`` with one line naming the file as ``what``.
     """
     path = Path(path)
-    where = f"cannot read {what} {str(path)!r}"
+    where = f"cannot read {what} {short_path(path)}"
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
     try:
         fd = os.open(path, flags)

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._errors import RollingTopError
+from rollingtop._errors import RollingTopError, short_path
 from rollingtop.atlas._cells import ATLAS_MODELS, FIELDS, MAX_CENTRES
 from rollingtop.atlas._spec import AtlasError, AtlasSpec
 from rollingtop.io import WriteFailed, check_output_path, netcdf_bytes, write_bytes_atomic
@@ -46,8 +46,8 @@ class CellsKept(WriteFailed):
 
     def __str__(self) -> str:
         return (
-            f"cannot write {self.filename!r}: {self.strerror}; the finished cells are kept "
-            f"in {self.kept!r}: run again to write them"
+            f"cannot write {short_path(self.filename)}: {self.strerror}; the finished cells "
+            f"are kept in {short_path(self.kept)}: run again to write them"
         )
 
 
@@ -222,7 +222,7 @@ def check_atlas_output(output: str | os.PathLike[str]) -> Path:
     if path.suffix.lower() == ".zarr" and path.is_dir():
         if not any((path / name).exists() for name in ("zarr.json", ".zgroup", ".zattrs")):
             raise AtlasError(
-                f"cannot write {str(path)!r}: a folder that is not a Zarr store is in the way"
+                f"cannot write {short_path(path)}: a folder that is not a Zarr store is in the way"
             )
         return path
     try:

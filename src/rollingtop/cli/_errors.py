@@ -23,7 +23,12 @@ from typing import IO, Any
 
 import click
 
-from rollingtop._errors import IntegrationError, Interrupted, RollingTopError, short_repr
+from rollingtop._errors import (
+    IntegrationError,
+    Interrupted,
+    RollingTopError,
+    short_path,
+)
 from rollingtop.io import WriteFailed
 
 __all__ = ["BadInput", "NotHeld", "Reported", "RunFailed", "Stopped", "one_line", "reported"]
@@ -107,7 +112,7 @@ def reported() -> Iterator[None]:
     except Interrupted as exc:
         raise Stopped.of(exc.signum)(exc.signum) from None
     except OSError as exc:
-        where = "" if exc.filename is None else f"{short_repr(str(exc.filename))}: "
+        where = "" if exc.filename is None else f"{short_path(exc.filename)}: "
         raise RunFailed(f"{where}{exc.strerror or exc}") from None
     except OverflowError:  # Python's float arithmetic raises where numpy's gives inf
         raise BadInput(
