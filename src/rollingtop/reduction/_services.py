@@ -130,6 +130,9 @@ class Level(ABC):
     #: What to do about a wall of ``U`` too thin for doubles next to a pole (a level within
     #: round-off of a pole level): :func:`rollingtop.reduction.orbits.orbits`' refusal says it.
     pole_advice: ClassVar[str] = "rescale the level's integrals"
+    #: What :meth:`pole_label` calls a level through one pole: the meridian model's "pole case"
+    #: (``C1 = +-M3``), another model's "pole level".
+    pole_noun: ClassVar[str] = "case"
     #: Whether :func:`rollingtop.reduction.near_pole.near_pole` knows this model's limits on
     #: its pole levels (the meridian model's only, so far).
     near_pole_limits: ClassVar[bool] = False
@@ -287,12 +290,11 @@ class Level(ABC):
 
     def pole_label(self) -> str:
         """The pole case in words, for :meth:`describe` (empty for no pole case)."""
-        return {
-            None: "",
-            "south": " (south pole case)",
-            "north": " (north pole case)",
-            "both": " (no spin: both poles)",
-        }[self.pole]
+        if self.pole is None:
+            return ""
+        if self.pole == "both":
+            return " (no spin: both poles)"
+        return f" ({self.pole} pole {self.pole_noun})"
 
     def _repr_html_(self) -> str:
         """The notebook's view: model, integrals, body, the steady motions' count."""

@@ -27,7 +27,7 @@ from rollingtop.reduction._orbit import Orbit
 from rollingtop.reduction._quadrature import energy_gap
 from rollingtop.reduction.level import Level, LevelSetError, Real
 from rollingtop.reduction.orbits import orbits
-from rollingtop.reduction.steady import steady_motions
+from rollingtop.reduction.steady import SteadyMotion, steady_motions
 
 __all__ = [
     "OrbitCurve",
@@ -169,15 +169,21 @@ def on_a_saddle(h: float, saddle_levels: set[float]) -> bool:
     return any(abs(h - u) <= SAME_LEVEL_RTOL * max(1.0, abs(u)) for u in saddle_levels)
 
 
-def portrait_curves(level: Level, levels: Sequence[float]) -> PortraitCurves:
-    """The closed curve of every orbit at the energies ``levels`` and their window.
+def portrait_curves(
+    level: Level, levels: Sequence[float], *, motions: Sequence[SteadyMotion] | None = None
+) -> PortraitCurves:
+    """The closed curve of every orbit at the energies ``levels`` and their window;
+    ``motions``: the level's steady motions where the caller has them already (default: they
+    are computed).
 
     Raises
     ------
     LevelSetError
         When none of ``levels`` has a motion.
     """
-    saddle_levels = {m.U for m in steady_motions(level) if m.type == "saddle"}
+    if motions is None:
+        motions = steady_motions(level)
+    saddle_levels = {m.U for m in motions if m.type == "saddle"}
     curves = []
     g_lo, g_hi, w_top = 1.0, -1.0, 0.0
     for h in levels:

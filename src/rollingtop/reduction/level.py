@@ -50,8 +50,10 @@ __all__ = [
     "POLE_TOLERANCE",
     "PoleLevelError",
     "Real",
+    "LagrangeSpin",
     "RollingMass",
     "SpinAndArea",
+    "SpinInPotential",
     "near_north",
 ]
 
@@ -60,19 +62,52 @@ __all__ = [
 POLE_TOLERANCE = POLE_CASE_TOLERANCE
 
 
-class SpinAndArea:
+class LagrangeSpin:
+    """Lagrange's integral ``M3 = I3 w3`` of a level (the meridian, smooth and shell-rotor
+    models'): the spin is constant and its energy is not part of ``U`` (a mixin of
+    :class:`Level` kinds with a field ``M3``)."""
+
+    body: SphericalTop
+    M3: float
+    #: :meth:`full_energy` in words.
+    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
+
+    def spin(self, theta: Real) -> Real:
+        """The spin ``w3`` at ``theta``: ``M3 / I3``, constant (Lagrange's integral)."""
+        out: Real = self.M3 / self.body.I3 + 0.0 * theta
+        return out
+
+    def full_energy(self, h: float) -> float:
+        """The energy ``E`` of the full system on this level at reduced energy ``h``:
+        ``h + M3^2 / (2 I3) + m g R`` (:func:`rollingtop.reduction.start.level_energy`)."""
+        b = self.body
+        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
+
+
+class SpinInPotential:
+    """A level whose spin varies with ``theta`` (the rough and rubber models'): the spin's
+    energy is part of ``U``, so ``E = h + m g R`` (a mixin of :class:`Level` kinds)."""
+
+    body: SphericalTop
+    #: :meth:`full_energy` in words.
+    energy_formula: ClassVar[str] = "h + m g R"
+
+    def full_energy(self, h: float) -> float:
+        """The energy ``E = h + m g R`` of the full system at reduced energy ``h`` (the spin's
+        energy is in ``U``)."""
+        b = self.body
+        return h + b.m * b.g * b.R
+
+
+class SpinAndArea(LagrangeSpin):
     """The Lagrange and area integrals ``M3 = I3 w3`` and ``C1 = (I w, gamma)`` of a level (the
     meridian and smooth models'): the spin, ``w_n``, the precession and the pole decision
     ``C1 = +-M3`` that they fix (a mixin of :class:`Level` kinds with fields ``M3`` and ``C1``).
     """
 
-    body: SphericalTop
-    M3: float
     C1: float
     scale: float
     pole: str | None
-    #: :meth:`full_energy` in words.
-    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
 
     def _decide_pole(self) -> None:
         """Set :attr:`pole` from ``(M3, C1)`` (:func:`rollingtop.contact.meridian.pole_case`,
@@ -86,17 +121,6 @@ class SpinAndArea:
             object.__setattr__(self, "M3", 0.0)
             object.__setattr__(self, "C1", 0.0)
         object.__setattr__(self, "pole", pole)
-
-    def spin(self, theta: Real) -> Real:
-        """The spin ``w3`` at ``theta``: ``M3 / I3``, constant (Lagrange's integral)."""
-        out: Real = self.M3 / self.body.I3 + 0.0 * theta
-        return out
-
-    def full_energy(self, h: float) -> float:
-        """The energy ``E`` of the full system on this level at reduced energy ``h``:
-        ``h + M3^2 / (2 I3) + m g R`` (:func:`rollingtop.reduction.start.level_energy`)."""
-        b = self.body
-        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
 
     def pole_offsets(self) -> tuple[float, float]:
         """How far the level is from its south and north pole levels: ``C1 - M3`` and

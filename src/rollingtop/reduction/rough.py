@@ -63,6 +63,7 @@ from rollingtop.reduction.level import (
     Level,
     Real,
     RollingMass,
+    SpinInPotential,
 )
 
 __all__ = ["RoughLevel", "rough_integrals"]
@@ -73,12 +74,13 @@ POLE_LEVEL_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True, kw_only=True)
-class RoughLevel(RollingMass, Level):
+class RoughLevel(SpinInPotential, RollingMass, Level):
     """A level set ``(jellett, routh)`` of Routh's sphere (module docstring): the rough model's
     potential, spin and centre-of-mass velocity, with the rolling body's mass
     (:class:`~rollingtop.reduction.level.RollingMass`)."""
 
     integrals: ClassVar[tuple[str, ...]] = ("jellett", "routh")
+    pole_noun: ClassVar[str] = "level"
     model: ClassVar[str] = "rough"
     near_pole_limits: ClassVar[bool] = False
     #: :attr:`LevelSet.pole_advice`.
@@ -244,24 +246,6 @@ class RoughLevel(RollingMass, Level):
         """``jellett + I3 k w3`` at the south and north poles: 0 on a pole level
         (:func:`~rollingtop.reduction.level.near_north` mirrors a level nearer the north one)."""
         return self._numerator(0.0), self._numerator(math.pi)
-
-    def pole_label(self) -> str:
-        """The pole level in words, for :meth:`describe`."""
-        return {
-            None: "",
-            "south": " (south pole level)",
-            "north": " (north pole level)",
-            "both": " (no spin: both poles)",
-        }[self.pole]
-
-    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here.
-    energy_formula: ClassVar[str] = "h + m g R"
-
-    def full_energy(self, h: float) -> float:
-        """The energy ``E = h + m g R`` of the full system at reduced energy ``h`` (the spin's
-        energy is in ``U``)."""
-        b = self.body
-        return h + b.m * b.g * b.R
 
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
     #: own linearisation (:meth:`~rollingtop.reduction.Level.curvature_eigenvalues`).

@@ -62,6 +62,7 @@ from rollingtop.reduction.level import (
     Level,
     Real,
     RollingMass,
+    SpinInPotential,
 )
 
 __all__ = ["RubberLevel", "rubber_integrals"]
@@ -70,7 +71,7 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True, kw_only=True)
-class RubberLevel(RollingMass, Level):
+class RubberLevel(SpinInPotential, RollingMass, Level):
     """A level set ``rubber_spin = F`` of a body of revolution rolling without slipping or
     spinning (module docstring): the rubber model's potential, spin and centre-of-mass velocity,
     with the rolling body's mass (:class:`~rollingtop.reduction.level.RollingMass`). ``F``
@@ -175,15 +176,6 @@ class RubberLevel(RollingMass, Level):
         t = np.asarray(theta, dtype=float)
         rate: float | FloatArray = -self.w_n(t) / np.sin(t)
         return rate
-
-    #: :meth:`full_energy` in words: the spin's energy is part of ``U`` here.
-    energy_formula: ClassVar[str] = "h + m g R"
-
-    def full_energy(self, h: float) -> float:
-        """The energy ``E = h + m g R`` of the full system at reduced energy ``h`` (the spin's
-        energy is in ``U``)."""
-        b = self.body
-        return h + b.m * b.g * b.R
 
     #: No reduced equations of the paper's (eq. 3.3) for this model: the one degree of freedom's
     #: own linearisation (:meth:`~rollingtop.reduction.Level.curvature_eigenvalues`).

@@ -63,6 +63,7 @@ from rollingtop.reduction._services import (
     check_level_values,
 )
 from rollingtop.reduction.level import (
+    LagrangeSpin,
     Level,
     LevelSetError,
     PoleLevelError,
@@ -77,10 +78,11 @@ POLE_LEVEL_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True, kw_only=True)
-class ShellRotorLevel(Level):
+class ShellRotorLevel(LagrangeSpin, Level):
     """A level set ``(M3, jellett, C2)`` of the shell-rotor pair (module docstring)."""
 
     integrals: ClassVar[tuple[str, ...]] = ("M3", "jellett", "C2")
+    pole_noun: ClassVar[str] = "level"
     model: ClassVar[str] = "shell-rotor"
     near_pole_limits: ClassVar[bool] = False
     #: :attr:`LevelSet.pole_advice`.
@@ -97,8 +99,6 @@ class ShellRotorLevel(Level):
     jellett: float
     #: Set at construction: the pole levels (module docstring).
     pole: str | None = field(init=False, repr=False, compare=False)
-    #: :meth:`full_energy` in words.
-    energy_formula: ClassVar[str] = "h + M3^2/(2 I3) + m g R"
 
     def __post_init__(self) -> None:
         check_level_values(self, ("M3", "jellett", "C2"))
@@ -243,16 +243,6 @@ class ShellRotorLevel(Level):
             jellett=self.jellett,
         )
 
-    def spin(self, theta: Real) -> Real:
-        """The rotor's spin ``w3 = M3 / I3``, constant (its Lagrange integral)."""
-        out: Real = self.M3 / self.body.I3 + 0.0 * theta
-        return out
-
-    def full_energy(self, h: float) -> float:
-        """The pair's energy ``E = h + M3^2 / (2 I3) + m g R`` at reduced energy ``h``."""
-        b = self.body
-        return h + self.M3 * self.M3 / (2.0 * b.I3) + b.m * b.g * b.R
-
     def omega3(self, theta: Real) -> Real:
         """The shell's spin about the axis, ``Omega3 = (C2 - R M3 Phi) / sqrt(N)``."""
         out: Real = self._parts(theta)[3]
@@ -359,15 +349,6 @@ class ShellRotorLevel(Level):
     def describe(self) -> str:
         """One line naming the level set."""
         return f"M3 = {self.M3:g}, jellett = {self.jellett:g}, C2 = {self.C2:g}{self.pole_label()}"
-
-    def pole_label(self) -> str:
-        """The pole level in words, for :meth:`describe`."""
-        return {
-            None: "",
-            "south": " (south pole level)",
-            "north": " (north pole level)",
-            "both": " (no spin: both poles)",
-        }[self.pole]
 
 
 def shell_rotor_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
