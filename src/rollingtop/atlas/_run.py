@@ -165,10 +165,9 @@ def _kill_workers(cluster: Any) -> None:
     would wait for either (seconds). Its finished chunks are saved by this process. Each
     nanny is first told not to start a new worker when its worker dies (Dask's own signal for
     a cluster that shuts down, ``Nanny.close_gracefully``)."""
-    for nanny in list(getattr(cluster, "workers", {}).values()):
-        with contextlib.suppress(AttributeError):
-            nanny.close_gracefully(reason="rollingtop: the run stopped")
-        pid = getattr(nanny, "pid", None)
+    for nanny in list(cluster.workers.values()):
+        nanny.close_gracefully(reason="rollingtop: the run stopped")
+        pid = nanny.pid
         if pid is not None:
             with contextlib.suppress(OSError):
                 os.kill(pid, getattr(signal, "SIGKILL", signal.SIGTERM))

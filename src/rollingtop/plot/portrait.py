@@ -52,7 +52,7 @@ def _draw_orbits(
     """The upper panel of :func:`phase_portrait` on ``ax``; returns its abscissa's limits."""
     body = level.body
     saddle_levels = {m.U for m in motions if m.type == "saddle"}
-    found = portrait_curves(level, levels)
+    found = portrait_curves(level, levels, motions=motions)
     g_lo, g_hi, w_top = found.window
     drawn_sep = drawn = False
     for curve in found.curves:
@@ -218,7 +218,7 @@ def draw_potential(
     levels = _levels(level, h_levels)
     motions = steady_motions(level)
     if window is None:
-        g_lo, g_hi, _ = portrait_curves(level, levels).window
+        g_lo, g_hi, _ = portrait_curves(level, levels, motions=motions).window
         window = (g_lo, g_hi)
     _draw_potential(ax, level, levels, motions, window)
     if mark_steady:
