@@ -138,6 +138,37 @@ def test_an_edit_of_a_shared_module_recompiles_the_stepper(tmp_path):
     assert again["compiled"] == [] and again["steps"] == edited["steps"]
 
 
+def test_an_edit_of_a_compile_option_alone_recompiles(tmp_path):
+    """A decorator's options (here ``nogil`` on the template's ``rhs``) change the machine code
+    but neither a function's bytecode nor its module's digest: they are in each entry's key
+    (``_kernel_cache.options_key``), so the edited kernel is compiled, not loaded."""
+    src, cache = _copy_tree(tmp_path), tmp_path / "cache"
+    first, _ = _run(src, cache, "smooth", "rhs")
+    assert _ours(first["compiled"], "rollingtop._compiled.smooth.dynamics.rhs")
+    _edit(src / "rollingtop" / "_compiled" / "_template" / "dynamics.py",
+          "@kernel\ndef rhs(", "@compiled(nogil=True, _nrt=False)\ndef rhs(")  # fmt: skip
+    edited, _ = _run(src, cache, "smooth", "rhs")
+    assert "rollingtop._compiled.smooth.dynamics.rhs" in edited["compiled"]
+    assert edited["dy"] == first["dy"]  # the same physics, compiled again
+    again, _ = _run(src, cache, "smooth", "rhs")
+    assert again["compiled"] == []
+
+
+def test_the_options_key_is_the_same_in_every_process():
+    """A set of options (``fastmath``) iterates in a per-process order: the key sorts it."""
+    script = (
+        "from rollingtop._kernel_cache import options_key\n"
+        "print(options_key({'fastmath': {'contract', 'nnan', 'ninf', 'arcp'}, 'nogil': True}))\n"
+    )
+    keys = set()
+    for seed in ("1", "2", "3"):
+        env = os.environ | {"PYTHONHASHSEED": seed}
+        proc = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env,
+                              capture_output=True, text=True, timeout=120, check=True)  # fmt: skip
+        keys.add(proc.stdout)
+    assert len(keys) == 1, keys
+
+
 def test_two_models_never_share_an_entry(tmp_path):
     """The template's ``rhs`` instantiated for two models has one file, name and line: with
     numba's own cache the second model would load the first's machine code. Here each module

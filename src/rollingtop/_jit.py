@@ -94,7 +94,7 @@ def _njit(func: Callable[..., Any], options: dict[str, Any]) -> Any:
                     ),
                     stacklevel=4,
                 )
-            dispatcher._cache = _kernel_cache.KernelCache(func)
+            dispatcher._cache = _kernel_cache.KernelCache(func, dispatcher.targetoptions)
     return _registered(dispatcher)
 
 

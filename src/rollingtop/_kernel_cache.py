@@ -20,7 +20,9 @@ copy, a layout size imported by name, a compiler option), with the versions of r
 numba, llvmlite, NumPy and Python. Both are read from memory, not from files: a file edited
 after the import cannot stamp the old code. So an edit of one model's module changes the key of
 that model's kernels only (and of the models that call its functions); an edit of a shared
-compiled module or of the template changes every model's.
+compiled module or of the template changes every model's. Each entry's index key also holds the
+options the function is compiled with (:func:`options_key`: ``nogil``, ``fastmath``, ...): they
+change its machine code, not its bytecode, and numba's own key leaves them out.
 
 **The place** (:func:`cache_root`): ``NUMBA_CACHE_DIR/rollingtop`` when numba's variable is set,
 else ``__pycache__/kernels`` beside the package, else the user's cache folder -- numba's own
@@ -40,6 +42,7 @@ import hashlib
 import shutil
 import sys
 import tempfile
+from collections.abc import Mapping
 from importlib import metadata
 from pathlib import Path
 from types import CodeType, FunctionType, ModuleType
@@ -53,6 +56,7 @@ __all__ = [
     "explicit_folder",
     "first_writable",
     "module_digest",
+    "options_key",
 ]
 
 #: The package whose modules are followed and hashed (others are covered by their versions).
@@ -374,12 +378,19 @@ def kernel_cache_class() -> type:
 
         _impl_class = Impl
 
-        def __init__(self, py_func: Any) -> None:
+        def __init__(self, py_func: Any, options: Mapping[str, Any] | None = None) -> None:
             self._name = repr(py_func)
             self._py_func = py_func
+            self._options = options_key(options or {})
             self._impl = Impl(py_func)
             self._file: Any = None
             self.enable()  # type: ignore[no-untyped-call]
+
+        def _index_key(self, sig: Any, codegen: Any) -> Any:
+            """numba's key (the signature, the target, the function's bytecode) and the options
+            it is compiled with (``nogil``, ``fastmath``, ...): they change the machine code but
+            neither the bytecode nor the module's digest."""
+            return (*super()._index_key(sig, codegen), self._options)  # type: ignore[no-untyped-call]
 
         @property
         def cache_path(self) -> str:
@@ -398,7 +409,18 @@ def kernel_cache_class() -> type:
     return Cache
 
 
-def KernelCache(py_func: Any) -> Any:  # noqa: N802 (stands for the class)
-    """A numba cache for ``py_func`` keyed on every source compiled into it (module docstring);
-    :func:`cache_root` must have found a folder."""
-    return kernel_cache_class()(py_func)
+def options_key(options: Mapping[str, Any]) -> str:
+    """The compile options as text that is the same in every process (a set's items sorted:
+    a set of strings iterates in a per-process order)."""
+
+    def plain(value: Any) -> Any:
+        return sorted(map(repr, value)) if isinstance(value, set | frozenset) else value
+
+    return repr(sorted((str(k), plain(v)) for k, v in options.items()))
+
+
+def KernelCache(py_func: Any, options: Mapping[str, Any] | None = None) -> Any:  # noqa: N802
+    """A numba cache for ``py_func`` compiled with ``options`` (the dispatcher's target
+    options), keyed on every source compiled into it (module docstring) and on those options;
+    :func:`cache_root` must have found a folder. (The name stands for the class.)"""
+    return kernel_cache_class()(py_func, options)
