@@ -400,7 +400,9 @@ def _ensemble_integrals(
     for b, c, members in groups.values():
         idx = np.array(members)
         for key, Y in (("initial", initial[idx]), ("final", final[idx])):
-            for name, values in evaluate(b, Y, names, pole=kernel_by_code(c).variant).items():
+            kernel = kernel_by_code(c)
+            values_of = evaluate(b, Y, names, pole=kernel.variant, model=kernel.model)
+            for name, values in values_of.items():
                 result[name][key][idx] = values
     for d in result.values():
         d["drift"] = d["final"] - d["initial"]

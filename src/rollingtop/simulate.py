@@ -88,7 +88,7 @@ def _given_state(
         raise InitialStateError(f"state must be {N_STATE} numbers") from None
     if y.shape != (N_STATE,) or not np.all(np.isfinite(y)):
         raise InitialStateError(f"state must be {N_STATE} finite numbers, got shape {y.shape}")
-    if model.slot_value is not None:  # the model's own velocity must agree with v
+    if model.own is not None:  # the model's own velocity must agree with v
         projected = y.copy()
         code = model.kernel_code(body, y)
         call(for_code(code).dynamics.project, code, body.params, projected, call(new_workspace))

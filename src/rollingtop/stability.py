@@ -15,12 +15,12 @@ restricted to the null space of the constraints' Jacobian, whose eigenvalues are
 imaginary or zero for a stable spin.
 
 A model whose constraint is singular at the vertical supplies its own eigenvalues
-(:attr:`~rollingtop.contact.ContactModel.vertical_eigenvalues`), or declares that they come from
-the reduction (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`: the meridian
+(:attr:`~rollingtop.contact.Vertical.eigenvalues`), or declares that they come from
+the reduction (:attr:`~rollingtop.contact.Vertical.through_reduction`: the meridian
 model, whose eigenvalues are those of the reduced motion on the pole level,
 :func:`rollingtop.stability.pole_eigenvalues`; computed here, so that the contact package
 never imports the reduction). A model may also give a closed form of the threshold
-(:attr:`~rollingtop.contact.ContactModel.vertical_spin`), which is reported beside the one found
+(:attr:`~rollingtop.contact.Vertical.spin`), which is reported beside the one found
 from the eigenvalues.
 """
 
@@ -168,8 +168,8 @@ def vertical_spin_eigenvalues(
         _require_vertical_spin(model)
     own = (
         partial(_reduced_eigenvalues, model)
-        if model.vertical_through_reduction
-        else model.vertical_eigenvalues
+        if model.vertical.through_reduction
+        else model.vertical.eigenvalues
     )
     if own is not None:
         try:
@@ -183,7 +183,7 @@ def _reduced_eigenvalues(
     model: ContactModel, body: SphericalTop, omega3: float, pole: int
 ) -> ComplexArray:
     """The eigenvalues of a model analysed through the reduction
-    (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`): those of the reduced
+    (:attr:`~rollingtop.contact.Vertical.through_reduction`): those of the reduced
     motion at the pole of the pole level. A ValueError for a body the reduction cannot take."""
     if not body.symmetric:
         raise ValueError(
@@ -275,8 +275,8 @@ def vertical_spins(body: SphericalTop, model: str | ContactModel) -> list[Vertic
     out = []
     for pole, sign in POLES.items():
         closed = None
-        if model.vertical_spin is not None and body.symmetric:
-            closed = float(model.vertical_spin(body, sign))
+        if model.vertical.spin is not None and body.symmetric:
+            closed = float(model.vertical.spin(body, sign))
         out.append(VerticalSpin(pole, sign * body.a3 > 0.0, _critical(body, model, pole), closed))
     return out
 
@@ -286,7 +286,7 @@ def pole_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArr
     ``pole`` (+1 south, ``gamma3 = 1``; -1 north): ``+-sqrt(-U''/rho)`` at the pole of the pole
     level ``(M3 = I3 omega3, C1 = pole M3, C2)`` (``C2 = 0`` south, ``-pi M3 a3`` north, the value
     of ``F6`` at the vertical spin); the other directions are integrals (0). The meridian model's
-    vertical spin (:attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`,
+    vertical spin (:attr:`~rollingtop.contact.Vertical.through_reduction`,
     :mod:`rollingtop.stability`); ``body`` must be dynamically symmetric."""
     M3 = body.I3 * omega3
     C2 = 0.0 if pole > 0 else -math.pi * M3 * body.a3

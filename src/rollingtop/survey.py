@@ -111,7 +111,7 @@ def motion_period_map(scenario: Scenario) -> PeriodMap | None:
         return None
     try:
         level, h = scenario.level_set(), scenario.level_h()
-        theta = float(reduce_state(scenario.require_state())["theta"])
+        theta = float(reduce_state(scenario.require_state(), model=scenario.model)["theta"])
         found = [
             o for o in orbits(level, h) if o.theta_min - ON_ORBIT <= theta <= o.theta_max + ON_ORBIT
         ]

@@ -146,7 +146,7 @@ class Trajectory(NetCDFOutput):
     def integrals(self) -> dict[str, FloatArray]:
         """First integrals of the model and body along the samples, each shape (n,)."""
         names = self.model.integrals_for(self.body)
-        return evaluate(self.body, self.y, names, pole=self.pole_case)
+        return evaluate(self.body, self.y, names, pole=self.pole_case, model=self.model)
 
     @functools.cached_property
     def _diagnostics(self) -> FloatArray:
@@ -225,7 +225,7 @@ class Trajectory(NetCDFOutput):
             self.y,
             self.integrals,
             self.pole_case,
-            slot_is_velocity=self.model.slot_name != "psi_nu",
+            model=self.model,
         )
         for name, values in self.integrals.items():
             drift = float(np.max(np.abs(values - values[0])))

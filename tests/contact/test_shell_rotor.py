@@ -111,6 +111,29 @@ def test_the_pairs_integrals_are_conserved_the_rotors_own_are_not():
         assert np.ptp(values) > 1e-2, name
 
 
+def test_the_pairs_integrals_are_the_models_and_a_shell_without_it_is_refused(rng):
+    """The integrals module evaluates the pair's energy under the model's name
+    (ContactModel.own.integrals), the rotor's plus the shell's ms v_O^2/2 + Js |Omega|^2/2 written
+    here with vectors; without the model a body with a shell is refused, not given the rotor's
+    value."""
+    for _ in range(5):
+        body = _random_pair(rng)
+        y = _random_state(rng, body)
+        pair = evaluate(body, y, ["energy"], model="shell-rotor")["energy"]
+        v, w, gamma, delta = y[0:3], y[3:6], y[12:15], y[17]
+        e3 = np.array([0.0, 0.0, 1.0])
+        r = -body.R * gamma - body.a3 * e3  # contact point from the rotor's centre of mass
+        rotor = (0.5 * body.m * v @ v + 0.5 * w @ (np.array(body.inertia) * w)
+                 - body.m * body.g * r @ gamma)  # fmt: skip
+        v_O = v - np.cross(w, body.a3 * e3)
+        omega = w + delta * e3
+        shell = 0.5 * body.shell_mass * v_O @ v_O + 0.5 * body.shell_inertia * omega @ omega
+        assert pair == pytest.approx(rotor + shell, rel=1e-13)
+        for name in ("energy", "jellett", "F6"):
+            with pytest.raises(ValueError, match="model='shell-rotor'"):
+                evaluate(body, y, [name])
+
+
 def _distance(eps, t_end=10.0):
     body = SphericalTop(**PAPER, shell_mass=eps, shell_inertia=eps)
     pair = simulate(body, MODEL, initial_state(body, MODEL, **STATE), t_end=t_end, rtol=1e-13,

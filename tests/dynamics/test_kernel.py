@@ -71,7 +71,7 @@ def test_rhs_matches_reference_at_random_states(model, rng):
         expected, _ = reference.rhs(model, body.params, y)
         scale = np.max(np.abs(expected))
         np.testing.assert_allclose(dy[:17], expected[:17], rtol=0, atol=RHS_RTOL * 10 * scale)
-        if get_model(model).carries_direction:  # psi_nu' is the axis azimuth's rate
+        if get_model(model).vertical.carries_direction:  # psi_nu' is the axis azimuth's rate
             a3, b3, a3d, b3d = y[8], y[11], expected[8], expected[11]
             assert dy[17] == pytest.approx((a3 * b3d - b3 * a3d) / (a3**2 + b3**2), rel=1e-12)
         else:

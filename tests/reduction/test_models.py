@@ -516,13 +516,13 @@ def test_a_rough_level_near_its_north_pole_level_is_computed_on_its_mirror(paper
 def test_the_smooth_reduction_has_the_vertical_spins_threshold(paper_body, pole):
     """On the smooth plane's pole level (C1 = +-M3) the vertical spin is the critical point at
     the pole; U'' there changes sign at the closed-form threshold of the contact model
-    (ContactModel.vertical_spin: Lagrange's top about the centre of mass, 2 sqrt(I1 m g a)/I3
+    (Vertical.spin: Lagrange's top about the centre of mass, 2 sqrt(I1 m g a)/I3
     with a = pole a3): a centre above it, a saddle below (both sides within 1 %)."""
     from rollingtop.contact import get_model
 
     for a3 in (0.1, -0.1):
         b = replace(paper_body, a3=a3)
-        critical = get_model("smooth").vertical_spin(b, pole)
+        critical = get_model("smooth").vertical.spin(b, pole)
         if critical == 0.0:  # a <= 0: stable at every spin; check one
             spins = [0.5]
         else:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rollingtop import SphericalTop
-from rollingtop.dynamics.integrals import pair_weight
+from rollingtop.contact._shell_pair import pair_weight
 from rollingtop.reduction import ShellRotorLevel, orbits, steady_motions
 from rollingtop.reduction.level import LevelSetError
 

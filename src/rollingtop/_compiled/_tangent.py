@@ -66,7 +66,7 @@ FD_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
 TANGENT_TOL = 1e-8
 
 #: Status of a run stopped where the axis passed through the vertical (a model whose motion is not
-#: determined through it: ``ContactModel.determined_through_vertical``).
+#: determined through it: ``Vertical.determined`` of the contact model).
 REACHED_VERTICAL = -4
 #: Names of the statuses of :func:`run_indicators`.
 STATUS_NAMES = {

@@ -15,7 +15,7 @@ subset ``hold``. A sample is drawn in two steps:
    direction of ``N``, orthogonal to ``c_p`` in the kinetic-energy metric. The energy, quadratic
    in ``x``, then fixes ``x`` (one of its two roots at random); an orientation where the level's
    energy is out of reach is drawn again. A model with its own velocity in the state's last
-   slot (:attr:`~rollingtop.contact.ContactModel.slot_value`: the shell-rotor pair's shell
+   slot (:attr:`~rollingtop.contact.OwnVelocity.value`: the shell-rotor pair's shell
    spin) has it set from ``u`` at every evaluation, so its integrals are the pair's. Newton
    iterations on all held integrals (least-squares steps) polish the result, so an integral that
    is not linear in ``u`` is held as well, and each sample is checked: every held integral within
@@ -87,12 +87,14 @@ def level_values(
     model = get_model(model)
     y = np.asarray(state, dtype=float)
     pole = model.kernel(body, y).variant
-    values = evaluate(body, y, names, pole=pole)
+    values = evaluate(body, y, names, pole=pole, model=model)
     return np.array([float(values[n]) for n in names])
 
 
-def _values(body: SphericalTop, Y: FloatArray, names: Sequence[str]) -> FloatArray:
-    values = evaluate(body, Y, names)
+def _values(
+    body: SphericalTop, model: ContactModel, Y: FloatArray, names: Sequence[str]
+) -> FloatArray:
+    values = evaluate(body, Y, names, model=model)
     return np.stack([np.asarray(values[n], dtype=float) for n in names], axis=-1)
 
 
@@ -102,9 +104,9 @@ def _orientation(
     while True:
         gamma = rng.normal(size=3)
         gamma /= np.linalg.norm(gamma)
-        if model.vertical_tolerance > 0 and math.hypot(gamma[0], gamma[1]) < VERTICAL_MARGIN:
+        if model.vertical.tolerance > 0 and math.hypot(gamma[0], gamma[1]) < VERTICAL_MARGIN:
             continue
-        if model.singular is not None and model.singular(body, gamma) is not None:
+        if model.vertical.singular is not None and model.vertical.singular(body, gamma) is not None:
             continue
         alpha = np.cross(gamma, rng.normal(size=3))
         return gamma, alpha / np.linalg.norm(alpha)
@@ -140,14 +142,14 @@ def _sample(
     def states(c: FloatArray) -> FloatArray:
         Y = np.repeat(y[None, :], len(c), axis=0)
         Y[:, :6] = c @ basis
-        if model.slot_value is not None:  # the model's own velocity (the pair's shell spin)
+        if model.own is not None:  # the model's own velocity (the pair's shell spin)
             for row in Y:
-                row[17] = model.slot_value(body, row)
+                row[17] = model.own.value(body, row)
         return Y
 
     def jacobian(c: FloatArray) -> tuple[FloatArray, FloatArray]:
         steps = np.vstack([c, c + FD_STEP * np.eye(d), c - FD_STEP * np.eye(d)])
-        F = _values(body, states(steps), names)
+        F = _values(body, model, states(steps), names)
         return F[0], (F[1 : d + 1] - F[d + 1 :]).T / (2 * FD_STEP)
 
     energy_row = list(names).index("energy")
@@ -171,7 +173,7 @@ def _sample(
         return None
     # the energy along c + x n is quadratic in x (the kinetic energy is a quadratic form in the
     # velocities, the model's own slot included): E(x) = e0 + b x + a x^2 from three values
-    e_m, e0, e_p = _values(body, states(np.array([c - n, c, c + n])), ["energy"])[:, 0]
+    e_m, e0, e_p = _values(body, model, states(np.array([c - n, c, c + n])), ["energy"])[:, 0]
     a, b = 0.5 * (e_p + e_m) - e0, 0.5 * (e_p - e_m)
     disc = b * b - 4.0 * a * (e0 - target[energy_row])
     if not (a > 0.0 and disc >= 0.0):

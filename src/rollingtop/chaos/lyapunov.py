@@ -54,7 +54,7 @@ def vertical_stop(model: ContactModel) -> float:
     vertical) for a model whose motion the state there does not determine (the ``parallel``
     model: its flow has no derivative at the pole, the tangent vector would explode at every
     passage)."""
-    return 0.0 if model.determined_through_vertical else 1.0
+    return 0.0 if model.vertical.determined else 1.0
 
 
 #: Seed of the default initial tangent vector (a fixed random direction: reproducible runs).
@@ -146,8 +146,8 @@ class ChaosIndicators(NetCDFOutput):
         """Largest ``|I(t) - I(0)|`` over the samples of each integral of the model."""
         names = self.model.integrals_for(self.body)
         pole = self.model.kernel(self.body, self.initial).variant
-        start = evaluate(self.body, self.initial, names, pole=pole)
-        along = evaluate(self.body, self.states, names, pole=pole)
+        start = evaluate(self.body, self.initial, names, pole=pole, model=self.model)
+        along = evaluate(self.body, self.states, names, pole=pole, model=self.model)
         return {n: float(np.max(np.abs(along[n] - start[n]))) for n in names}
 
     def summary(self) -> dict[str, Any]:

@@ -239,9 +239,7 @@ def poincare_section(
     mask = np.arange(crossings)[None, :] >= found[:, None]
     ev_t[mask] = np.nan
     ev_y[mask] = np.nan
-    # the basis of the carried direction in the last slot; a model that keeps a variable of its
-    # own there (ContactModel.own_inertia) has the geometric one
-    red = reduced_components(ev_y[..., :17] if model.own_inertia else ev_y)
+    red = reduced_components(ev_y, model=model)
     levels = np.array([level_values(body, model, y, names) for y in Y0])
     data: dict[str, tuple[Any, NDArray[Any]]] = {
         "gamma3": (("trajectory", "crossing"), red["gamma3"]),

@@ -29,7 +29,14 @@ from typing import TYPE_CHECKING
 
 from rollingtop._errors import ContactModelError
 from rollingtop.contact import meridian, parallel, rough, rubber, shell_rotor, smooth
-from rollingtop.contact._base import ContactModel, Kernel, register_kernels
+from rollingtop.contact._base import (
+    ContactModel,
+    Kernel,
+    OwnVelocity,
+    Symbolic,
+    Vertical,
+    register_kernels,
+)
 
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
@@ -53,9 +60,9 @@ DEFAULT_MODEL: str = MODULES[0].MODEL.name
 def _kernels() -> tuple[Kernel, ...]:
     """Model by model in registry order, each model's own kernel then its variants: a model
     added at the end of :data:`MODULES` leaves every existing code as it was."""
-    pairs = [(m.MODEL, v) for m in MODULES for v in (None, *m.MODEL.variants)]
+    pairs = [(m.MODEL, v) for m in MODULES for v in (None, *m.MODEL.vertical.variants)]
     return tuple(
-        Kernel(model.name, v, code, v is not None or model.carries_direction)
+        Kernel(model.name, v, code, v is not None or model.vertical.carries_direction)
         for code, (model, v) in enumerate(pairs)
     )
 
@@ -78,6 +85,9 @@ __all__ = [
     "MODULES",
     "ContactModel",
     "Kernel",
+    "OwnVelocity",
+    "Symbolic",
+    "Vertical",
     "get_model",
     "kernel_by_code",
 ]
@@ -98,7 +108,7 @@ def get_model(name: str | ContactModel) -> ContactModel:
 def kernels_of(model: ContactModel) -> tuple[Kernel, ...]:
     """The kernels of ``model``: its own first, then its variants in declaration order."""
     by_variant = {k.variant: k for k in KERNELS if k.model == model.name}
-    return tuple(by_variant[v] for v in (None, *model.variants))
+    return tuple(by_variant[v] for v in (None, *model.vertical.variants))
 
 
 def kernel_by_code(code: int) -> Kernel:

@@ -26,8 +26,8 @@ VelocityFunction: TypeAlias = Callable[
 
 
 class VerticalDirection(Protocol):
-    """``vertical_direction(omega, alpha, beta, psi_nu=0.0) -> psi_nu``
-    (:attr:`ContactModel.vertical_direction`)."""
+    """``direction(omega, alpha, beta, psi_nu=0.0) -> psi_nu``
+    (:attr:`Vertical.direction`)."""
 
     def __call__(
         self, omega: FloatArray, alpha: FloatArray, beta: FloatArray, psi_nu: float = 0.0, /
@@ -53,7 +53,7 @@ class Kernel:
         compiled package (:mod:`rollingtop._compiled`) selects the variant by it.
     carries_direction : bool
         Whether the state's ``psi_nu`` is a carried constraint direction: a variant, or the
-        own kernel of a model that always carries it (:attr:`ContactModel.carries_direction`);
+        own kernel of a model that always carries it (:attr:`Vertical.carries_direction`);
         set by the registry.
     """
 
@@ -74,6 +74,135 @@ def register_kernels(kernels: Mapping[str, tuple[Kernel, ...]]) -> None:
     _KERNELS_OF.update(kernels)
 
 
+#: An integral of states ``Y`` (shape ``(..., 18)``) of a body: values of shape ``(...)``.
+IntegralForm: TypeAlias = Callable[["SphericalTop", FloatArray], FloatArray]
+
+
+@dataclass(frozen=True)
+class Vertical:
+    """How a contact model meets a vertical symmetry axis, ``gamma = (0, 0, +-1)``
+    (:attr:`ContactModel.vertical`). The defaults are a model whose constraint directions are
+    regular there.
+
+    Attributes
+    ----------
+    singular : callable or None
+        ``singular(body, gamma) -> str | None``: why no motion of this model can start at this
+        orientation (``None`` where one can).
+    tolerance : float
+        Below this ``sqrt(gamma1^2 + gamma2^2)`` an initial axis counts as vertical and is set
+        exactly vertical, ``gamma = (0, 0, +-1)`` (0: never; the models whose constraint
+        directions are regular at the vertical need no such rule).
+    direction : callable or None
+        ``direction(omega, alpha, beta, psi_nu) -> psi_nu``: for a model that carries a
+        constraint direction in the state (the meridian model's pole variants), its azimuth
+        ``psi_nu`` in the fixed frame (``nu = cos(psi_nu) alpha + sin(psi_nu) beta``) at an
+        exactly vertical axis, given the angular velocity and the frame; ``psi_nu`` is the value
+        to keep where the model leaves the direction free. ``None``: the state's ``psi_nu`` is
+        the axis azimuth, 0 at the vertical (unused by the model).
+    variants : tuple of str
+        Names of the model's variants (:class:`Kernel`), each compiled as a kernel of its own.
+    select_variant : callable or None
+        ``select_variant(body, y) -> str | None``: the variant for a motion from state ``y``
+        (:func:`rollingtop.contact.meridian.select_variant`); ``None``: never a variant.
+    spin : callable or None
+        ``spin(body, pole) -> omega3``: closed form of the critical spin rate of the vertical
+        spin on the pole ``pole`` (+1: ``gamma3 = 1``, the south pole on the plane; -1: north)
+        for a dynamically symmetric body, above which it is linearly stable; 0 when every spin
+        rate is (:mod:`rollingtop.stability`). ``None``: no closed form.
+    eigenvalues : callable or None
+        ``eigenvalues(body, omega3, pole) -> complex ndarray``: the eigenvalues of the
+        linearisation at the vertical spin, for a model whose equations are singular at the
+        vertical (the meridian model: its constraint direction is undefined there). ``None``: the
+        generic linearisation in ``(v, w, gamma)`` on the constraint manifold applies.
+    through_reduction : bool
+        Whether the vertical spin is analysed through the reduction instead (the meridian
+        model, singular at the vertical, with the paper's whole reduction): the eigenvalues are
+        those of the reduced motion at the pole of the pole level
+        (:func:`rollingtop.stability.pole_eigenvalues`), which :mod:`rollingtop.stability`
+        computes. A declaration only: the contact package never imports the reduction.
+    carries_direction : bool
+        Whether the model's own kernel carries its constraint direction in the state's
+        ``psi_nu`` (the ``parallel`` model, whose direction ``tau`` is undefined at the vertical
+        that its motions reach generically, :mod:`rollingtop.contact.parallel`), as the variants
+        of the meridian model do on their pole levels.
+    determined : bool
+        Whether the state at a vertical axis determines the motion after it (``False`` for the
+        ``parallel`` model: a one-parameter family of continuations leaves the pole,
+        :mod:`rollingtop.contact.parallel`); tools that need a unique flow there (the tangent
+        dynamics of :mod:`rollingtop.chaos`) stop before it.
+    """
+
+    singular: Callable[[SphericalTop, FloatArray], str | None] | None = None
+    tolerance: float = 0.0
+    direction: VerticalDirection | None = None
+    variants: tuple[str, ...] = ()
+    select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
+    spin: Callable[[SphericalTop, int], float] | None = None
+    eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
+    through_reduction: bool = False
+    carries_direction: bool = False
+    determined: bool = True
+
+
+@dataclass(frozen=True)
+class Symbolic:
+    """A contact model as the symbolic layer (:mod:`rollingtop.symbolic`) sees it
+    (:attr:`ContactModel.symbolic`): sympy is passed in, so that the model never imports it.
+
+    Attributes
+    ----------
+    directions : callable
+        ``directions(sp, gamma) -> list of sympy 3-vectors``: the directions ``d_k`` of the
+        constraints ``(vp, d_k) = 0`` in the body frame, as functions of the sympy symbols
+        ``gamma`` (the symbolic layer derives the equations from them).
+    velocity : callable
+        ``velocity(gamma, tau, wxr, free) -> v``: the centre-of-mass velocity on the constraint
+        manifold in terms of the free components ``free`` (sympy symbols), the unit vector
+        ``tau = e3 x gamma / s`` and ``w x r`` (the symbolic analogue of
+        :attr:`ContactModel.velocity`).
+    omega : callable or None
+        ``omega(gamma, tau, spin) -> w``: the angular velocity on the manifold of the
+        constraints :attr:`ContactModel.spin_directions`, in terms of the sympy symbol ``spin``
+        and ``tau`` (rational in ``gamma``); ``None`` with no such constraints.
+    claims : str or None
+        ``"module:function"`` of the symbolic layer returning further claims for
+        :func:`rollingtop.symbolic.verify` (a reduced system, particular cases); imported only
+        there.
+    """
+
+    directions: Callable[[ModuleType, Any], list[Any]]
+    velocity: Callable[[Any, Any, Any, Any], Any]
+    omega: Callable[[Any, Any, Any], Any] | None = None
+    claims: str | None = None
+
+
+@dataclass(frozen=True)
+class OwnVelocity:
+    """The velocity of its own that a model's kinetic energy has beyond the body's
+    (:attr:`ContactModel.own`; the ``shell-rotor`` pair: the shell's spin relative to the
+    rotor), kept in the state's last slot. With it the general row path of the dynamics (mass
+    matrix ``diag(m, m, m, I)``) does not apply: the model's closed forms are the equations.
+
+    Attributes
+    ----------
+    name : str
+        Name of the state's last slot in the outputs (``shell_spin``).
+    value : callable
+        ``value(body, y) -> float``: the slot for a new state whose ``v``, ``w`` and frame are
+        set (:func:`rollingtop.initial_state`).
+    integrals : mapping of str to callable
+        The model's own form of each integral whose lone-body form
+        (:mod:`rollingtop.dynamics.integrals`) the extra kinetic energy changes, by the same
+        name (``energy``, ``jellett``, ``F6``: :mod:`rollingtop.contact._shell_pair`);
+        :func:`rollingtop.dynamics.integrals.evaluate` uses them for this model.
+    """
+
+    name: str
+    value: Callable[[SphericalTop, FloatArray], float]
+    integrals: Mapping[str, IntegralForm]
+
+
 @dataclass(frozen=True)
 class ContactModel:
     """A set of ideal constraints at the contact point, with everything that follows from it.
@@ -82,7 +211,10 @@ class ContactModel:
     constraint rows (``rows``) and, optionally, their closed forms (``accel``,
     ``project_velocity``) and the carried direction of its variants (``direction_rate``,
     ``sync_direction``); the registry (:data:`rollingtop.contact.MODELS`) lists it. Everything
-    else in the package asks the model.
+    else in the package asks the model. Its fields come in groups: what it is (name,
+    constraints, velocity), its integrals and reduction, its behaviour at a vertical axis
+    (:class:`Vertical`), its symbolic form (:class:`Symbolic`), a velocity of its own
+    (:class:`OwnVelocity`) and its presentation (outputs, colour, devices).
 
     Attributes
     ----------
@@ -94,68 +226,9 @@ class ContactModel:
         Human-readable name of each constraint row, in kernel order.
     free_velocity : dict of str to int
         Velocity components the constraints leave free, each with its length (1: scalar).
-    integrals_symmetric, integrals_general : tuple of str
-        First integrals that hold for a dynamically symmetric body (``I1 == I2``) and for a
-        general one (names of :mod:`rollingtop.dynamics.integrals`).
     velocity : callable
         ``velocity(body, gamma, omega, alpha, beta, free) -> v``: the body-frame CoM velocity,
         shape (3,), that satisfies the constraints for the given free components.
-    symbolic_directions : callable
-        ``symbolic_directions(sp, gamma) -> list of sympy 3-vectors``: the directions ``d_k`` of
-        the constraints ``(vp, d_k) = 0`` in the body frame, as functions of the sympy symbols
-        ``gamma`` (the symbolic layer, :mod:`rollingtop.symbolic`, derives the equations from
-        them; sympy is passed in, so that the model does not import it).
-    symbolic_velocity : callable
-        ``symbolic_velocity(gamma, tau, wxr, free) -> v``: the centre-of-mass velocity on the
-        constraint manifold in terms of the free components ``free`` (sympy symbols), the unit
-        vector ``tau = e3 x gamma / s`` and ``w x r`` (the symbolic analogue of
-        :attr:`velocity`).
-    singular : callable or None
-        ``singular(body, gamma) -> str | None``: why no motion of this model can start at this
-        orientation (``None`` where one can).
-    vertical_tolerance : float
-        Below this ``sqrt(gamma1^2 + gamma2^2)`` an initial axis counts as vertical and is set
-        exactly vertical, ``gamma = (0, 0, +-1)`` (0: never; the models whose constraint
-        directions are regular at the vertical need no such rule).
-    vertical_direction : callable or None
-        ``vertical_direction(omega, alpha, beta, psi_nu) -> psi_nu``: for a model that carries a
-        constraint direction in the state (the meridian model's pole variants), its azimuth
-        ``psi_nu`` in the fixed frame (``nu = cos(psi_nu) alpha + sin(psi_nu) beta``) at an
-        exactly vertical axis, given the angular velocity and the frame; ``psi_nu`` is the value
-        to keep where the model leaves the direction free. ``None``: the state's ``psi_nu`` is
-        the axis azimuth, 0 at the vertical (unused by the model).
-    variants : tuple of str
-        Names of the model's variants (:class:`Kernel`), each compiled as a kernel of its own.
-    select_variant : callable or None
-        ``select_variant(body, y) -> str | None``: the variant for a motion from state ``y``
-        (:func:`rollingtop.contact.meridian.select_variant`); ``None``: never a variant.
-    vertical_spin : callable or None
-        ``vertical_spin(body, pole) -> omega3``: closed form of the critical spin rate of the
-        vertical spin on the pole ``pole`` (+1: ``gamma3 = 1``, the south pole on the plane; -1:
-        north) for a dynamically symmetric body, above which it is linearly stable; 0 when every
-        spin rate is (:mod:`rollingtop.stability`). ``None``: no closed form.
-    vertical_eigenvalues : callable or None
-        ``vertical_eigenvalues(body, omega3, pole) -> complex ndarray``: the eigenvalues of the
-        linearisation at the vertical spin, for a model whose equations are singular at the
-        vertical (the meridian model: its constraint direction is undefined there). ``None``: the
-        generic linearisation in ``(v, w, gamma)`` on the constraint manifold applies.
-    vertical_through_reduction : bool
-        Whether the vertical spin is analysed through the reduction instead (the meridian
-        model, singular at the vertical, with the paper's whole reduction): the eigenvalues are
-        those of the reduced motion at the pole of the pole level
-        (:func:`rollingtop.stability.pole_eigenvalues`), which
-        :mod:`rollingtop.stability` computes. A declaration only: the contact package
-        never imports the reduction.
-    carries_direction : bool
-        Whether the model's own kernel carries its constraint direction in the state's
-        ``psi_nu`` (the ``parallel`` model, whose direction ``tau`` is undefined at the vertical
-        that its motions reach generically, :mod:`rollingtop.contact.parallel`), as the variants
-        of the meridian model do on their pole levels.
-    determined_through_vertical : bool
-        Whether the state at a vertical axis determines the motion after it (``False`` for the
-        ``parallel`` model: a one-parameter family of continuations leaves the pole,
-        :mod:`rollingtop.contact.parallel`); tools that need a unique flow there (the tangent
-        dynamics of :mod:`rollingtop.chaos`) stop before it.
     spin_directions : callable or None
         ``spin_directions(gamma) -> {name: d}``: the constraints on the angular velocity alone,
         ``(w, d) = 0`` (rubber rolling: no spin about the normal, ``d = gamma``), each with its
@@ -163,11 +236,16 @@ class ContactModel:
         matrices alike (the symbolic layer adds these constraints to the contact rows). An initial
         ``omega`` that violates one is refused (:func:`rollingtop.dynamics.state.initial_state`),
         not projected. ``None``: the angular velocity is free.
-    symbolic_omega : callable or None
-        ``symbolic_omega(gamma, tau, spin) -> w``: the angular velocity on the manifold of the
-        constraints :attr:`spin_directions`, in terms of the two sympy symbols ``spin`` and the
-        unit vector ``tau = e3 x gamma / s`` (the symbolic layer's parametrisation, rational in
-        ``gamma``); ``None`` with no such constraints.
+    symbolic : Symbolic
+        The model for the symbolic layer.
+    integrals_symmetric, integrals_general : tuple of str
+        First integrals that hold for a dynamically symmetric body (``I1 == I2``) and for a
+        general one (names of :mod:`rollingtop.dynamics.integrals`).
+    particular_integrals : callable or None
+        ``particular_integrals(body) -> names``: integrals (keys of
+        :data:`rollingtop.dynamics.integrals.INTEGRALS`) the model gains for particular bodies
+        (``parallel``: the slip along ``nu`` when ``a3 = 0`` and ``I3 = I1``); see
+        :meth:`integrals_for`.
     reduction : tuple of str
         The names of the integrals that fix a level set of the model's reduction to one degree
         of freedom (a dynamically symmetric body), in order: ``("M3", "C1", "C2")`` for the
@@ -175,70 +253,56 @@ class ContactModel:
         table. The reduction itself (potential, mass, level of a state, state of a level) is
         registered under the model's name in :mod:`rollingtop.reduction.models`: a declaration
         here, since the contact package never imports the reduction.
-    colour : str
-        Matplotlib colour of the model in figures that compare models.
-    particular_integrals : callable or None
-        ``particular_integrals(body) -> names``: integrals (keys of
-        :data:`rollingtop.dynamics.integrals.INTEGRALS`) the model gains for particular bodies
-        (``parallel``: the slip along ``nu`` when ``a3 = 0`` and ``I3 = I1``); see
-        :meth:`integrals_for`.
-    own_inertia : bool
-        Whether the model's kinetic energy is more than the body's own (the ``shell-rotor``
-        pair): the general row path of the dynamics (mass matrix ``diag(m, m, m, I)``) does
-        not apply, the model's closed forms are the equations, and the state's last slot is
-        the model's own velocity (:attr:`slot_value`).
-    slot_value : callable or None
-        ``slot_value(body, y) -> float``: the state's last slot for a new state whose ``v``,
-        ``w`` and frame are set (:func:`rollingtop.initial_state`), for a model that keeps a
-        variable of its own there (``shell-rotor``: the shell's relative spin).
-    slot_name : str
-        Name of the state's last slot in the outputs: ``psi_nu`` (the constraint direction's
-        azimuth) unless the model keeps its own velocity there (``shell-rotor``:
-        ``shell_spin``, the shell's spin about the axis relative to the rotor).
+    vertical : Vertical
+        The model at a vertical axis (default: regular there).
+    own : OwnVelocity or None
+        The model's own velocity beyond the body's (``shell-rotor``); ``None``: the state's
+        last slot is the constraint direction's azimuth ``psi_nu``.
     state_outputs : callable or None
         ``state_outputs(body, Y) -> {name: array (n, 3)}``: further per-sample quantities of
         the model's states ``Y`` (n, 18) for the outputs (``shell-rotor``: the shell's angular
         velocity and the bearing's reaction torque), body frame.
+    colour : str
+        Matplotlib colour of the model in figures that compare models.
     devices : tuple of str
         The devices of the paper's Sec. 1 (:data:`rollingtop.devices.DEVICES`) that realise
         this model's constraint, drawn by ``rollingtop animate --look`` (the meridian model:
         all three; ``shell-rotor``: the shell).
-    symbolic_claims : str or None
-        ``"module:function"`` of the symbolic layer returning further claims for
-        :func:`rollingtop.symbolic.verify` (a reduced system, particular cases); imported only
-        there, so the model itself never imports sympy.
     """
 
     name: str
     description: str
     constraints: tuple[str, ...]
     free_velocity: dict[str, int]
+    velocity: VelocityFunction
+    symbolic: Symbolic
     integrals_symmetric: tuple[str, ...]
     integrals_general: tuple[str, ...]
-    velocity: VelocityFunction
-    symbolic_directions: Callable[[ModuleType, Any], list[Any]]
-    symbolic_velocity: Callable[[Any, Any, Any, Any], Any]
-    singular: Callable[[SphericalTop, FloatArray], str | None] | None = None
-    vertical_tolerance: float = 0.0
-    vertical_direction: VerticalDirection | None = None
-    variants: tuple[str, ...] = ()
-    select_variant: Callable[[SphericalTop, FloatArray], str | None] | None = None
-    vertical_spin: Callable[[SphericalTop, int], float] | None = None
-    vertical_eigenvalues: Callable[[SphericalTop, float, int], ComplexArray] | None = None
-    vertical_through_reduction: bool = False
-    carries_direction: bool = False
-    determined_through_vertical: bool = True
     spin_directions: Callable[[Any], dict[str, Any]] | None = None
-    symbolic_omega: Callable[[Any, Any, Any], Any] | None = None
-    reduction: tuple[str, ...] = ()
-    colour: str = "#7f7f7f"
     particular_integrals: Callable[[SphericalTop], tuple[str, ...]] | None = None
-    symbolic_claims: str | None = None
-    own_inertia: bool = False
-    devices: tuple[str, ...] = ()
+    reduction: tuple[str, ...] = ()
+    vertical: Vertical = Vertical()
+    own: OwnVelocity | None = None
     state_outputs: Callable[[SphericalTop, FloatArray], dict[str, FloatArray]] | None = None
-    slot_value: Callable[[SphericalTop, FloatArray], float] | None = None
-    slot_name: str = "psi_nu"
+    colour: str = "#7f7f7f"
+    devices: tuple[str, ...] = ()
+
+    @property
+    def own_inertia(self) -> bool:
+        """Whether the model's kinetic energy is more than the body's own (:attr:`own`)."""
+        return self.own is not None
+
+    @property
+    def slot_name(self) -> str:
+        """Name of the state's last slot in the outputs: ``psi_nu`` (the constraint
+        direction's azimuth) unless the model keeps its own velocity there (:attr:`own`)."""
+        return "psi_nu" if self.own is None else self.own.name
+
+    @property
+    def integral_forms(self) -> Mapping[str, IntegralForm]:
+        """The model's own form of each integral it changes from the lone body's
+        (:attr:`OwnVelocity.integrals`); empty for most models."""
+        return {} if self.own is None else self.own.integrals
 
     def integrals(self, symmetric: bool) -> tuple[str, ...]:
         """Names of the first integrals of this model for a (non-)symmetric body."""
@@ -302,7 +366,8 @@ class ContactModel:
     def kernel(self, body: SphericalTop, y: FloatArray) -> Kernel:
         """The kernel for a motion of ``body`` from state ``y``: the model's own, or the variant
         :attr:`select_variant` picks."""
-        variant = None if self.select_variant is None else self.select_variant(body, y)
+        select = self.vertical.select_variant
+        variant = None if select is None else select(body, y)
         for k in self.kernels:
             if k.variant == variant:
                 return k

@@ -59,7 +59,7 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import Float6, FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
+from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import contact_row, normal_row, sync_azimuth
 from rollingtop.contact._rows import sync_direction as sync_geometric
@@ -341,7 +341,7 @@ def _vertical_spin(body: SphericalTop, pole: int) -> float:
     ``m g a cos(theta)`` to second order). Stable for ``U'' > 0``:
     ``w3 > 2 I1 sqrt(m g a / (I1 + m l^2)) / I3``; every spin when ``a <= 0``. The constraint
     direction is undefined at the vertical, so this (and the eigenvalues,
-    :attr:`~rollingtop.contact.ContactModel.vertical_through_reduction`) comes from the reduction
+    :attr:`~rollingtop.contact.Vertical.through_reduction`) comes from the reduction
     rather than from a linearisation in ``(v, w, gamma)``.
     """
     a = pole * body.a3
@@ -364,15 +364,16 @@ MODEL = ContactModel(
     integrals_symmetric=("energy", "lagrange", "jellett", "area", "F6"),
     integrals_general=("energy", "area"),
     velocity=_velocity,
-    symbolic_directions=_symbolic_directions,
-    symbolic_velocity=_symbolic_velocity,
-    singular=_singular,
-    vertical_tolerance=POLE_TOLERANCE,
-    vertical_direction=vertical_direction,
-    variants=VARIANTS,
-    select_variant=select_variant,
-    vertical_spin=_vertical_spin,
-    vertical_through_reduction=True,
+    symbolic=Symbolic(_symbolic_directions, _symbolic_velocity),
+    vertical=Vertical(
+        singular=_singular,
+        tolerance=POLE_TOLERANCE,
+        direction=vertical_direction,
+        variants=VARIANTS,
+        select_variant=select_variant,
+        spin=_vertical_spin,
+        through_reduction=True,
+    ),
     reduction=("M3", "C1", "C2"),
     colour="#1f77b4",
     devices=("roller", "shell", "skates"),

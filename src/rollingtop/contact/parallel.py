@@ -79,7 +79,7 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import ComplexArray, Float3, Float6, FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
+from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import (
     contact_arm_rate,
@@ -342,13 +342,15 @@ MODEL = ContactModel(
     integrals_symmetric=("energy", "jellett"),
     integrals_general=("energy",),
     velocity=_velocity,
-    symbolic_directions=_symbolic_directions,
-    symbolic_velocity=_symbolic_velocity,
-    vertical_direction=vertical_direction,
-    vertical_eigenvalues=_vertical_eigenvalues,
-    carries_direction=True,
-    determined_through_vertical=False,
+    symbolic=Symbolic(
+        _symbolic_directions, _symbolic_velocity, claims="rollingtop.symbolic.parallel:claims"
+    ),
+    vertical=Vertical(
+        direction=vertical_direction,
+        eigenvalues=_vertical_eigenvalues,
+        carries_direction=True,
+        determined=False,
+    ),
     colour="#9467bd",
     particular_integrals=_particular,
-    symbolic_claims="rollingtop.symbolic.parallel:claims",
 )

@@ -14,7 +14,7 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import Float3, Float6, FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
+from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._rows import contact_arm_rate, contact_row, free_forces
 
 #: The stepper's stage loop inlines this model's right-hand side (short closed form: fast, and
@@ -184,8 +184,7 @@ MODEL = ContactModel(
     reduction=("jellett", "routh"),
     integrals_general=("energy",),
     velocity=_velocity,
-    symbolic_directions=_symbolic_directions,
-    symbolic_velocity=_symbolic_velocity,
-    vertical_spin=_vertical_spin,
+    symbolic=Symbolic(_symbolic_directions, _symbolic_velocity),
+    vertical=Vertical(spin=_vertical_spin),
     colour="#d62728",
 )

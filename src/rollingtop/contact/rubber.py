@@ -25,7 +25,7 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
+from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, contact_arm
 from rollingtop.contact._rows import contact_arm_rate, contact_row, free_forces
 from rollingtop.contact.rough import _rough_matrix, _solve3
 
@@ -186,10 +186,12 @@ MODEL = ContactModel(
     reduction=("rubber_spin",),
     integrals_general=("energy",),
     velocity=_velocity,
-    symbolic_directions=_symbolic_directions,
-    symbolic_velocity=_symbolic_velocity,
     spin_directions=_spin_directions,
-    symbolic_omega=_symbolic_omega,
-    symbolic_claims="rollingtop.symbolic.rubber:claims",
+    symbolic=Symbolic(
+        _symbolic_directions,
+        _symbolic_velocity,
+        omega=_symbolic_omega,
+        claims="rollingtop.symbolic.rubber:claims",
+    ),
     colour="#ff7f0e",
 )

@@ -35,14 +35,15 @@ drops out of ``T^T (M u' - F) = 0``: a 4x4 SPD system ``(T^T M T) q' = T^T (F - 
 (:func:`accelerations`); then ``lambda = (M u')_v - F_v``.
 
 **Integrals** (all proved by :mod:`rollingtop.symbolic.shell_rotor`): energy (the pair's,
-:func:`rollingtop.dynamics.integrals.energy` with the shell's terms); the rotor's axial spin
-``w3`` -- the bearing is frictionless and every force the shell exerts on the rotor acts on the
-axis, so its torque about ``C`` has no ``e3`` component, and Euler's equation gives
-``I3 w3' = (I1 - I2) w1 w2 = 0`` for a symmetric rotor (Lagrange's integral ``I3 w3``); a
-Jellett integral about the pair's centre of mass and the pair's ``F6``
-(:func:`rollingtop.dynamics.integrals.jellett`, :func:`~rollingtop.dynamics.integrals.F6` for a
-body with a shell): as many as the meridian model has, which it becomes as the shell's mass and
-inertia vanish.
+:func:`rollingtop.contact._shell_pair.pair_energy`: the body's with the shell's terms); the rotor's
+axial spin ``w3`` -- the bearing is frictionless and every force the shell exerts on the rotor acts
+on the axis, so its torque about ``C`` has no ``e3`` component, and Euler's equation gives ``I3 w3'
+= (I1 - I2) w1 w2 = 0`` for a symmetric rotor (Lagrange's integral ``I3 w3``); a Jellett integral
+about the pair's centre of mass and the pair's ``F6``
+(:func:`~rollingtop.contact._shell_pair.pair_jellett`,
+:func:`~rollingtop.contact._shell_pair.pair_F6`; the model declares them,
+:attr:`~rollingtop.contact.OwnVelocity.integrals`): as many as the meridian model has, which it
+becomes as the shell's mass and inertia vanish.
 """
 
 from __future__ import annotations
@@ -55,8 +56,9 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import ComplexArray, FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity
+from rollingtop.contact._base import ContactModel, FreeVelocity, OwnVelocity, Symbolic, Vertical
 from rollingtop.contact._rows import contact_row, normal_row
+from rollingtop.contact._shell_pair import pair_energy, pair_F6, pair_jellett
 
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
@@ -377,14 +379,16 @@ MODEL = ContactModel(
     reduction=("M3", "jellett", "C2"),
     integrals_general=("energy",),
     velocity=_velocity,
-    symbolic_directions=_symbolic_directions,
-    symbolic_velocity=_symbolic_velocity,
-    vertical_eigenvalues=_vertical_eigenvalues,
-    own_inertia=True,
+    symbolic=Symbolic(
+        _symbolic_directions, _symbolic_velocity, claims="rollingtop.symbolic.shell_rotor:claims"
+    ),
+    vertical=Vertical(eigenvalues=_vertical_eigenvalues),
+    own=OwnVelocity(
+        "shell_spin",
+        relative_spin,
+        {"energy": pair_energy, "jellett": pair_jellett, "F6": pair_F6},
+    ),
     devices=("shell",),
-    slot_value=relative_spin,
-    slot_name="shell_spin",
     state_outputs=outputs,
-    symbolic_claims="rollingtop.symbolic.shell_rotor:claims",
     colour="#8c564b",
 )

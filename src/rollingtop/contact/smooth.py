@@ -10,7 +10,7 @@ import numpy as np
 
 from rollingtop._jit import inline, kernel
 from rollingtop._types import FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity, contact_arm
+from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import normal_row
 
@@ -85,9 +85,8 @@ MODEL = ContactModel(
     integrals_symmetric=("energy", "lagrange", "jellett", "area", "momentum_x", "momentum_y"),
     integrals_general=("energy", "area", "momentum_x", "momentum_y"),
     velocity=_velocity,
-    symbolic_directions=_symbolic_directions,
-    symbolic_velocity=_symbolic_velocity,
-    vertical_spin=_vertical_spin,
+    symbolic=Symbolic(_symbolic_directions, _symbolic_velocity),
+    vertical=Vertical(spin=_vertical_spin),
     reduction=("M3", "C1", "p_horizontal"),
     colour="#2ca02c",
 )

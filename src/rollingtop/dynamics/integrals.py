@@ -9,19 +9,30 @@ Which integrals hold for which model and body is declared by the contact models
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import Any, TypeAlias
+from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._layout import ALPHA, BETA, GAMMA, PSI_NU, V, W
 from rollingtop.body import SphericalTop
+from rollingtop.contact import ContactModel, get_model
 
 __all__ = ["HELD_TOLERANCE", "INTEGRALS", "F6_reduced", "evaluate", "natural_scales"]
 
 FloatArray: TypeAlias = NDArray[np.float64]
 #: An integral: ``(body, Y)`` with states ``Y`` of shape ``(..., 18)`` -> values, shape ``(...)``.
 Integral: TypeAlias = Callable[[SphericalTop, FloatArray], FloatArray]
+
+
+def _lone(body: SphericalTop, name: str) -> None:
+    """Refuse a body with a shell: its integral ``name`` is the model's
+    (:attr:`rollingtop.contact.ContactModel.integral_forms`), not the lone body's."""
+    if body.has_shell:
+        raise ValueError(
+            f"the {name} integral of a body with a shell is the shell-rotor pair's: evaluate it "
+            "with model='shell-rotor' (rollingtop.dynamics.integrals.evaluate)"
+        )
 
 
 def _arm(body: SphericalTop, Y: FloatArray) -> FloatArray:
@@ -40,19 +51,14 @@ def _Iw(body: SphericalTop, Y: FloatArray) -> FloatArray:
 def energy(body: SphericalTop, Y: FloatArray) -> FloatArray:
     """``E = m (v, v)/2 + (w, I w)/2 - m g (r, gamma)``; zero with the CoM on the plane.
 
-    With a shell (:attr:`rollingtop.SphericalTop.has_shell`, model ``shell-rotor``) the pair's:
-    plus ``ms v_O^2/2 + Js |Omega|^2/2``, ``v_O = v - a3 w x e3``, ``Omega = w + delta e3``
-    with the shell's relative spin ``delta`` in the state's last slot
-    (:mod:`rollingtop.contact.shell_rotor`); the shell's centre stays at height ``R``.
+    A lone body's. A model whose kinetic energy is more than the body's declares its own
+    (:attr:`rollingtop.contact.ContactModel.integral_forms`: the ``shell-rotor`` pair's
+    :func:`rollingtop.contact._shell_pair.pair_energy`), which :func:`evaluate` uses for it;
+    a body with a shell is refused here (``ValueError``).
     """
+    _lone(body, "energy")
     v, w, gamma = Y[..., V], Y[..., W], Y[..., GAMMA]
     kinetic = 0.5 * body.m * np.sum(v * v, axis=-1) + 0.5 * np.sum(w * _Iw(body, Y), axis=-1)
-    if body.has_shell:
-        o1 = v[..., 0] - body.a3 * w[..., 1]
-        o2 = v[..., 1] + body.a3 * w[..., 0]
-        spin = w[..., 2] + Y[..., PSI_NU]
-        kinetic = kinetic + 0.5 * body.shell_mass * (o1 * o1 + o2 * o2 + v[..., 2] ** 2)
-        kinetic = kinetic + 0.5 * body.shell_inertia * (w[..., 0] ** 2 + w[..., 1] ** 2 + spin**2)
     E: FloatArray = kinetic - body.m * body.g * np.sum(_arm(body, Y) * gamma, axis=-1)
     return E
 
@@ -64,26 +70,11 @@ def lagrange(body: SphericalTop, Y: FloatArray) -> FloatArray:
 
 
 def jellett(body: SphericalTop, Y: FloatArray) -> FloatArray:
-    """Jellett's integral ``F4 = (I w, r)``.
-
-    With a shell (``shell-rotor``, :mod:`rollingtop.symbolic.shell_rotor`) the pair's:
-    ``(K_G, r_G)``, the angular momentum about the pair's centre of mass ``G`` against the
-    contact point seen from ``G``: ``K_G = I w + Js Omega + m (C - G) x v + ms (O - G) x v_O``,
-    ``r_G = -R gamma - a3 e3 - G`` (``C``: the rotor's centre of mass, the origin; ``O = -a3 e3``
-    the shell's centre; ``G = ms O / (m + ms)``)."""
-    if not body.has_shell:
-        F4: FloatArray = np.sum(_Iw(body, Y) * _arm(body, Y), axis=-1)
-        return F4
-    ms, Js, a3 = body.shell_mass, body.shell_inertia, body.a3
-    e3 = np.array([0.0, 0.0, 1.0])
-    O = -a3 * e3
-    G = ms * O / (body.m + ms)
-    v, w = Y[..., V], Y[..., W]
-    omega = w + Y[..., PSI_NU][..., None] * e3
-    v_O = v - np.cross(w, a3 * e3)
-    K = _Iw(body, Y) + Js * omega + body.m * np.cross(-G, v) + ms * np.cross(O - G, v_O)
-    pair: FloatArray = np.sum(K * (_arm(body, Y) - G), axis=-1)
-    return pair
+    """Jellett's integral ``F4 = (I w, r)`` of a lone body (the ``shell-rotor`` pair's:
+    :func:`rollingtop.contact._shell_pair.pair_jellett`, see :func:`energy`)."""
+    _lone(body, "jellett")
+    F4: FloatArray = np.sum(_Iw(body, Y) * _arm(body, Y), axis=-1)
+    return F4
 
 
 def area(body: SphericalTop, Y: FloatArray) -> FloatArray:
@@ -92,7 +83,9 @@ def area(body: SphericalTop, Y: FloatArray) -> FloatArray:
     return F5
 
 
-def reduced_components(Y: ArrayLike, pole: str | None = None) -> dict[str, FloatArray]:
+def reduced_components(
+    Y: ArrayLike, pole: str | None = None, *, model: str | ContactModel | None = None
+) -> dict[str, FloatArray]:
     """Reduced variables of states ``Y`` (paper Sec. 3.1), each of shape ``(...)``.
 
     Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``. The basis is the one of the
@@ -104,12 +97,15 @@ def reduced_components(Y: ArrayLike, pole: str | None = None) -> dict[str, Float
     and the components along them change sign (the signed convention of
     :mod:`rollingtop.reduction.level`), and ``theta = atan2(s, gamma3)`` is the signed nutation
     angle (taken in ``(0, 2 pi)`` for ``pole="north"``). States of 17 components (no
-    ``psi_nu``) use the geometric ``nu``.
+    ``psi_nu``), and the states of a ``model`` that keeps a velocity of its own in the last slot
+    (:attr:`rollingtop.contact.ContactModel.own`, the shell-rotor pair), use the geometric
+    ``nu``.
     """
     Y = np.asarray(Y, dtype=float)
+    carried = Y.shape[-1] > 17 and (model is None or get_model(model).own is None)
     g1, g2, g3 = Y[..., 12], Y[..., 13], Y[..., 14]
     nu: FloatArray
-    if Y.shape[-1] > 17:
+    if carried:
         c, sn = np.cos(Y[..., 17]), np.sin(Y[..., 17])
         nu = c[..., None] * Y[..., ALPHA] + sn[..., None] * Y[..., BETA]
     else:
@@ -161,44 +157,15 @@ def F6_reduced(
     return F6
 
 
-def pair_weight(body: SphericalTop, g3: Any) -> tuple[Any, Any]:
-    """The shell-rotor pair's ``N(gamma3)`` and ``Phi(gamma3)`` of its ``F6``
-    (:func:`rollingtop.symbolic.shell_rotor.f6_pair`, where they are derived and proved):
-    ``Phi' = ((m + ms) R gamma3 + m a3) / sqrt(N)``. Real arrays (``arccos``'s argument is
-    clipped to ``[-1, 1]``, round-off at the poles) or complex ones (the complex step of the
-    reduction's ``d2U``: not clipped)."""
-    R, m, a3, I1 = body.R, body.m, body.a3, body.I1
-    ms, Js = body.shell_mass, body.shell_inertia
-    K = (m + ms) * I1 + m * ms * a3**2
-    alpha = Js * (I1 + Js + ms * R**2 + m * R**2 + m * a3**2) + R**2 * K
-    beta = 2.0 * Js * m * R * a3
-    kappa = R**2 * K
-    N = alpha + beta * g3 - kappa * g3**2
-    p = (m + ms) * R
-    x = (2 * kappa * g3 - beta) / np.sqrt(beta**2 + 4 * alpha * kappa)
-    arc = np.arccos(x if np.iscomplexobj(x) else np.clip(x, -1, 1))
-    phi = -p / kappa * np.sqrt(N) - (m * a3 + p * beta / (2 * kappa)) / np.sqrt(kappa) * arc
-    return N, phi
-
-
-def _f6_pair(body: SphericalTop, Y: FloatArray) -> FloatArray:
-    """The shell-rotor pair's ``F6``: ``Omega3 sqrt(N) + R I3 w3 Phi(gamma3)``
-    (:func:`pair_weight`)."""
-    N, phi = pair_weight(body, Y[..., 14])
-    w3 = Y[..., 5]
-    f6: FloatArray = (w3 + Y[..., PSI_NU]) * np.sqrt(N) + body.R * body.I3 * w3 * phi
-    return f6
-
-
 def F6(body: SphericalTop, Y: FloatArray, pole: str | None = None) -> FloatArray:
     """The paper's new linear integral (symmetric body, meridian model, eq. 3.9) of states ``Y``:
     :func:`F6_reduced` of the reduced variables of :func:`reduced_components`, where
     ``sqrt(1 - gamma3^2)`` and ``arccos(gamma3)`` are the signed ``s`` and ``theta``, so that it
     stays constant through the pole passages of a pole case, where the paper's unsigned
-    expression changes sign.
+    expression changes sign. A lone body's (the ``shell-rotor`` pair's:
+    :func:`rollingtop.contact._shell_pair.pair_F6`, see :func:`energy`).
     """
-    if body.has_shell:  # the shell-rotor pair's
-        return _f6_pair(body, Y)
+    _lone(body, "F6")
     c = reduced_components(Y, pole)
     M3: FloatArray = body.I3 * Y[..., 5]
     return F6_reduced(body, M3, c["gamma3"], c["s"], c["theta"], c["v_tau"], c["w_n"])
@@ -274,12 +241,30 @@ INTEGRALS: dict[str, Integral] = {
 
 
 def evaluate(
-    body: SphericalTop, Y: ArrayLike, names: Iterable[str], pole: str | None = None
+    body: SphericalTop,
+    Y: ArrayLike,
+    names: Iterable[str],
+    pole: str | None = None,
+    *,
+    model: str | ContactModel | None = None,
 ) -> dict[str, FloatArray]:
-    """Evaluate the integrals ``names`` on states ``Y`` (shape ``(..., 18)``); ``pole`` is the
-    meridian pole case the states belong to, if any (see :func:`F6`)."""
+    """Evaluate the integrals ``names`` on states ``Y`` (shape ``(..., 18)``).
+
+    ``pole`` is the meridian pole case the states belong to, if any (see :func:`F6`);
+    ``model`` the contact model of the states, whose own forms of an integral
+    (:attr:`rollingtop.contact.ContactModel.integral_forms`, the ``shell-rotor`` pair's energy,
+    Jellett integral and ``F6``) replace the lone body's. Without a model, the lone body's
+    (a body with a shell is then refused, ``ValueError``).
+    """
     Y = np.asarray(Y, dtype=float)
-    return {name: F6(body, Y, pole) if name == "F6" else INTEGRALS[name](body, Y) for name in names}
+    forms = {} if model is None else get_model(model).integral_forms
+    out: dict[str, FloatArray] = {}
+    for name in names:
+        if name in forms:
+            out[name] = forms[name](body, Y)
+        else:
+            out[name] = F6(body, Y, pole) if name == "F6" else INTEGRALS[name](body, Y)
+    return out
 
 
 #: Largest drift of a held integral (:func:`rollingtop.simulate`'s ``project_integrals``), as a
@@ -293,7 +278,7 @@ def natural_scales(
     names: Iterable[str],
     pole: str | None = None,
     *,
-    slot_is_velocity: bool = False,
+    model: str | ContactModel | None = None,
 ) -> dict[str, float]:
     """The natural size of each integral ``names`` along the states ``Y`` (shape ``(n, 18)``):
     the largest, over the states, of the size the integral can take at the state's speed, so
@@ -301,14 +286,17 @@ def natural_scales(
     integral's own value (which may be zero, with every term of it: the spin of a body that
     rolls over).
 
-    Every integral but the energy is homogeneous of degree one in the velocity ``u`` (``v``,
-    ``w`` and, with ``slot_is_velocity``, the state's last slot: the shell's spin): by
+    The integrals are ``model``'s (:func:`evaluate`). Every integral but the energy is
+    homogeneous of degree one in the velocity ``u`` (``v``, ``w`` and, for a model with its own
+    inertia, :attr:`rollingtop.contact.ContactModel.own_inertia`, the state's last slot: the
+    shell's spin): by
     Cauchy-Schwarz ``|I| <= |grad I|_(M^-1) |u|_M`` in the kinetic-energy metric ``M =
     diag(m, m, m, I1, I2, I3[, shell_inertia])``, with ``grad I`` read off the integral at each
     unit velocity component (for ``slip_nu``, a norm, a bound of it). The energy's size is the
     kinetic energy plus the magnitude of the potential, ``(E - E|u=0) + |E|u=0|``.
     """
     Y = np.atleast_2d(np.asarray(Y, dtype=float))
+    slot_is_velocity = model is not None and get_model(model).own_inertia
     velocity = [*range(6), *([PSI_NU] if slot_is_velocity else [])]
     still = Y.copy()
     still[:, velocity] = 0.0
@@ -318,14 +306,14 @@ def natural_scales(
     out = {}
     for name in names:
         if name == "energy":
-            e0 = energy(body, still)
-            size = energy(body, Y) - e0 + np.abs(e0)
+            e0 = evaluate(body, still, (name,), model=model)[name]
+            size = evaluate(body, Y, (name,), model=model)[name] - e0 + np.abs(e0)
         else:
             dual = np.zeros(Y.shape[0])  # |grad I|^2 in the metric M^-1
             for j, mass in zip(velocity, metric, strict=True):
                 unit = still.copy()
                 unit[:, j] = 1.0
-                dual += evaluate(body, unit, (name,), pole)[name] ** 2 / mass
+                dual += evaluate(body, unit, (name,), pole, model=model)[name] ** 2 / mass
             size = np.sqrt(dual) * speed
         out[name] = float(np.max(size)) if size.size else 0.0
     return out

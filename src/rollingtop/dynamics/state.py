@@ -65,8 +65,8 @@ def default_alpha(gamma: FloatArray) -> FloatArray:
 
 def _vertical(model: ContactModel, gamma: FloatArray) -> FloatArray:
     """``gamma`` set exactly vertical, ``(0, 0, +-1)``, where the model counts it as vertical
-    (``sqrt(gamma1^2 + gamma2^2)`` below :attr:`ContactModel.vertical_tolerance`)."""
-    if math.hypot(gamma[0], gamma[1]) < model.vertical_tolerance:
+    (``sqrt(gamma1^2 + gamma2^2)`` below :attr:`rollingtop.contact.Vertical.tolerance`)."""
+    if math.hypot(gamma[0], gamma[1]) < model.vertical.tolerance:
         return np.array([0.0, 0.0, math.copysign(1.0, gamma[2])])
     return gamma
 
@@ -166,16 +166,15 @@ def initial_state(
 
     Notes
     -----
-    **Vertical axis.** A model with :attr:`~ContactModel.vertical_tolerance` (the meridian model:
-    ``1e-8``) takes an axis that close to the vertical as exactly vertical, ``gamma = (0, 0,
+    **Vertical axis.** A model with a :attr:`~rollingtop.contact.Vertical.tolerance` (the meridian
+    model: ``1e-8``) takes an axis that close to the vertical as exactly vertical, ``gamma = (0, 0,
     +-1)`` (and ``alpha`` re-orthogonalised to it); the others keep ``gamma`` as given. At an
-    exactly vertical axis ``psi_nu`` is the model's carried constraint direction,
-    ``nu = cos(psi_nu) alpha + sin(psi_nu) beta``: for the meridian model
-    (:func:`rollingtop.contact.meridian.vertical_direction`) the direction in which the axis
-    leaves the vertical, ``(w x e3)/|w x e3|``, or ``nu = alpha`` (``psi_nu = 0``) when
-    ``w1 = w2 = 0``; the state lies on a pole level ``C1 = +-M3`` and
-    :func:`rollingtop.contact.meridian.select_variant` picks the pole variant that carries
-    ``nu``.
+    exactly vertical axis ``psi_nu`` is the model's carried constraint direction, ``nu = cos(psi_nu)
+    alpha + sin(psi_nu) beta``: for the meridian model
+    (:func:`rollingtop.contact.meridian.vertical_direction`) the direction in which the axis leaves
+    the vertical, ``(w x e3)/|w x e3|``, or ``nu = alpha`` (``psi_nu = 0``) when ``w1 = w2 = 0``;
+    the state lies on a pole level ``C1 = +-M3`` and
+    :func:`rollingtop.contact.meridian.select_variant` picks the pole variant that carries ``nu``.
     Other models: ``psi_nu = 0`` (unused).
 
     **Spin constraints.** A model that constrains the angular velocity alone
@@ -197,7 +196,10 @@ def initial_state(
                 f"tolerance {UNIT_TOLERANCE:g})"
             )
     gamma = _vertical(model, gamma)
-    if model.singular is not None and (why := model.singular(body, gamma)) is not None:
+    if (
+        model.vertical.singular is not None
+        and (why := model.vertical.singular(body, gamma)) is not None
+    ):
         raise InitialStateError(f"model {model.name!r}: {why}")
     _check_spin(model, gamma, omega)
     alpha = default_alpha(gamma) if alpha is None else _horizontal(alpha, gamma)
@@ -216,8 +218,8 @@ def initial_state(
     y[6:9], y[9:12], y[12:15] = alpha, beta, gamma
     y[15:17] = position
     y[17] = _axis_azimuth(y)
-    if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
-        y[17] = model.vertical_direction(omega, alpha, beta)
+    if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical.direction is not None:
+        y[17] = model.vertical.direction(omega, alpha, beta)
     if v is not None:
         if free:
             raise InitialStateError(
@@ -244,8 +246,8 @@ def initial_state(
             else:
                 values[name] = _vector(name, raw, length)
         y[0:3] = model.velocity(body, gamma, omega, alpha, beta, values)
-    if model.slot_value is not None:
-        y[17] = model.slot_value(body, y)
+    if model.own is not None:
+        y[17] = model.own.value(body, y)
     code = _start_code(body, model, y)
     kernels = for_code(code)  # the model's own package, or its variants'
     with compiling(kernels, "integrator"):  # the projection: a model's first compiled kernel
@@ -274,33 +276,37 @@ def project_state(
     the integrator). Used to start several contact models from "the same" state.
 
     At a vertical axis the rule of :func:`initial_state` applies: an axis within the model's
-    :attr:`~ContactModel.vertical_tolerance` is set exactly vertical, and ``psi_nu`` becomes the
-    model's carried direction there (meridian: the direction in which the axis leaves the
-    vertical; kept when ``w1 = w2 = 0``, where it is free).
+    :attr:`~rollingtop.contact.Vertical.tolerance` is set exactly vertical, and ``psi_nu``
+    becomes the model's carried direction there (meridian: the direction in which the axis
+    leaves the vertical; kept when ``w1 = w2 = 0``, where it is free).
 
     ``source`` is the model ``y`` was made for, if another: where its last slot is its own
-    (:attr:`~ContactModel.slot_value`; the shell-rotor pair's shell spin) and ``model``'s is a
-    direction, the slot starts again from the axis azimuth, as in :func:`initial_state`.
+    (:attr:`~rollingtop.contact.OwnVelocity.value`; the shell-rotor pair's shell spin) and
+    ``model``'s is a direction, the slot starts again from the axis azimuth, as in
+    :func:`initial_state`.
     """
     model = get_model(model)
     y = np.array(y, dtype=float)
-    if source is not None and get_model(source).slot_value is not None and model.slot_value is None:
+    if source is not None and get_model(source).own is not None and model.own is None:
         y[17] = _axis_azimuth(y)
     gamma = _vertical(model, y[12:15])
-    if model.singular is not None and (why := model.singular(body, gamma)) is not None:
+    if (
+        model.vertical.singular is not None
+        and (why := model.vertical.singular(body, gamma)) is not None
+    ):
         raise InitialStateError(f"model {model.name!r}: {why}")
     if gamma is not y[12:15]:  # set vertical: the frame follows
         y[12:15] = gamma
         y[6:9] = _horizontal(y[6:9], gamma)
         y[9:12] = np.cross(gamma, y[6:9])
-    if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical_direction is not None:
-        y[17] = model.vertical_direction(y[3:6], y[6:9], y[9:12], y[17])
+    if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical.direction is not None:
+        y[17] = model.vertical.direction(y[3:6], y[6:9], y[9:12], y[17])
     ws = call(new_workspace)
     code = _start_code(body, model, y)
     dynamics = for_code(code).dynamics
     with compiling(for_code(code), "integrator"):
-        if model.slot_value is not None:  # the rows' projection of (v, w), then the model's slot
+        if model.own is not None:  # the rows' projection of (v, w), then the model's slot
             call(dynamics.project_velocity_rows, code, body.params, y, ws)
-            y[17] = model.slot_value(body, y)
+            y[17] = model.own.value(body, y)
         call(dynamics.project, code, body.params, y, ws)
     return y

@@ -212,7 +212,7 @@ def compare_figure(
         colour = run.model.colour
         ax.plot(run.position[:, 0], run.position[:, 1], lw=0.9, color=colour, label=model)
         ax.plot(*run.position[0], "s", color="black", ms=4)
-        values = evaluate(run.body, run.y, shown, pole=run.pole_case)
+        values = evaluate(run.body, run.y, shown, pole=run.pole_case, model=run.model)
         for a, name in zip(axes, shown, strict=True):
             v = values[name]
             scale = max(abs(v[0]), 1e-300)

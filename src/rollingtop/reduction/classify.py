@@ -251,9 +251,7 @@ def classify_models(
                 y = initial_state(body, name, gamma=gamma, omega=w)
             level = reduction.level_of_state(body, y)
             h = reduction.reduced_energy(body, y)
-            # the shell-rotor pair's last slot is its shell's spin, not a carried direction:
-            # the geometric one then (reduced_components on 17 components)
-            theta = float(reduce_state(y[:17] if MODELS[name].own_inertia else y)["theta"])
+            theta = float(reduce_state(y, model=name)["theta"])
             found = [
                 o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9
             ]

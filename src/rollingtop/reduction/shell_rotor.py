@@ -17,7 +17,7 @@ and its integrals (proved by :mod:`rollingtop.symbolic.shell_rotor`) are Lagrang
     (m + ms) jellett = R s (K + (m + ms) Js) w_n - k_p (M3 + Js Omega3),
     C2 = Omega3 sqrt(N) + R M3 Phi(cos),       K = (m + ms) I1 + m ms a3^2
 
-(``N``, ``Phi``: :func:`rollingtop.dynamics.integrals.pair_weight`). On a level
+(``N``, ``Phi``: :func:`rollingtop.contact._shell_pair.pair_weight`). On a level
 ``(M3, jellett, C2)`` they give ``Omega3(theta)`` and then ``w_n(theta)``, and
 
     h = rho_p w_tau^2 / 2 + U(theta),    theta' = -w_tau,    h = E - M3^2/(2 I3) - m g R,
@@ -55,7 +55,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
-from rollingtop.dynamics.integrals import pair_weight
+from rollingtop.contact._shell_pair import pair_energy, pair_F6, pair_jellett, pair_weight
 from rollingtop.reduction._services import (
     _Analytic,
     _AnalyticResult,
@@ -354,9 +354,9 @@ class ShellRotorLevel(LagrangeSpin, Level):
 def shell_rotor_integrals(body: SphericalTop, Y: ArrayLike) -> dict[str, FloatArray]:
     """``M3 = I3 w3``, the pair's Jellett integral and ``C2 = F6`` and the reduced energy
     ``h = E - M3^2/(2 I3) - m g R`` of states ``Y`` (shape ``(..., 18)``)."""
-    from rollingtop.dynamics.integrals import F6, energy, jellett, lagrange
+    from rollingtop.dynamics.integrals import lagrange
 
     Y = np.asarray(Y, dtype=float)
     M3 = lagrange(body, Y)
-    h = energy(body, Y) - M3**2 / (2 * body.I3) - body.m * body.g * body.R
-    return {"M3": M3, "jellett": jellett(body, Y), "C2": F6(body, Y), "h": h}
+    h = pair_energy(body, Y) - M3**2 / (2 * body.I3) - body.m * body.g * body.R
+    return {"M3": M3, "jellett": pair_jellett(body, Y), "C2": pair_F6(body, Y), "h": h}

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
+from rollingtop.contact import ContactModel
 from rollingtop.dynamics.integrals import F6, area, energy, lagrange, reduced_components
 from rollingtop.reduction.level import Level, LevelSetError
 
@@ -36,13 +37,16 @@ __all__ = [
 FloatArray: TypeAlias = NDArray[np.float64]
 
 
-def reduce_state(Y: ArrayLike, pole: str | None = None) -> dict[str, FloatArray]:
-    """Reduced variables of states ``Y`` (shape ``(..., 18)``), each of shape ``(...)``.
+def reduce_state(
+    Y: ArrayLike, pole: str | None = None, *, model: str | ContactModel | None = None
+) -> dict[str, FloatArray]:
+    """Reduced variables of states ``Y`` (shape ``(..., 18)``) of ``model``, each of shape
+    ``(...)``.
 
     Returns ``gamma3, s, theta, v_tau, w_tau, w_n, v_n, v3, w3``; see
     :func:`rollingtop.dynamics.integrals.reduced_components` for the (signed) basis.
     """
-    return reduced_components(Y, pole)
+    return reduced_components(Y, pole, model=model)
 
 
 def reduced_integrals(

@@ -79,7 +79,7 @@ free = sp.symbols(
     f"c1:{1 + max(2, *(sum(m.free_velocity.values()) for m in MODELS.values()))}", real=True
 )
 #: the angular velocity's components on the manifold of a model that constrains it alone
-#: (:attr:`~rollingtop.contact.ContactModel.symbolic_omega`; rubber rolling: ``w`` horizontal)
+#: (:attr:`~rollingtop.contact.Symbolic.omega`; rubber rolling: ``w`` horizontal)
 spin = sp.symbols("w_a w_b", real=True)
 
 
@@ -134,9 +134,9 @@ def _manifold(model: str) -> dict[Any, Any]:
     tau = e3.cross(gamma) / sq  # unit, rational
     r = -S.R * gamma - sp.Matrix([0, 0, S.a3])
     contact = get_model(model)
-    w = S.w if contact.symbolic_omega is None else contact.symbolic_omega(gamma, tau, spin)
+    w = S.w if contact.symbolic.omega is None else contact.symbolic.omega(gamma, tau, spin)
     wxr = w.cross(r)  # with the parametrised w: xreplace does not substitute into v's value
-    v = contact.symbolic_velocity(gamma, tau, wxr, free)
+    v = contact.symbolic.velocity(gamma, tau, wxr, free)
     nu = (e3 - gamma[2] * gamma) / sq  # unit, rational
     alpha = ((1 - j**2) * tau + 2 * j * nu) / (1 + j**2)  # generic horizontal unit vector
     beta = gamma.cross(alpha)
@@ -146,7 +146,7 @@ def _manifold(model: str) -> dict[Any, Any]:
         subs[S.v[i]] = v[i]
         subs[S.alpha[i]] = alpha[i]
         subs[S.beta[i]] = beta[i]
-        if contact.symbolic_omega is not None:
+        if contact.symbolic.omega is not None:
             subs[S.w[i]] = w[i]
     return subs
 
@@ -332,8 +332,8 @@ def invariant_measure_claim() -> tuple[bool, str]:
 
 
 def _model_claims(model: str) -> list[Claim]:
-    """The claims of the model's own symbolic module (``ContactModel.symbolic_claims``)."""
-    extra = get_model(model).symbolic_claims
+    """The claims of the model's own symbolic module (``Symbolic.claims``)."""
+    extra = get_model(model).symbolic.claims
     if extra is None:
         return []
     module, function = extra.split(":")

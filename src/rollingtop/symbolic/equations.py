@@ -93,7 +93,7 @@ def constraints(model: str, S: Symbols = SYMBOLS) -> list[Any]:
     r = -S.R * S.gamma - sp.Matrix([0, 0, S.a3])
     vp = S.v + _cross(S.w, r)
     m = get_model(model)
-    out = [sp.expand(vp.dot(d)) for d in m.symbolic_directions(sp, S.gamma)]
+    out = [sp.expand(vp.dot(d)) for d in m.symbolic.directions(sp, S.gamma)]
     if m.spin_directions is not None:
         out += [sp.expand(S.w.dot(d)) for d in m.spin_directions(S.gamma).values()]
     return out
