@@ -149,6 +149,11 @@ def test_another_model_is_chosen_on_the_page(page, served):
     page.get_by_text("rough model: jellett = ").first.wait_for(timeout=30_000)
     page.wait_for_url("**model=rough**", timeout=10_000)
     assert page.get_by_text("routh:").count() == 1
+    page.wait_for_url("**jellett=**", timeout=10_000)  # the URL holds rough's level, and only it
+    assert "C2=" not in page.url and "M3=" not in page.url and "routh=" in page.url
+    page.goto(page.url)  # and loads it again: the same view
+    page.get_by_text("rough model: jellett = ").first.wait_for(timeout=30_000)
+    assert not page.locator(".rt-message").first.is_visible()
 
 
 def test_the_server_says_one_line_and_stops_on_a_signal():

@@ -329,3 +329,56 @@ def test_views_are_cached_on_the_state(fig5):
         lv.U_y[0] = 0.0
     with pytest.raises(ValueError, match="read-only"):
         dv.centres[0][0] = 0.0
+
+
+def _settled(page):
+    deadline = time.time() + 60
+    while any(w.running for w in (page.level_work, page.diagram_work)):
+        assert time.time() < deadline, "the page's plots took over 60 s"
+        time.sleep(0.02)
+
+
+def test_the_pages_view_is_its_parameters(fig5):
+    """Issue 37, item 5: the page's state is its param parameters, one per key of the URL
+    (QUERY_KEYS, every model's level keys among them). A query's values arrive as parameters
+    (the URL's text or Panel's number); a new valid value there is the new view; a bad one is a
+    message, and the parameters go back to the last valid view; another model's keys are None."""
+    from rollingtop.contact import MODELS
+    from rollingtop.explore.app import QUERY_KEYS, ExplorePage
+
+    assert {k for m in MODELS.values() for k in m.reduction} < set(QUERY_KEYS)
+    assert set(QUERY_KEYS) <= set(ExplorePage.param)
+    page = ExplorePage(fig5, "plain", query={"C2": -1.0, "h": "0.8"})
+    try:
+        assert page.state.level["C2"] == -1.0 and page.state.h == 0.8
+        assert page.C2 == repr(-1.0) and page.h == repr(0.8) and page.model == "meridian"
+        assert page.jellett is None and page.routh is None
+        page.param.update(C2="-1.5")  # a script (or the URL) sets a parameter: the new view
+        assert page.state.level["C2"] == -1.5 and not page.message.visible
+        page.param.update(C2="abc")
+        assert page.message.visible and "C2 = 'abc' is not a number" in page.message.object
+        assert page.state.level["C2"] == -1.5 and page.C2 == repr(-1.5)  # the last valid view
+        page.param.update(I3="0.9")  # a body the model refuses (I3 > I1 + I2)
+        assert "body:" in page.message.object and page.I3 == repr(fig5.body.I3)
+        page.param.update(model="rough")
+        assert page.state.model == "rough" and page.M3 is None and page.C2 is None
+        assert float(page.jellett) == page.state.level["jellett"]
+        _settled(page)
+    finally:
+        page.close()
+
+
+def test_a_bad_or_unknown_query_key_is_a_message_and_the_scenarios_view_stays(fig5):
+    from rollingtop.explore.app import ExplorePage
+
+    for query, text in (({"C2": "abc"}, "C2 = 'abc' is not a number"),
+                        ({"foo": "1"}, "unknown parameter 'foo'"),
+                        ({"jellett": "1"}, "unknown parameter 'jellett' for the meridian"),
+                        ({"C2": 10**400}, "beyond double precision")):  # fmt: skip
+        page = ExplorePage(fig5, "plain", query=query)
+        try:
+            assert page.message.visible and text in page.message.object, query
+            assert page.state == fig5 and page.C2 == repr(-2.0)
+        finally:
+            _settled(page)
+            page.close()

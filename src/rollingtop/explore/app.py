@@ -6,9 +6,14 @@ off the server's event loop, so the page never blocks; each kind of work (the le
 diagram, a trajectory, the device's frame, a section) keeps only its newest request -- a newer
 one supersedes an older one that has not started, and an older result that arrives late is
 dropped. Results are applied to the page on the document's next tick (Bokeh's thread-safe way
-in). The URL's query carries the view (``?model=meridian&C2=-1.0&h=0.8``): it is read when the
-page loads and rewritten after every accepted change; a bad value is shown on the page and the
-previous valid view stays.
+in).
+
+The page's view is its parameters (``param``): one per key of the URL's query
+(``?model=meridian&C2=-1.0&h=0.8``), kept in step with the URL by Panel
+(``pn.state.location.sync``): the URL's values arrive as the parameters' values when the page
+loads, and each accepted view sets them, which rewrites the URL. A value is the query's text (or
+the number Panel read from it), validated once by :func:`rollingtop.explore.view.parse_query`:
+a bad value is shown on the page and the previous valid view stays, in the widgets and the URL.
 """
 
 from __future__ import annotations
@@ -17,10 +22,10 @@ import io
 from collections.abc import Callable
 from concurrent.futures import Executor
 from typing import Any
-from urllib.parse import urlencode
 
 import numpy as np
 import panel as pn
+import param
 from bokeh.events import Tap
 
 from rollingtop._errors import RollingTopError
@@ -32,13 +37,24 @@ from rollingtop.explore.path import PATH_SAMPLES, PATH_T_END, path_view
 from rollingtop.explore.section import section_view
 from rollingtop.explore.view import (
     BODY_KEYS,
+    H_KEY,
     ExploreState,
     cached_diagram_view,
     cached_level_view,
     parse_query,
 )
 
-__all__ = ["ExplorePage", "LOOKS"]
+__all__ = ["ExplorePage", "LOOKS", "QUERY_KEYS"]
+
+#: The keys of the page's URL, each a parameter of :class:`ExplorePage`: the model, the body's
+#: numbers, every reduced model's level (:attr:`rollingtop.contact.ContactModel.reduction`) and
+#: ``h``.
+QUERY_KEYS: tuple[str, ...] = (
+    "model",
+    *BODY_KEYS,
+    *dict.fromkeys(k for m in MODELS.values() for k in m.reduction),
+    H_KEY,
+)
 
 #: Device looks of the frame beside the path (``plain``: the body itself).
 LOOKS = ("plain", *DEVICES)
@@ -64,8 +80,17 @@ def _drop_js_callbacks(layout: Any) -> None:
         Callback.registry.pop(source, None)
 
 
-class ExplorePage:
+def _query_value(doc: str) -> Any:
+    """A parameter of the page's view: the URL's text for one key (``None``: not in this view)."""
+    return param.Parameter(default=None, doc=doc)
+
+
+class ExplorePage(pn.viewable.Viewer):
     """The widgets, plots and callbacks of one session; :attr:`layout` is what Panel serves.
+
+    Its parameters (:data:`QUERY_KEYS`) are the view as the URL's query carries it: the text
+    of each value (``repr`` of a float), or the number Panel read from the URL; ``None`` for a
+    key the view does not have (another model's level).
 
     Parameters
     ----------
@@ -80,6 +105,22 @@ class ExplorePage:
         of the page's own, shut down by :meth:`close`).
     """
 
+    model = _query_value("the contact model's name")
+    R = _query_value("the sphere's radius")
+    m = _query_value("the body's mass")
+    a3 = _query_value("the centre of mass's offset along the axis")
+    I1 = _query_value("the body's equatorial moment of inertia (I2 = I1)")
+    I3 = _query_value("the body's axial moment of inertia")
+    g = _query_value("gravity")
+    M3 = _query_value("level: Lagrange's integral I3 w3")
+    C1 = _query_value("level: the area integral")
+    C2 = _query_value("level: the paper's F6 (meridian, shell-rotor)")
+    p_horizontal = _query_value("level: the horizontal momentum (smooth)")
+    jellett = _query_value("level: Jellett's integral")
+    routh = _query_value("level: Routh's integral (rough)")
+    rubber_spin = _query_value("level: the rubber model's spin integral")
+    h = _query_value("the reduced energy")
+
     def __init__(
         self,
         base: ExploreState,
@@ -87,6 +128,7 @@ class ExplorePage:
         query: dict[str, Any] | None = None,
         executor: Executor | None = None,
     ) -> None:
+        super().__init__()  # type: ignore[no-untyped-call]
         self.doc = pn.state.curdoc
         self.location = pn.state.location
         self.muted = False
@@ -113,16 +155,79 @@ class ExplorePage:
         self.diagram_work = Latest(pool, self.on_document, cached_diagram_view, self._apply_diagram)
         self.path_work = Latest(pool, self.on_document, self._compute_path, self._apply_path)
         self.frame_work = Latest(pool, self.on_document, self._compute_frame, self._apply_frame)
-        if query is None and self.location is not None:
-            query = dict(self.location.query_params)
-        if query:
-            try:
-                self.state = parse_query(query, base)
-            except RollingTopError as err:
-                self._show_error(f"URL: {err}")
+        self.synced: list[str] = []  # the parameters kept in step with the URL
+        self.loading = True  # the URL's view is read: nothing drawn yet
+        self.quiet = False  # the page sets its own parameters
+        self._set_query(self.state)
+        self.param.watch(self._on_query, list(QUERY_KEYS))
+        if query is None and self.location is not None:  # the URL's values arrive (Panel)
+            asked = dict(self.location.query_params)
+            self._refuse_unknown(asked)
+            self._resync([k for k in QUERY_KEYS if k in asked or getattr(self, k) is not None])
+        elif query:
+            self._refuse_unknown(query)
+            self.param.update(**{k: v for k, v in query.items() if k in QUERY_KEYS})
+        self.loading = False
+        self._set_query(self.state)
         self._sync_widgets()
         self.layout = self._layout()
         self._refresh(diagram=True)
+
+    def __panel__(self) -> Any:
+        return self.layout
+
+    # ---- the view's parameters and the URL -----------------------------------------------
+    def _keys(self) -> list[str]:
+        """The keys of the current view's query."""
+        return [k for k in QUERY_KEYS if getattr(self, k) is not None]
+
+    def _set_query(self, state: ExploreState) -> None:
+        """The parameters set to ``state`` (without the page reacting); Panel rewrites the URL,
+        without the keys of another view."""
+        self.quiet = True
+        try:
+            self.param.update(**(dict.fromkeys(QUERY_KEYS) | state.to_query()))
+        finally:
+            self.quiet = False
+        if not self.loading:
+            self._resync(self._keys())
+
+    def _resync(self, keys: list[str]) -> None:
+        """Keep exactly ``keys`` in step with the URL: a key that leaves the view leaves the
+        URL (``unsync``), and the URL's values of the new keys are read (``sync``)."""
+        if self.location is None or keys == self.synced:
+            return
+        if self.synced:
+            self.location.unsync(self)
+        self.synced = keys
+        self.location.sync(self, keys, on_error=self._on_url_error)
+
+    def _refuse_unknown(self, query: dict[str, Any]) -> None:
+        """A key of the URL that no view has: said by name (:func:`parse_query`'s message)."""
+        unknown = {k: v for k, v in query.items() if k not in QUERY_KEYS}
+        if unknown:
+            try:
+                parse_query(unknown, self.state)
+            except RollingTopError as err:
+                self._show_error(f"URL: {err}")
+
+    def _on_url_error(self, values: dict[str, Any]) -> None:  # pragma: no cover - Panel's
+        self._show_error(f"URL: cannot read {', '.join(values)}")
+
+    def _on_query(self, *events: Any) -> None:
+        """The URL's values arrived (or a script set the parameters): the view they ask for,
+        the changed values applied to the current view (:func:`parse_query`: ``model`` first)."""
+        if self.quiet:
+            return
+        changes = {e.name: e.new for e in events if e.new is not None}
+        if self.loading:
+            try:
+                self.state = parse_query(changes, self.state)
+            except RollingTopError as err:
+                self._show_error(f"URL: {err}")
+            return
+        if not self._accept(changes):
+            self._set_query(self.state)
 
     # ---- running on the document -------------------------------------------------------
     def on_document(self, fn: Callable[[], None]) -> None:
@@ -155,7 +260,7 @@ class ExplorePage:
     # ---- widgets -------------------------------------------------------------------------
     def _slider(self, name: str, value: float, lo: float, hi: float) -> Any:
         w = pn.widgets.EditableFloatSlider(
-            name=name, value=value, start=lo, end=hi, step=(hi - lo) / 400, width=260
+            label=name, value=value, start=lo, end=hi, step=(hi - lo) / 400, width=260
         )
         w.param.watch(self._on_widget, "value")
         return w
@@ -163,11 +268,11 @@ class ExplorePage:
     def _build_widgets(self) -> None:
         names = [m.name for m in MODELS.values() if m.own_inertia == self.state.body.has_shell]
         self.model_select = pn.widgets.Select(
-            name="contact model", options=names, value=self.state.model, width=260
+            label="contact model", options=names, value=self.state.model, width=260
         )
         self.model_select.param.watch(self._on_model, "value")
         self.look_select = pn.widgets.Select(
-            name="device look", options=list(LOOKS), value=self.look, width=260
+            label="device look", options=list(LOOKS), value=self.look, width=260
         )
         self.look_select.param.watch(self._on_look, "value")
         b = self.state.body
@@ -312,20 +417,15 @@ class ExplorePage:
         self.path_work.request((self.state, states[k], None))
 
     def _refresh(self, diagram: bool) -> None:
-        """Ask for the plots of :attr:`state`; the URL follows. A clicked orbit belonged to
-        the previous view: it goes."""
+        """Ask for the plots of :attr:`state`; the parameters, and so the URL, follow. A clicked
+        orbit belonged to the previous view: it goes."""
         self.plots.clear_clicked()
         self.level_work.request(self.state)
         if diagram and self.state.reduces:
             self.diagram_work.request(self.state)
         elif self.state.reduces:  # the same curves: only the marker moves
             self._move_mark()
-        self._write_url()
-
-    def _write_url(self) -> None:
-        """The URL's query: the current view."""
-        if self.location is not None:
-            self.location.search = "?" + urlencode(self.state.to_query())
+        self._set_query(self.state)
 
     def _move_mark(self) -> None:
         self.plots.move_mark(self.state.level[self._axis()], self.state.h)
@@ -342,7 +442,7 @@ class ExplorePage:
             if self.drawn is not None and self.drawn != state:
                 self.state = self.drawn
                 self._sync_widgets()
-                self._write_url()
+                self._set_query(self.state)
             return
         self.drawn = state
         self.readout.object = f"<b>{view.readout}</b>"
