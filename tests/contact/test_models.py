@@ -106,7 +106,7 @@ def test_constraints_and_claimed_integrals_are_preserved(name, body):
     assert np.all(residuals <= RESIDUAL * scale)
     names = model.integrals(body.symmetric)
     assert "energy" in names
-    values = evaluate(body, res.y, names, pole=kernel.variant)
+    values = evaluate(body, res.y, names, pole=kernel.variant, model=model)
     for integral in names:
         assert _max_drift(values[integral]) < DRIFT, integral
 
@@ -180,7 +180,7 @@ def test_pole_passage(name):
     assert 0.05 < s[-1]  # and left it again
     back_at_start = res.y[300]
     assert np.allclose(back_at_start[:6], -y0[:6], atol=1e-8)  # reversed motion retraced
-    values = evaluate(body, res.y, model.integrals(True), pole=kernel.variant)
+    values = evaluate(body, res.y, model.integrals(True), pole=kernel.variant, model=model)
     for integral, v in values.items():
         assert _max_drift(v) < DRIFT, integral
 
