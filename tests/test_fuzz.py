@@ -832,8 +832,10 @@ SHORT_RUN = {"--t-end": "0.05", "--samples": "5", "--crossings": "3", "--traject
              "--t-max": "2", "--resolution": "5", "--points": "11", "--duration": "1",
              "--fps": "2", "--speed": "0.05", "--workers": "1", "--processes": "1",
              "--grid": "omega3=1:3:2"}  # fmt: skip
-#: ... and per command (``verify``: sympy on every model takes about a minute).
-SHORT_RUN_BY_COMMAND = {"verify": {"--model": "meridian"}, "warmup": {"--model": "meridian"}}
+#: ... and per command (``verify``: sympy on every model takes about a minute; ``periodic``: a
+#: few crossings seed it).
+SHORT_RUN_BY_COMMAND = {"verify": {"--model": "meridian"}, "warmup": {"--model": "meridian"},
+                        "periodic": {"--settle": "9", "--returns": "2"}}  # fmt: skip
 #: Drawing the key leaves out these short-run options (``--t-end`` overrides ``--periods``;
 #: ``ensemble`` takes exactly one of ``--initial`` and ``--grid``).
 LEFT_OUT_WITH = {"--periods": {"--t-end"}, "--initial": {"--grid"}}

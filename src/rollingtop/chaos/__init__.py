@@ -9,7 +9,9 @@ to :mod:`rollingtop.contact` is served without code here:
 - :func:`chaos_indicators`: the maximal Lyapunov exponent and MEGNO from the tangent dynamics
   integrated with the motion (:mod:`.lyapunov`, :mod:`._tangent`);
 - :func:`indicator_map`: the indicators over many initial states, in parallel or on Dask
-  (:mod:`.maps`).
+  (:mod:`.maps`);
+- :func:`periodic_orbits`: the relative periodic orbits on a level, fixed points of the
+  section's map with their multipliers (:mod:`.periodic`).
 """
 
 from __future__ import annotations
@@ -17,13 +19,17 @@ from __future__ import annotations
 from rollingtop.chaos.level import level_states
 from rollingtop.chaos.lyapunov import ChaosIndicators, chaos_indicators
 from rollingtop.chaos.maps import indicator_map
+from rollingtop.chaos.periodic import PeriodicOrbit, PeriodicOrbits, periodic_orbits
 from rollingtop.chaos.section import poincare_section, section_summary
 
 __all__ = [
     "ChaosIndicators",
+    "PeriodicOrbit",
+    "PeriodicOrbits",
     "chaos_indicators",
     "indicator_map",
     "level_states",
+    "periodic_orbits",
     "poincare_section",
     "section_summary",
 ]

@@ -13,6 +13,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._figures`: ``path``, ``plot``, ``compare``, ``animate``;
 - :mod:`._ensemble`: ``ensemble``;
 - :mod:`._chaos`: ``section``, ``chaos`` (Poincare sections, Lyapunov exponent and MEGNO);
+- :mod:`._periodic`: ``periodic`` (relative periodic orbits on a level, their multipliers);
 - :mod:`._verify`: ``verify``;
 - :mod:`._warmup`: ``warmup``.
 """
@@ -28,6 +29,7 @@ from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._explore import explore
 from rollingtop.cli._figures import animate, compare, path, plot
 from rollingtop.cli._level import equilibria, orbits, portrait
+from rollingtop.cli._periodic import periodic
 from rollingtop.cli._rotation import rotation
 from rollingtop.cli._simulate import simulate
 from rollingtop.cli._stability import stability
@@ -53,6 +55,7 @@ for _command in (
     ensemble,
     section,
     chaos,
+    periodic,
     explore,
     verify,
     warmup,

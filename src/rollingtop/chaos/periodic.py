@@ -1,0 +1,509 @@
+"""Relative periodic orbits on a level set, found on the Poincare section (issue 38, item 1).
+
+**The section map.** The section is :mod:`rollingtop.chaos.section`'s: ``w_tau = 0`` crossed
+upward, the minima of ``gamma3``. For a dynamically symmetric body the motion does not see the
+rotation about the vertical nor the one about the body's axis, so a crossing is fixed by its
+*section coordinates* ``x = (gamma3, w_n, w3, u)``: the inclination, the angular velocity about
+the horizontal axis ``n``, the spin ``w3`` and the model's free velocity component ``u`` (the
+``parallel`` model's ``v_nu``, the meridian model's ``v_tau``). They are read in the geometric
+basis of the axis's horizontal projection ``nu = (e3 - gamma3 gamma) / s``, ``s =
+sqrt(1 - gamma3^2) > 0`` (so a carried direction's sign, which flips at a passage of the vertical,
+does not enter), and a state is rebuilt from them (:func:`section_state`) with ``gamma = (0, s,
+gamma3)`` in the body frame, ``w = (0, -w_n, w3)`` and the free component by
+:func:`rollingtop.initial_state`. The map ``P`` takes ``x`` to the coordinates of the next
+crossing; a *relative periodic orbit with K returns* is a fixed point of ``P^K``, periodic in
+everything but the two symmetry angles.
+
+**Newton's method** solves ``P^K(x) = x`` together with the level's integrals (energy and the
+model's others held at the values of the scenario's state: ``I(x) = I_0``) in the least-squares
+sense (Gauss-Newton), the Jacobian of ``P^K`` by central differences of the compiled flow (every
+difference state of an iteration integrated in one parallel batch). On the level the map has two
+*trivial* multipliers, 1 along the integrals' gradients ``G`` (``G DP = G``: ``I(P(x)) = I(x)``),
+and its *multipliers* are those of ``DP`` restricted to the level's tangent plane: with ``T`` an
+orthonormal basis of ``ker G``, the eigenvalues of ``T^T DP T`` (the tangent plane is invariant
+under ``DP``). The trivial multipliers are reported with their distance from 1, a quality figure
+of the differences. The multipliers come from the differences of the flow, not from its
+variational equations (:mod:`rollingtop._compiled._tangent` integrates those for the Lyapunov
+exponents; the section map's are future work, issue 38, item 2).
+
+**Seeds** are the section's own iterates: trajectories sampled on the level
+(:func:`rollingtop.chaos.level_states`) run ``settle`` crossings; where the last iterates of one
+repeat after ``K`` returns (to ``SEED_MATCH``) Newton starts from them with ``K``. So the orbits
+the trajectories settle onto are found (attracting ones, and elliptic ones where the flow keeps
+a measure); repelling and saddle orbits need other seeds (future work). An orbit met again at
+another of its crossings, or as a multiple of a shorter one, is reported once, with its least
+number of returns.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rollingtop._errors import InitialStateError, RollingTopError, ScenarioError
+from rollingtop._types import FloatArray
+from rollingtop.body import SphericalTop
+from rollingtop.chaos.level import held_integrals, level_states, level_values
+from rollingtop.chaos.section import poincare_section
+from rollingtop.contact import ContactModel, get_model
+from rollingtop.dynamics.integrals import evaluate
+from rollingtop.dynamics.state import initial_state
+
+__all__ = [
+    "PeriodicOrbit",
+    "PeriodicOrbits",
+    "periodic_orbits",
+    "section_coordinates",
+    "section_state",
+]
+
+#: Iterates of one trajectory that agree to this (max norm of the section coordinates) after
+#: ``K`` returns seed Newton with ``K``.
+SEED_MATCH = 1e-3
+#: Newton has converged when the residual (max norm of ``P^K(x) - x`` and of the integrals'
+#: mismatch) is below this; where it stalls (the flow's round-off: a few crossings and passages
+#: of the vertical at ``rtol = 1e-11`` leave ~1e-9), its best iterate counts below ACCEPT_TOL.
+NEWTON_TOL = 1e-10
+#: See :data:`NEWTON_TOL`.
+ACCEPT_TOL = 1e-8
+#: Newton's iterations at most.
+NEWTON_ITERATIONS = 12
+#: A crossing at a time up to this after the start is the start itself (it lies on the section).
+START_CROSSING = 1e-9
+#: Relative step of the central differences of the section map.
+FD_STEP = 1e-5
+#: The multipliers are computed again with this step; their difference is reported
+#: (``multiplier_spread``): the differences' error, large where the orbit passes close to the
+#: vertical (the flow's derivative there is steep and its round-off amplified).
+FD_CHECK_STEP = 1e-4
+#: Singular values of the integrals' gradients below this fraction of the largest count as 0.
+RANK_TOL = 1e-8
+#: Two fixed points are the same orbit when a crossing of one is this close to one of the other.
+SAME_ORBIT = 1e-6
+#: A multiplier this close to modulus 1 counts as on the unit circle (``neutral`` / ``elliptic``).
+UNIT_CIRCLE = 1e-5
+#: An orbit whose axis comes within this tilt of the vertical (``sqrt(gamma1^2 + gamma2^2)``,
+#: sampled along the orbit at :data:`VERTICAL_SAMPLES` points) is flagged ``through_vertical``:
+#: there the ``parallel`` model continues by its regularised rule
+#: (:mod:`rollingtop.contact.parallel`), a modelling choice that the orbit then depends on.
+VERTICAL_DISTANCE = 1e-2
+#: Samples along an orbit for :data:`VERTICAL_DISTANCE`.
+VERTICAL_SAMPLES = 4001
+
+
+def _free_key(model: ContactModel) -> str:
+    """The model's one scalar free velocity component (``ScenarioError`` for another model)."""
+    scalar = [k for k, n in model.free_velocity.items() if n == 1]
+    if len(model.free_velocity) != 1 or len(scalar) != 1 or model.own is not None:
+        raise ScenarioError(
+            f"periodic orbits: the {model.name} model's state on the section is not fixed by "
+            "(gamma3, w_n, w3) and one free velocity component (models: meridian, parallel)"
+        )
+    return scalar[0]
+
+
+def _check_model(body: SphericalTop, model: ContactModel) -> None:
+    if not body.symmetric:
+        raise ScenarioError(
+            "periodic orbits need a dynamically symmetric body (I1 = I2): the section "
+            "coordinates leave out the body's rotation about its axis"
+        )
+    _free_key(model)
+
+
+def section_coordinates(model: str | ContactModel, Y: ArrayLike) -> FloatArray:
+    """The section coordinates ``(gamma3, w_n, w3, u)`` of states ``Y`` (shape ``(..., 18)``),
+    shape ``(..., 4)``, in the geometric basis of the module docstring (NaN at a vertical
+    axis)."""
+    model = get_model(model)
+    Y = np.asarray(Y, dtype=float)
+    g = Y[..., 12:15]
+    s = np.hypot(g[..., 0], g[..., 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        nu = (np.array([0.0, 0.0, 1.0]) - g[..., 2:3] * g) / s[..., None]
+    tau = np.cross(nu, g)
+    n = np.stack([-tau[..., 1], tau[..., 0], np.zeros_like(s)], axis=-1)
+    w = Y[..., 3:6]
+    key = _free_key(model)
+    u = np.sum(Y[..., 0:3] * (nu if key == "v_nu" else tau), axis=-1)
+    return np.stack([g[..., 2], np.sum(w * n, axis=-1), w[..., 2], u], axis=-1)
+
+
+def section_state(body: SphericalTop, model: str | ContactModel, x: ArrayLike) -> FloatArray:
+    """The state on the section with coordinates ``x = (gamma3, w_n, w3, u)`` (shape (4,)):
+    ``gamma = (0, s, gamma3)``, ``w = (0, -w_n, w3)`` (so ``w_tau = 0``), the free velocity
+    ``u`` (:func:`rollingtop.initial_state`). ``InitialStateError`` where ``|gamma3| >= 1``."""
+    model = get_model(model)
+    g3, w_n, w3, u = (float(v) for v in np.asarray(x, dtype=float))
+    if not abs(g3) < 1.0:
+        raise InitialStateError(f"gamma3 = {g3!r}: the section needs a tilted axis")
+    s = math.sqrt(1.0 - g3 * g3)
+    free = {_free_key(model): u}
+    return initial_state(body, model, gamma=[0.0, s, g3], omega=[0.0, -w_n, w3], free=free)
+
+
+@dataclass(frozen=True)
+class PeriodicOrbit:
+    """A relative periodic orbit: a fixed point of the section map's ``returns``-th iterate.
+
+    Attributes
+    ----------
+    returns : int
+        Crossings of the section per period (its least number).
+    period : float
+        Time of one period.
+    x : ndarray, shape (4,)
+        Section coordinates ``(gamma3, w_n, w3, u)`` of its crossing with the least ``gamma3``.
+    state : ndarray, shape (18,)
+        The state there (:func:`section_state`).
+    points : ndarray, shape (returns, 4)
+        Section coordinates of its crossings, in order from :attr:`x`.
+    multipliers : ndarray of complex, shape (d,)
+        The section map's multipliers on the level (module docstring), largest modulus first:
+        ``d = 2`` with two independent integrals held (``parallel``), ``d = 0`` where the level
+        meets the section in isolated points (the integrable meridian model: the orbit is
+        ``neutral``).
+    trivial : ndarray of complex, shape (4 - d,)
+        ``DP``'s other eigenvalues, 1 in exact arithmetic (the integrals').
+    type : str
+        ``attracting``, ``repelling``, ``saddle``, ``elliptic`` or ``neutral``.
+    closure : float
+        ``max |P^K(x) - x|`` of the section coordinates after one period.
+    min_tilt : float
+        Least ``sqrt(gamma1^2 + gamma2^2)`` along the orbit (sampled).
+    multiplier_spread : float
+        Largest change of a multiplier between the difference steps :data:`FD_STEP` and
+        :data:`FD_CHECK_STEP`: the error of the differences (large near the vertical).
+    """
+
+    returns: int
+    period: float
+    x: FloatArray
+    state: FloatArray
+    points: FloatArray
+    multipliers: NDArray[np.complex128]
+    trivial: NDArray[np.complex128]
+    type: str
+    closure: float
+    min_tilt: float
+    multiplier_spread: float = 0.0
+
+    @property
+    def through_vertical(self) -> bool:
+        """Whether the axis passes within :data:`VERTICAL_DISTANCE` of the vertical."""
+        return self.min_tilt < VERTICAL_DISTANCE
+
+    def initial_table(self, model: str | ContactModel) -> dict[str, Any]:
+        """A scenario's ``[initial]`` table that starts on this orbit (``gamma``, ``omega`` and
+        the model's free velocity key)."""
+        model = get_model(model)
+        g3, w_n, w3, u = (float(v) for v in self.x)
+        table: dict[str, Any] = {
+            "gamma": [0.0, math.sqrt(1.0 - g3 * g3), g3],
+            "omega": [0.0, -w_n, w3],
+        }
+        table[_free_key(model)] = u
+        return table
+
+    def to_dict(self, model: str | ContactModel) -> dict[str, Any]:
+        """JSON-ready (``rollingtop periodic --json``)."""
+        return {
+            "returns": self.returns,
+            "period": self.period,
+            "initial": self.initial_table(model),
+            "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
+            "trivial_multipliers_off_one": float(np.max(np.abs(self.trivial - 1.0))),
+            "multiplier_spread": self.multiplier_spread,
+            "type": self.type,
+            "through_vertical": self.through_vertical,
+            "min_tilt": self.min_tilt,
+            "closure": self.closure,
+            "section": [float(v) for v in self.x[:2]],
+        }
+
+
+@dataclass
+class PeriodicOrbits:
+    """The orbits found on one level: a list of :class:`PeriodicOrbit` with the level."""
+
+    model: str
+    level: dict[str, float]
+    orbits: list[PeriodicOrbit] = field(default_factory=list)
+    seeds: int = 0
+    #: The seeding trajectories' crossings, ``(gamma3, w_n)``, shape (trajectories, settle, 2).
+    iterates: FloatArray = field(default_factory=lambda: np.empty((0, 0, 2)))
+
+    def __len__(self) -> int:
+        return len(self.orbits)
+
+    def __iter__(self) -> Any:
+        return iter(self.orbits)
+
+    def __getitem__(self, k: int) -> PeriodicOrbit:
+        return self.orbits[k]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"model", "level", "orbits", "steady", "seeds"}`` (``rollingtop periodic --json``)."""
+        return {
+            "model": self.model,
+            "level": dict(self.level),
+            "orbits": [o.to_dict(self.model) for o in self.orbits],
+            "steady": [],
+            "seeds": self.seeds,
+        }
+
+
+def _classify(mu: NDArray[np.complex128]) -> str:
+    r = np.abs(mu)
+    if np.all(np.abs(r - 1.0) <= UNIT_CIRCLE):
+        return "elliptic" if np.any(np.abs(mu.imag) > UNIT_CIRCLE) else "neutral"
+    if np.all(r < 1.0 + UNIT_CIRCLE):
+        return "attracting"
+    if np.all(r > 1.0 - UNIT_CIRCLE):
+        return "repelling"
+    return "saddle"
+
+
+class _SectionMap:
+    """``P^K`` of batches of section coordinates, on the compiled section."""
+
+    def __init__(
+        self, body: SphericalTop, model: ContactModel, names: Sequence[str], rtol: float
+    ) -> None:
+        self.body, self.model, self.names, self.rtol = body, model, tuple(names), rtol
+
+    def states(self, X: FloatArray) -> FloatArray:
+        return np.array([section_state(self.body, self.model, x) for x in X])
+
+    def integrals(self, X: FloatArray) -> FloatArray:
+        """The held integrals at section coordinates ``X`` (n, 4): shape (n, len(names))."""
+        Y = self.states(X)
+        values = evaluate(self.body, Y, self.names, model=self.model)
+        return np.stack([np.asarray(values[k], dtype=float) for k in self.names], axis=-1)
+
+    def __call__(self, X: FloatArray, K: int) -> tuple[FloatArray, FloatArray]:
+        """``(P^1..K(X), t)``: the coordinates of the first ``K`` crossings, shape (n, K, 4),
+        and their times (n, K); NaN where a trajectory stopped before."""
+        ds = poincare_section(
+            self.body,
+            self.model,
+            self.states(X),
+            crossings=K + 1,
+            hold=self.names,
+            rtol=self.rtol,
+            atol=self.rtol * 1e-2,
+            max_gap_steps=20_000,
+            threads=None,
+        )
+        # a start on the section may count as its first crossing (w_tau = 0 at t = 0): skipped
+        t = ds["t"].values
+        first = (t[:, 0] <= START_CROSSING).astype(int)
+        rows = np.arange(t.shape[0])[:, None]
+        cols = first[:, None] + np.arange(K)[None, :]
+        coords = section_coordinates(self.model, ds["crossing_state"].values)
+        return coords[rows, cols], t[rows, cols]
+
+
+def _jacobian(
+    P: _SectionMap, x: FloatArray, K: int, step: float = FD_STEP
+) -> tuple[FloatArray, FloatArray, float]:
+    """``P^K(x)``, its Jacobian (4, 4) by central differences, and the period."""
+    h = step * np.maximum(1.0, np.abs(x))
+    X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
+    out, t = P(X, K)
+    F = out[:, K - 1]
+    J = (F[1:5] - F[5:9]).T / (2 * h)
+    return F[0], J, float(t[0, K - 1])
+
+
+def _gradients(P: _SectionMap, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The held integrals at ``x`` and their gradients (len(names), 4), central differences."""
+    h = FD_STEP * np.maximum(1.0, np.abs(x))
+    X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
+    V = P.integrals(X)
+    return V[0], ((V[1:5] - V[5:9]) / (2 * h[:, None])).T
+
+
+def _newton(
+    P: _SectionMap, x0: FloatArray, K: int, target: FloatArray
+) -> tuple[FloatArray, FloatArray, float] | None:
+    """Gauss-Newton on ``P^K(x) = x``, ``I(x) = target``; ``(x, DP^K, period)`` or None."""
+    x = x0.copy()
+    best: tuple[float, FloatArray, FloatArray, float] | None = None
+    for _ in range(NEWTON_ITERATIONS):
+        try:
+            F, J, period = _jacobian(P, x, K)
+            values, G = _gradients(P, x)
+        except RollingTopError:
+            break
+        if not (np.all(np.isfinite(F)) and np.all(np.isfinite(J))):
+            break
+        res = np.concatenate([F - x, values - target])
+        size = float(np.max(np.abs(res)))
+        if best is None or size < best[0]:
+            best = (size, x, J, period)
+        if size < NEWTON_TOL:
+            break
+        A = np.vstack([J - np.eye(4), G])
+        x = x + np.linalg.lstsq(A, -res, rcond=1e-12)[0]
+        if not abs(x[0]) < 1.0:
+            break
+    if best is None or best[0] >= ACCEPT_TOL:
+        return None
+    return best[1], best[2], best[3]
+
+
+def _seeds(iterates: FloatArray, returns: int) -> list[tuple[FloatArray, int]]:
+    """Per trajectory (iterates (n, N, 4)), the least ``K <= returns`` after which its last
+    iterates repeat, and the iterate with the least ``gamma3`` among its last ``K``."""
+    out = []
+    for traj in iterates:
+        traj = traj[np.all(np.isfinite(traj), axis=-1)]
+        if traj.shape[0] < 2 * returns + 1:
+            continue
+        last = traj[-1]
+        for K in range(1, returns + 1):
+            if np.max(np.abs(traj[-1 - K] - last)) < SEED_MATCH:
+                cycle = traj[-K:]
+                out.append((cycle[int(np.argmin(cycle[:, 0]))], K))
+                break
+    return out
+
+
+def _same(a: PeriodicOrbit, points: FloatArray) -> bool:
+    """Whether a crossing of ``a`` is one of ``points`` (section coordinates, (n, 4))."""
+    gaps = np.max(np.abs(a.points[:, None, :] - points[None, :, :]), axis=-1)
+    return bool(np.min(gaps) < SAME_ORBIT)
+
+
+def periodic_orbits(
+    body: SphericalTop,
+    model: str | ContactModel,
+    state: ArrayLike,
+    *,
+    returns: int = 4,
+    trajectories: int = 16,
+    settle: int = 300,
+    seed: int | None = 0,
+    rtol: float = 1e-11,
+) -> PeriodicOrbits:
+    """The relative periodic orbits on the level of ``state`` that the section's trajectories
+    settle onto, with 1 to ``returns`` crossings per period (module docstring).
+
+    Parameters
+    ----------
+    body : SphericalTop
+        Dynamically symmetric.
+    model : str or ContactModel
+        A model whose section state is fixed by ``(gamma3, w_n, w3)`` and at most one free
+        velocity component (``meridian``, ``parallel``).
+    state : array_like, shape (18,)
+        A state of the level (its energy and the model's other integrals are held).
+    returns : int
+        Largest number of crossings per period sought (1 to 12).
+    trajectories, settle, seed :
+        The seeds: ``trajectories`` states sampled on the level (``seed``), each run
+        ``settle`` crossings.
+    rtol : float
+        Tolerance of every integration (``atol = rtol / 100``).
+
+    Returns
+    -------
+    PeriodicOrbits
+        In order of ``returns``, then of ``gamma3``.
+    """
+    model = get_model(model)
+    _check_model(body, model)
+    if isinstance(returns, bool) or not isinstance(returns, int) or not 1 <= returns <= 12:
+        raise ScenarioError(f"returns = {returns!r} must be an integer from 1 to 12")
+    for name, value, lo in (("trajectories", trajectories, 1), ("settle", settle, 2 * returns + 1)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < lo:
+            raise ScenarioError(f"{name} = {value!r} must be an integer >= {lo}")
+    y0 = np.asarray(state, dtype=float)
+    names = held_integrals(body, model, None)
+    target = level_values(body, model, y0, names)
+    P = _SectionMap(body, model, names, rtol)
+    starts = level_states(body, model, y0, trajectories, seed=seed)
+    ds = poincare_section(body, model, starts, crossings=settle, rtol=rtol, atol=rtol * 1e-2)
+    iterates = section_coordinates(model, ds["crossing_state"].values)
+    found = PeriodicOrbits(model.name, dict(zip(names, map(float, target), strict=True)))
+    found.iterates = iterates[..., :2]
+    candidates = _seeds(iterates, returns)
+    found.seeds = len(candidates)
+    for x0, K in sorted(candidates, key=lambda c: c[1]):
+        if any(o.returns <= K and _same(o, x0[None, :]) for o in found.orbits):
+            continue
+        solved = _newton(P, x0, K, target)
+        if solved is None:
+            continue
+        x, DP, period = solved
+        pts, _ = P(x[None, :], K)
+        points = np.vstack([x, pts[0, : K - 1]])
+        if K > 1 and np.min(np.max(np.abs(points[1:, :2] - x[:2]), axis=-1)) < SAME_ORBIT:
+            continue  # a shorter orbit, found with its own K
+        if any(_same(o, points) for o in found.orbits):
+            continue
+        found.orbits.append(_orbit(P, x, DP, K, period, points, target))
+    found.orbits.sort(key=lambda o: (o.returns, float(o.x[0])))
+    return found
+
+
+def _orbit(
+    P: _SectionMap,
+    x: FloatArray,
+    DP: FloatArray,
+    K: int,
+    period: float,
+    points: FloatArray,
+    target: FloatArray,
+) -> PeriodicOrbit:
+    k = int(np.argmin(points[:, 0]))
+    _, G = _gradients(P, x)
+    _, sv, vt = np.linalg.svd(G)
+    rank = int(np.sum(sv > RANK_TOL * sv[0]))
+    # orthonormal basis of the level's tangent plane on the section: empty where the level meets
+    # the section in isolated points (an integrable level: every multiplier is trivial)
+    T = vt[rank:].T
+
+    def on_level(D: FloatArray) -> NDArray[np.complex128]:
+        mu = np.linalg.eigvals(T.T @ D @ T).astype(np.complex128)
+        return mu[np.lexsort((mu.imag, -np.abs(mu)))]
+
+    mu = on_level(DP)
+    spread = 0.0
+    if mu.size:
+        spread = float(np.max(np.abs(mu - on_level(_jacobian(P, x, K, FD_CHECK_STEP)[1]))))
+    every = list(np.linalg.eigvals(DP))
+    for m in mu:  # the others are the trivial ones
+        every.pop(int(np.argmin([abs(e - m) for e in every])))
+    end, _ = P(x[None, :], K)
+    closure = float(np.max(np.abs(end[0, K - 1] - x)))
+    return PeriodicOrbit(
+        returns=K,
+        period=period,
+        x=points[k],
+        state=section_state(P.body, P.model, points[k]),
+        points=np.roll(points, -k, axis=0),
+        multipliers=mu.astype(np.complex128),
+        trivial=np.array(every, dtype=np.complex128),
+        type=_classify(mu),
+        closure=closure,
+        min_tilt=_min_tilt(P, x, period),
+        multiplier_spread=spread,
+    )
+
+
+def _min_tilt(P: _SectionMap, x: FloatArray, period: float) -> float:
+    """Least ``sqrt(gamma1^2 + gamma2^2)`` along one period from ``x`` (sampled)."""
+    from rollingtop.integrate.driver import integrate
+
+    y0 = section_state(P.body, P.model, x)
+    code = P.model.kernel_code(P.body, y0)
+    t = np.linspace(0.0, period, VERTICAL_SAMPLES)
+    res = integrate(code, P.body.params, y0, t, rtol=P.rtol, atol=P.rtol * 1e-2)
+    return float(np.min(np.hypot(res.y[:, 12], res.y[:, 13])))

@@ -1,0 +1,97 @@
+"""``rollingtop periodic``: the relative periodic orbits on the level of the scenario's state
+(:func:`rollingtop.chaos.periodic_orbits`)."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from rollingtop.cli._options import json_option, scenario_argument
+
+__all__ = ["periodic"]
+
+
+@click.command()
+@scenario_argument
+@click.option(
+    "--returns",
+    type=click.IntRange(1, 12),
+    default=4,
+    show_default=True,
+    help="Largest number of section crossings per period sought.",
+)
+@click.option(
+    "--trajectories",
+    type=click.IntRange(1, 1000),
+    default=16,
+    show_default=True,
+    help="Seeding trajectories sampled on the level (the scenario's state first).",
+)
+@click.option(
+    "--settle",
+    type=click.IntRange(3, 100_000),
+    default=300,
+    show_default=True,
+    help="Crossings each seeding trajectory runs before its last ones seed Newton.",
+)
+@click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Sampling seed.")
+@click.option(
+    "-o", "--output", type=click.Path(), default=None, help="Also draw them: FIG.png, .svg, .pdf."
+)
+@json_option
+def periodic(
+    scenario: str,
+    returns: int,
+    trajectories: int,
+    settle: int,
+    seed: int,
+    output: str | None,
+    as_json: bool,
+) -> None:
+    """Relative periodic orbits on the level of the scenario's state (its energy and the model's
+    other integrals): fixed points of the Poincare section's map after 1 to --returns crossings,
+    seeded by the section's trajectories, solved by Newton, with the section map's multipliers
+    on the level and their type (attracting, repelling, saddle, elliptic, neutral)."""
+    from rollingtop.chaos.periodic import periodic_orbits
+    from rollingtop.cli._errors import BadInput
+    from rollingtop.io import check_output_path
+    from rollingtop.plot import FIGURE_SUFFIXES
+    from rollingtop.scenario import load_scenario
+
+    if output is not None:
+        check_output_path(output, FIGURE_SUFFIXES)
+    if settle < 2 * returns + 1:
+        raise BadInput(f"--settle {settle} must be at least 2 * --returns + 1 = {2 * returns + 1}")
+    sc = load_scenario(scenario)
+    found = periodic_orbits(
+        sc.body,
+        sc.model,
+        sc.require_state(),
+        returns=returns,
+        trajectories=trajectories,
+        settle=settle,
+        seed=seed,
+    )
+    if output is not None:
+        from rollingtop.io import write_together
+        from rollingtop.plot.periodic import periodic_figure
+
+        fig = periodic_figure(found)
+        fmt = output.rsplit(".", 1)[-1].lower()
+        write_together([(output, lambda tmp: fig.savefig(tmp, format=fmt, dpi=200))])
+    if as_json:
+        click.echo(json.dumps(found.to_dict()))
+        return
+    level = ", ".join(f"{k} = {v:.6g}" for k, v in found.level.items())
+    click.echo(f"{len(found)} periodic orbits of the {found.model} model on the level {level}")
+    for k, o in enumerate(found, 1):
+        mu = ", ".join(f"{abs(m):.4g}" for m in o.multipliers)
+        flag = " (through the vertical: depends on the model's rule there)" * o.through_vertical
+        click.echo(
+            f"  {k}: {o.returns} returns, period {o.period:.10g}, {o.type} (|multipliers| {mu}, "
+            f"spread {o.multiplier_spread:.1g}), gamma3 = {o.x[0]:.6g}, w_n = {o.x[1]:.6g}, "
+            f"closure {o.closure:.1g}{flag}"
+        )
+    if output is not None:
+        click.echo(f"wrote {output}")

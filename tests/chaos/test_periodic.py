@@ -1,0 +1,140 @@
+"""Relative periodic orbits (rollingtop.chaos.periodic, ``rollingtop periodic``).
+
+Each orbit of the companion model's example level closes under SciPy's integration of the
+independent NumPy equations (tests/dynamics/reference.py, rtol 1e-12); the multipliers of an
+attracting orbit agree with the rate at which the section map's own iterates approach it; on the
+paper's integrable level the periods are the quadrature's (``rollingtop orbits``) and every
+multiplier is trivial.
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rollingtop import ScenarioError, SphericalTop
+from rollingtop.chaos import periodic_orbits
+from rollingtop.chaos.level import held_integrals
+from rollingtop.chaos.periodic import _SectionMap, section_coordinates, section_state
+from rollingtop.scenario import load_scenario
+
+from ..conftest import EXAMPLES
+from ..dynamics import reference
+from ..test_cli import run_cli
+
+#: One pytest-xdist worker runs this module (its fixture finds the example's orbits once).
+pytestmark = pytest.mark.xdist_group("periodic")
+
+#: Section coordinates rebuilt from a state: round-off.
+ROUND_TRIP_TOL = 1e-13
+#: An orbit's section coordinates after one period of SciPy's integration (rtol = atol = 1e-12)
+#: of the reference equations (the issue's bound).
+SCIPY_CLOSURE_TOL = 1e-8
+#: The periods of the integrable level against the quadrature of ``rollingtop orbits``.
+PERIOD_RTOL = 1e-9
+#: Trivial multipliers' distance from 1 (central differences at step 1e-5 of a flow at
+#: rtol 1e-11).
+TRIVIAL_TOL = 1e-4
+#: The largest multiplier's modulus against the contraction of the map's iterates.
+RATE_TOL = 0.02
+
+
+@pytest.fixture(scope="module")
+def parallel():
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    return sc, periodic_orbits(sc.body, sc.model, sc.require_state(), returns=4)
+
+
+def test_section_coordinates_rebuild_the_state(rng):
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    for model in ("parallel", "meridian"):
+        for _ in range(10):
+            x = np.array([rng.uniform(-0.95, 0.95), *rng.normal(size=3)])
+            y = section_state(sc.body, model, x)
+            assert abs(np.cross(y[3:6], [0.0, 0.0, 1.0]) @ y[12:15]) < ROUND_TRIP_TOL  # w_tau
+            np.testing.assert_allclose(section_coordinates(model, y), x, atol=ROUND_TRIP_TOL)
+
+
+def test_the_example_levels_orbits_are_attracting_and_close(parallel):
+    """The issue's done-when: the orbits the section's trajectories settle onto (section
+    examples/parallel.toml: a fixed point, a 3-cycle, 4-cycles), each attracting, each closing."""
+    sc, found = parallel
+    assert len(found) >= 2
+    assert {o.returns for o in found} >= {1, 3}
+    for o in found:
+        assert o.type == "attracting", o
+        assert np.all(np.abs(o.multipliers) < 1.0)
+        assert o.closure < SCIPY_CLOSURE_TOL
+        assert np.max(np.abs(o.trivial - 1.0)) < TRIVIAL_TOL
+        assert o.period > 0 and o.returns == len(o.points)
+
+
+def test_an_orbit_closes_under_scipy_on_the_reference_equations(parallel):
+    """The 3-cycle stays away from the vertical (where the reference's direction tau is
+    undefined): one period of SciPy's DOP853 on the NumPy equations brings its state back to
+    its section coordinates."""
+    sc, found = parallel
+    (orbit,) = [o for o in found if o.returns == 3]
+    assert not orbit.through_vertical
+    p = sc.body.params
+    sol = solve_ivp(lambda t, y: reference.rhs("parallel", p, y)[0], (0.0, orbit.period),
+                    orbit.state, method="DOP853", rtol=1e-12, atol=1e-12)  # fmt: skip
+    end = section_coordinates("parallel", sol.y[:, -1])
+    np.testing.assert_allclose(end, orbit.x, atol=SCIPY_CLOSURE_TOL)
+
+
+def test_the_multipliers_give_the_rate_of_approach(parallel):
+    """A start on the level beside the 3-cycle approaches it at the rate of the largest
+    multiplier's modulus per period (the map's own iterates, no differences)."""
+    sc, found = parallel
+    (orbit,) = [o for o in found if o.returns == 3]
+    names = held_integrals(sc.body, sc.model, None)
+    P = _SectionMap(sc.body, sc.model, names, 1e-11)
+    # a displacement along gamma3 compensated in w3 and v_nu to stay on the level (first order)
+    x = orbit.x.copy()
+    h = 1e-6
+    G = np.array([(P.integrals((x + h * e)[None])[0] - P.integrals((x - h * e)[None])[0]) / (2 * h)
+                  for e in np.eye(4)]).T  # fmt: skip
+    d = np.array([1.0, 0.0, 0.0, 0.0])
+    d[2:] = -np.linalg.solve(G[:, 2:], G[:, :2] @ d[:2])
+    pts, _ = P((x + 1e-4 * d)[None], 3 * 24)
+    dist = np.max(np.abs(pts[0, 2::3] - x), axis=-1)
+    rate = math.exp(np.polyfit(np.arange(4, 20), np.log(dist[4:20]), 1)[0])
+    assert rate == pytest.approx(abs(orbit.multipliers[0]), abs=RATE_TOL)
+
+
+def test_the_integrable_level_has_the_quadratures_periods_and_trivial_multipliers(capsys):
+    path = str(EXAMPLES / "fig5.toml")
+    code, out, err = run_cli(capsys, "periodic", path, "--json", "--returns", "2")
+    assert code == 0, err
+    got = json.loads(out)
+    code, out, err = run_cli(capsys, "orbits", path, "--json")
+    assert code == 0, err
+    want = sorted(o["period"] for o in json.loads(out)["orbits"] if o["kind"] == "periodic")
+    orbits = got["orbits"]
+    assert sorted(o["period"] for o in orbits) == pytest.approx(want, rel=PERIOD_RTOL)
+    for o in orbits:
+        assert o["returns"] == 1 and o["type"] == "neutral" and o["multipliers"] == []
+        assert o["trivial_multipliers_off_one"] < TRIVIAL_TOL
+        assert set(o) >= {"returns", "period", "initial", "multipliers", "type",
+                          "through_vertical", "closure"}  # fmt: skip
+        assert set(o["initial"]) == {"gamma", "omega", "v_tau"}
+    assert set(got) >= {"level", "orbits", "steady"}
+
+
+def test_bad_input_is_refused_in_one_line(capsys, tmp_path):
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    y = sc.require_state()
+    lopsided = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=0.3, I2=0.35, I3=0.5)
+    with pytest.raises(ScenarioError, match="dynamically symmetric"):
+        periodic_orbits(lopsided, "parallel", y)
+    with pytest.raises(ScenarioError, match="smooth model"):
+        periodic_orbits(sc.body, "smooth", y)
+    with pytest.raises(ScenarioError, match="returns = 0"):
+        periodic_orbits(sc.body, "parallel", y, returns=0)
+    for args in (("--returns", "0"), ("--settle", "5"), ("-o", str(tmp_path / "x.txt"))):
+        code, out, err = run_cli(capsys, "periodic", str(EXAMPLES / "parallel.toml"), *args)
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+        assert "Traceback" not in err
