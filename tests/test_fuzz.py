@@ -835,7 +835,8 @@ SHORT_RUN = {"--t-end": "0.05", "--samples": "5", "--crossings": "3", "--traject
 #: ... and per command (``verify``: sympy on every model takes about a minute; ``periodic``: a
 #: few crossings seed it).
 SHORT_RUN_BY_COMMAND = {"verify": {"--model": "meridian"}, "warmup": {"--model": "meridian"},
-                        "periodic": {"--settle": "9", "--returns": "2"}}  # fmt: skip
+                        "periodic": {"--settle": "9", "--returns": "2",
+                                     "--grid-seeds": "3"}}  # fmt: skip
 #: Drawing the key leaves out these short-run options (``--t-end`` overrides ``--periods``;
 #: ``ensemble`` takes exactly one of ``--initial`` and ``--grid``).
 LEFT_OUT_WITH = {"--periods": {"--t-end"}, "--initial": {"--grid"}}

@@ -28,6 +28,7 @@ DRAWERS: dict[str, str] = {
     "gamma3": "rollingtop.plot.paths:draw_gamma3",
     "drift": "rollingtop.plot.paths:draw_drift",
     "reactions": "rollingtop.plot.paths:draw_reactions",
+    "periodic": "rollingtop.plot.periodic:draw_periodic",
 }
 
 #: The kinds :meth:`rollingtop.Trajectory.plot` draws (the panels of ``rollingtop plot``).

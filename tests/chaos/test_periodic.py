@@ -57,32 +57,38 @@ def test_section_coordinates_rebuild_the_state(rng):
             np.testing.assert_allclose(section_coordinates(model, y), x, atol=ROUND_TRIP_TOL)
 
 
-def test_the_example_levels_orbits_are_attracting_and_close(parallel):
+def test_the_example_levels_orbits_are_found_typed_and_closed(parallel):
     """The issue's done-when: the orbits the section's trajectories settle onto (section
-    examples/parallel.toml: a fixed point, a 3-cycle, 4-cycles), each attracting, each closing."""
+    examples/parallel.toml: a fixed point, a 3-cycle, 4-cycles), each attracting, each closing;
+    and, from the grid of seeds, an elliptic fixed point, the centre the scenario's own
+    trajectory winds around (the model is reversible: symmetric orbits may be elliptic)."""
     sc, found = parallel
-    assert len(found) >= 2
-    assert {o.returns for o in found} >= {1, 3}
-    for o in found:
-        assert o.type == "attracting", o
+    attracting = [o for o in found if o.type == "attracting"]
+    assert {o.returns for o in attracting} >= {1, 3, 4}
+    for o in attracting:
         assert np.all(np.abs(o.multipliers) < 1.0)
+    (centre,) = [o for o in found if o.type == "elliptic"]
+    assert centre.returns == 1
+    np.testing.assert_allclose(np.abs(centre.multipliers), 1.0, atol=1e-6)
+    for o in found:
         assert o.closure < SCIPY_CLOSURE_TOL
         assert np.max(np.abs(o.trivial - 1.0)) < TRIVIAL_TOL
         assert o.period > 0 and o.returns == len(o.points)
 
 
 def test_an_orbit_closes_under_scipy_on_the_reference_equations(parallel):
-    """The 3-cycle stays away from the vertical (where the reference's direction tau is
-    undefined): one period of SciPy's DOP853 on the NumPy equations brings its state back to
-    its section coordinates."""
+    """The 3-cycle and the elliptic fixed point stay away from the vertical (where the
+    reference's direction tau is undefined): one period of SciPy's DOP853 on the NumPy equations
+    brings each state back to its section coordinates."""
     sc, found = parallel
-    (orbit,) = [o for o in found if o.returns == 3]
-    assert not orbit.through_vertical
+    away = [o for o in found if not o.through_vertical]
+    assert {(o.returns, o.type) for o in away} == {(3, "attracting"), (1, "elliptic")}
     p = sc.body.params
-    sol = solve_ivp(lambda t, y: reference.rhs("parallel", p, y)[0], (0.0, orbit.period),
-                    orbit.state, method="DOP853", rtol=1e-12, atol=1e-12)  # fmt: skip
-    end = section_coordinates("parallel", sol.y[:, -1])
-    np.testing.assert_allclose(end, orbit.x, atol=SCIPY_CLOSURE_TOL)
+    for orbit in away:
+        sol = solve_ivp(lambda t, y: reference.rhs("parallel", p, y)[0], (0.0, orbit.period),
+                        orbit.state, method="DOP853", rtol=1e-12, atol=1e-12)  # fmt: skip
+        end = section_coordinates("parallel", sol.y[:, -1])
+        np.testing.assert_allclose(end, orbit.x, atol=SCIPY_CLOSURE_TOL)
 
 
 def test_the_multipliers_give_the_rate_of_approach(parallel):
@@ -90,6 +96,7 @@ def test_the_multipliers_give_the_rate_of_approach(parallel):
     multiplier's modulus per period (the map's own iterates, no differences)."""
     sc, found = parallel
     (orbit,) = [o for o in found if o.returns == 3]
+    assert orbit.type == "attracting"
     names = held_integrals(sc.body, sc.model, None)
     P = _SectionMap(sc.body, sc.model, names, 1e-11)
     # a displacement along gamma3 compensated in w3 and v_nu to stay on the level (first order)
@@ -108,6 +115,7 @@ def test_the_multipliers_give_the_rate_of_approach(parallel):
 def test_the_integrable_level_has_the_quadratures_periods_and_trivial_multipliers(capsys):
     path = str(EXAMPLES / "fig5.toml")
     code, out, err = run_cli(capsys, "periodic", path, "--json", "--returns", "2")
+    # (the meridian model's level meets the section in points: no grid of seeds there)
     assert code == 0, err
     got = json.loads(out)
     code, out, err = run_cli(capsys, "orbits", path, "--json")
@@ -134,7 +142,29 @@ def test_bad_input_is_refused_in_one_line(capsys, tmp_path):
         periodic_orbits(sc.body, "smooth", y)
     with pytest.raises(ScenarioError, match="returns = 0"):
         periodic_orbits(sc.body, "parallel", y, returns=0)
-    for args in (("--returns", "0"), ("--settle", "5"), ("-o", str(tmp_path / "x.txt"))):
+    with pytest.raises(ScenarioError, match="grid = -1"):
+        periodic_orbits(sc.body, "parallel", y, grid=-1)
+    for args in (("--returns", "0"), ("--settle", "5"), ("-o", str(tmp_path / "x.txt")),
+                 ("--grid-seeds", "-1")):  # fmt: skip
         code, out, err = run_cli(capsys, "periodic", str(EXAMPLES / "parallel.toml"), *args)
         assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
         assert "Traceback" not in err
+
+
+def test_the_orbits_show_themselves_in_a_notebook(parallel, tmp_path):
+    """_repr_html_: a row per orbit with its type; .plot(): the orbits' crossings on the section
+    plane, on the caller's axes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    _, found = parallel
+    html = found._repr_html_()
+    assert html.count("<tr>") == len(found) + 3  # the two tables' headers, the level, the orbits
+    assert "elliptic" in html and "attracting" in html
+    ax = Figure().add_subplot()
+    assert found.plot(ax) is ax
+    drawn = [line for line in ax.get_lines() if line.get_marker() in ("o", "D")]
+    assert sum(len(line.get_xdata()) for line in drawn) == sum(o.returns for o in found)
+    ax.figure.savefig(tmp_path / "periodic.png")

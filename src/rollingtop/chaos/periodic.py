@@ -29,10 +29,11 @@ exponents; the section map's are future work, issue 38, item 2).
 **Seeds** are the section's own iterates: trajectories sampled on the level
 (:func:`rollingtop.chaos.level_states`) run ``settle`` crossings; where the last iterates of one
 repeat after ``K`` returns (to ``SEED_MATCH``) Newton starts from them with ``K``. So the orbits
-the trajectories settle onto are found (attracting ones, and elliptic ones where the flow keeps
-a measure); repelling and saddle orbits need other seeds (future work). An orbit met again at
-another of its crossings, or as a multiple of a shorter one, is reported once, with its least
-number of returns.
+the trajectories settle onto are found. Then a grid of the section plane on the level
+(:func:`_grid_seeds`): the grid points where ``|P^K(x) - x|`` is least among their neighbours
+seed Newton too, which finds orbits no trajectory settles onto (elliptic, saddle, repelling
+ones), as far as the grid resolves them. An orbit met again at another of its crossings, or as
+a multiple of a shorter one, is reported once, with its least number of returns.
 """
 
 from __future__ import annotations
@@ -46,6 +47,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._errors import InitialStateError, RollingTopError, ScenarioError
+from rollingtop._figures import draw
+from rollingtop._html import Num, block, count, row_table, table
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
 from rollingtop.chaos.level import held_integrals, level_states, level_values
@@ -247,6 +250,51 @@ class PeriodicOrbits:
     def __getitem__(self, k: int) -> PeriodicOrbit:
         return self.orbits[k]
 
+    def _repr_html_(self) -> str:
+        """The level, then a row per orbit (returns, period, type, multipliers' moduli,
+        closure, through the vertical)."""
+        header = [
+            "returns",
+            "period",
+            "type",
+            "|mu_1|",
+            "|mu_2|",
+            "spread",
+            "gamma3",
+            "w_n",
+            "closure",
+            "through the vertical",
+        ]
+        rows = []
+        for o in self.orbits:
+            mods = [abs(m) for m in o.multipliers] + [None] * (2 - len(o.multipliers))
+            rows.append(
+                [
+                    o.returns,
+                    Num(o.period, 10),
+                    o.type,
+                    Num(mods[0], 4),
+                    Num(mods[1], 4),
+                    Num(o.multiplier_spread, 1),
+                    Num(o.x[0], 6),
+                    Num(o.x[1], 6),
+                    Num(o.closure, 1),
+                    o.through_vertical,
+                ]
+            )
+        return block(
+            "rollingtop.chaos.PeriodicOrbits",
+            f"{count(len(self.orbits), 'periodic orbit')} of the {self.model} model on its level "
+            f"({self.seeds} seeds)",
+            [("level", row_table(self.level)), ("", table(header, rows) if rows else "")],
+        )
+
+    def plot(self, ax: Any = None, **kw: Any) -> Any:
+        """Draw the seeding trajectories' crossings and the orbits on the section plane
+        ``(gamma3, w_n)`` on ``ax`` (default: a new figure's) and return ``ax``
+        (:func:`rollingtop.plot.periodic.draw_periodic`, ``rollingtop periodic -o``'s figure)."""
+        return draw("periodic", ax, self, **kw)
+
     def to_dict(self) -> dict[str, Any]:
         """``{"model", "level", "orbits", "steady", "seeds"}`` (``rollingtop periodic --json``)."""
         return {
@@ -375,6 +423,86 @@ def _seeds(iterates: FloatArray, returns: int) -> list[tuple[FloatArray, int]]:
     return out
 
 
+def _on_level(P: _SectionMap, target: FloatArray, g3: float, w_n: float) -> list[FloatArray]:
+    """The section coordinates ``(g3, w_n, w3, u)`` on the level: 0, 1 or 2 of them.
+
+    Written for a level of the energy (quadratic in the velocities) and one integral linear in
+    them (``parallel``'s energy and Jellett integral): both are fitted exactly in ``(w3, u)``
+    from six states, the linear one fixes a line, the energy a quadratic along it."""
+    base = np.array([g3, w_n, 0.0, 0.0])
+    probe = np.array([[0, 0], [1, 0], [0, 1], [-1, 0], [0, -1], [1, 1]], dtype=float)
+    X = np.repeat(base[None], len(probe), axis=0)
+    X[:, 2:] = probe
+    V = P.integrals(X)
+    e = P.names.index("energy")
+    lin = 1 - e
+    design = np.column_stack(
+        [np.ones(6), probe[:, 0], probe[:, 1], probe[:, 0] ** 2, probe[:, 1] ** 2, probe.prod(1)]
+    )
+    c0, c1, c2, c11, c22, c12 = np.linalg.solve(design, V[:, e])
+    j0, j1, j2 = V[0, lin], V[1, lin] - V[0, lin], V[2, lin] - V[0, lin]
+    # the line j0 + j1 w3 + j2 u = target: (w3, u) = p + t d
+    d = np.array([-j2, j1]) / math.hypot(j1, j2)
+    p = np.array([j1, j2]) * (target[lin] - j0) / (j1 * j1 + j2 * j2)
+    qa = c11 * d[0] ** 2 + c22 * d[1] ** 2 + c12 * d[0] * d[1]
+    qb = c1 * d[0] + c2 * d[1] + 2 * c11 * p[0] * d[0] + 2 * c22 * p[1] * d[1]
+    qb += c12 * (p[0] * d[1] + p[1] * d[0])
+    qc = c0 + c1 * p[0] + c2 * p[1] + c11 * p[0] ** 2 + c22 * p[1] ** 2 + c12 * p[0] * p[1]
+    qc -= target[e]
+    disc = qb * qb - 4 * qa * qc
+    if not (qa > 0 and disc >= 0):
+        return []
+    roots = {(-qb + sign * math.sqrt(disc)) / (2 * qa) for sign in (-1.0, 1.0)}
+    return [np.array([g3, w_n, *(p + t * d)]) for t in sorted(roots)]
+
+
+def _grid_seeds(
+    P: _SectionMap, target: FloatArray, iterates: FloatArray, returns: int, n: int
+) -> list[tuple[FloatArray, int]]:
+    """Seeds from an ``n`` x ``n`` grid of the section plane over the range of the iterates
+    (each grid point on each sheet of the level, :func:`_on_level`): for each ``K``, the points
+    whose ``|P^K(x) - x|`` is least among their grid neighbours and below the grid's spacing
+    (a fixed point of ``P^K`` nearby, whatever its stability)."""
+    if len(P.names) != 2 or "energy" not in P.names:
+        return []
+    pts = iterates[np.all(np.isfinite(iterates), axis=-1)]
+    if not len(pts):
+        return []
+    lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
+    pad = 0.1 * (hi - lo) + 1e-3
+    g3s = np.linspace(max(lo[0] - pad[0], -0.999), min(hi[0] + pad[0], 0.999), n)
+    wns = np.linspace(lo[1] - pad[1], hi[1] + pad[1], n)
+    spacing = max(g3s[1] - g3s[0], wns[1] - wns[0]) if n > 1 else 1.0
+    cells: list[tuple[int, int, int, FloatArray]] = []
+    for i, g3 in enumerate(g3s):
+        for j, w_n in enumerate(wns):
+            for sheet, x in enumerate(_on_level(P, target, float(g3), float(w_n))):
+                cells.append((i, j, sheet, x))
+    if not cells:
+        return []
+    X = np.array([c[3] for c in cells])
+    try:
+        out, _ = P(X, returns)
+    except RollingTopError:
+        return []
+    seeds = []
+    for K in range(1, returns + 1):
+        res = np.max(np.abs(out[:, K - 1, :2] - X[:, :2]), axis=-1)
+        res = np.where(np.isfinite(res), res, np.inf)
+        by_cell = {(i, j, sheet): r for (i, j, sheet, _), r in zip(cells, res, strict=True)}
+        for k, (i, j, sheet, x) in enumerate(cells):
+            r = res[k]
+            around = [
+                by_cell.get((i + a, j + b, sheet), np.inf)
+                for a in (-1, 0, 1)
+                for b in (-1, 0, 1)
+                if a or b
+            ]
+            if r < spacing and r <= min(around):
+                seeds.append((x, K))
+    return seeds
+
+
 def _same(a: PeriodicOrbit, points: FloatArray) -> bool:
     """Whether a crossing of ``a`` is one of ``points`` (section coordinates, (n, 4))."""
     gaps = np.max(np.abs(a.points[:, None, :] - points[None, :, :]), axis=-1)
@@ -390,6 +518,7 @@ def periodic_orbits(
     trajectories: int = 16,
     settle: int = 300,
     seed: int | None = 0,
+    grid: int = 12,
     rtol: float = 1e-11,
 ) -> PeriodicOrbits:
     """The relative periodic orbits on the level of ``state`` that the section's trajectories
@@ -409,6 +538,11 @@ def periodic_orbits(
     trajectories, settle, seed :
         The seeds: ``trajectories`` states sampled on the level (``seed``), each run
         ``settle`` crossings.
+    grid : int
+        Also seed from a ``grid`` x ``grid`` grid of the section plane on the level
+        (:func:`_grid_seeds`: for orbits no trajectory settles onto, repelling and saddle
+        ones); 0: none. Only on a level of the energy and one integral linear in the velocity
+        (``parallel``).
     rtol : float
         Tolerance of every integration (``atol = rtol / 100``).
 
@@ -421,7 +555,11 @@ def periodic_orbits(
     _check_model(body, model)
     if isinstance(returns, bool) or not isinstance(returns, int) or not 1 <= returns <= 12:
         raise ScenarioError(f"returns = {returns!r} must be an integer from 1 to 12")
-    for name, value, lo in (("trajectories", trajectories, 1), ("settle", settle, 2 * returns + 1)):
+    for name, value, lo in (
+        ("trajectories", trajectories, 1),
+        ("settle", settle, 2 * returns + 1),
+        ("grid", grid, 0),
+    ):
         if isinstance(value, bool) or not isinstance(value, int) or value < lo:
             raise ScenarioError(f"{name} = {value!r} must be an integer >= {lo}")
     y0 = np.asarray(state, dtype=float)
@@ -434,10 +572,13 @@ def periodic_orbits(
     found = PeriodicOrbits(model.name, dict(zip(names, map(float, target), strict=True)))
     found.iterates = iterates[..., :2]
     candidates = _seeds(iterates, returns)
+    if grid:
+        candidates += _grid_seeds(P, target, iterates, returns, grid)
     found.seeds = len(candidates)
     for x0, K in sorted(candidates, key=lambda c: c[1]):
-        if any(o.returns <= K and _same(o, x0[None, :]) for o in found.orbits):
-            continue
+        near = [o for o in found.orbits if K % o.returns == 0]
+        if any(np.min(np.max(np.abs(o.points - x0), axis=-1)) < SEED_MATCH for o in near):
+            continue  # a seed of an orbit found already
         solved = _newton(P, x0, K, target)
         if solved is None:
             continue

@@ -37,6 +37,14 @@ __all__ = ["periodic"]
 )
 @click.option("--seed", type=click.IntRange(0), default=0, show_default=True, help="Sampling seed.")
 @click.option(
+    "--grid-seeds",
+    type=click.IntRange(0, 200),
+    default=12,
+    show_default=True,
+    help="Also seed Newton from an N x N grid of the section plane on the level (orbits no "
+    "trajectory settles onto; 0: none).",
+)
+@click.option(
     "-o", "--output", type=click.Path(), default=None, help="Also draw them: FIG.png, .svg, .pdf."
 )
 @json_option
@@ -46,6 +54,7 @@ def periodic(
     trajectories: int,
     settle: int,
     seed: int,
+    grid_seeds: int,
     output: str | None,
     as_json: bool,
 ) -> None:
@@ -72,6 +81,7 @@ def periodic(
         trajectories=trajectories,
         settle=settle,
         seed=seed,
+        grid=grid_seeds,
     )
     if output is not None:
         from rollingtop.io import write_together

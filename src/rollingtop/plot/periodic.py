@@ -7,10 +7,14 @@ from typing import TYPE_CHECKING
 
 from matplotlib.figure import Figure
 
+from rollingtop.plot._axes import axes_for
+
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
     from rollingtop.chaos.periodic import PeriodicOrbits
 
-__all__ = ["periodic_figure"]
+__all__ = ["draw_periodic", "periodic_figure"]
 
 #: Marker and colour of each type of orbit.
 STYLE = {
@@ -22,11 +26,11 @@ STYLE = {
 }
 
 
-def periodic_figure(found: PeriodicOrbits) -> Figure:
+def draw_periodic(ax: Axes | None, found: PeriodicOrbits, *, legend: bool = True) -> Axes:
     """The seeding trajectories' crossings (grey) in the plane ``(gamma3, w_n)`` and each
-    orbit's crossings, marked by its type and labelled with its number of returns."""
-    fig = Figure(figsize=(7.0, 5.6))
-    ax = fig.add_subplot()
+    orbit's crossings, marked by its type and labelled ``orbit:returns``, on ``ax`` (``None``: a
+    new figure's); returns ``ax``."""
+    ax = axes_for(ax, (7.0, 5.6))
     pts = found.iterates.reshape(-1, 2)
     ax.plot(pts[:, 0], pts[:, 1], ".", ms=1.2, color="0.7", zorder=1)
     seen = set()
@@ -50,7 +54,7 @@ def periodic_figure(found: PeriodicOrbits) -> Figure:
                 f"{k + 1}:{orbit.returns}",
                 (x, y),
                 textcoords="offset points",
-                xytext=(6, 5),
+                xytext=(6, 5 - 11 * (k % 2)),  # neighbouring orbits' labels apart
                 fontsize=8,
             )
     level = ", ".join(f"{k} = {v:.6g}" for k, v in found.level.items())
@@ -61,7 +65,14 @@ def periodic_figure(found: PeriodicOrbits) -> Figure:
     )
     ax.set_xlabel("gamma3 at the section (minimum of gamma3)")
     ax.set_ylabel("w_n")
-    if found.orbits:
+    if legend and found.orbits:
         ax.legend(loc="best", fontsize=8)
+    return ax
+
+
+def periodic_figure(found: PeriodicOrbits) -> Figure:
+    """``rollingtop periodic -o``'s figure: :func:`draw_periodic` on a figure of its own."""
+    fig = Figure(figsize=(7.0, 5.6))
+    draw_periodic(fig.add_subplot(), found)
     fig.tight_layout()
     return fig
