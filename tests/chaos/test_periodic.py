@@ -16,8 +16,8 @@ from scipy.integrate import solve_ivp
 
 from rollingtop import ScenarioError, SphericalTop
 from rollingtop.chaos import periodic_orbits
+from rollingtop.chaos._section_map import SectionMap, section_coordinates, section_state
 from rollingtop.chaos.level import held_integrals
-from rollingtop.chaos.periodic import _SectionMap, section_coordinates, section_state
 from rollingtop.scenario import load_scenario
 
 from ..conftest import EXAMPLES
@@ -37,6 +37,9 @@ PERIOD_RTOL = 1e-9
 #: Trivial multipliers' distance from 1 (central differences at step 1e-5 of a flow at
 #: rtol 1e-11).
 TRIVIAL_TOL = 1e-4
+#: The steady motion's eigenvalues against those of the reference equations (both central
+#: differences of a difference).
+EIGENVALUE_TOL = 1e-5
 #: The largest multiplier's modulus against the contraction of the map's iterates.
 RATE_TOL = 0.02
 
@@ -98,7 +101,7 @@ def test_the_multipliers_give_the_rate_of_approach(parallel):
     (orbit,) = [o for o in found if o.returns == 3]
     assert orbit.type == "attracting"
     names = held_integrals(sc.body, sc.model, None)
-    P = _SectionMap(sc.body, sc.model, names, 1e-11)
+    P = SectionMap(sc.body, sc.model, names, 1e-11)
     # a displacement along gamma3 compensated in w3 and v_nu to stay on the level (first order)
     x = orbit.x.copy()
     h = 1e-6
@@ -168,3 +171,45 @@ def test_the_orbits_show_themselves_in_a_notebook(parallel, tmp_path):
     drawn = [line for line in ax.get_lines() if line.get_marker() in ("o", "D")]
     assert sum(len(line.get_xdata()) for line in drawn) == sum(o.returns for o in found)
     ax.figure.savefig(tmp_path / "periodic.png")
+
+
+def test_a_relative_equilibrium_is_found_on_its_level():
+    """A steady motion of the companion model (gamma3 constant), found here with SciPy's root
+    on the independent NumPy equations (tests/dynamics/reference.py) carried to the reduced
+    coordinates: on its level the library finds it, with the same nonzero eigenvalues, and the
+    compiled integrator keeps its gamma3 constant."""
+    from scipy.optimize import root
+
+    from rollingtop import simulate
+    from rollingtop.chaos._section_map import reduced_coordinates, reduced_state
+    from rollingtop.chaos.steady import relative_equilibria
+
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    body, p = sc.body, sc.body.params
+
+    def field(z):
+        y = reduced_state(body, "parallel", z)
+        dy = reference.rhs("parallel", p, y)[0]
+        e = 1e-7 / np.max(np.abs(dy))
+        return (reduced_coordinates("parallel", y + e * dy)
+                - reduced_coordinates("parallel", y - e * dy)) / (2 * e)  # fmt: skip
+
+    def steady(q):  # (gamma3, w_n, w3, u) with w_tau = 0
+        return field(np.array([q[0], 0.0, *q[1:]]))[1:]
+
+    sol = root(steady, [-0.19, -2.8, -0.25, 0.0], method="lm", tol=1e-14)
+    assert sol.success and np.max(np.abs(steady(sol.x))) < 1e-10
+    z_ref = np.array([sol.x[0], 0.0, *sol.x[1:]])
+    names = held_integrals(body, sc.model, None)
+    P = SectionMap(body, sc.model, names, 1e-11)
+    target = P.integrals(np.delete(z_ref, 1)[None])[0]
+    found = relative_equilibria(P, target, np.linspace(-0.9, 0.9, 10), np.linspace(-4, 1, 10))
+    (eq,) = [e for e in found if np.max(np.abs(e.z - z_ref)) < 1e-6]
+    A = np.array([(field(z_ref + h) - field(z_ref - h)) / 2e-4 for h in 1e-4 * np.eye(5)]).T
+    ref = [e for e in np.linalg.eigvals(A) if abs(e) > 1e-4]
+    assert len(ref) == len(eq.eigenvalues)
+    for e in eq.eigenvalues:
+        assert min(abs(e - r) for r in ref) < EIGENVALUE_TOL
+    assert eq.type == "unstable" and eq.eigenvalues[0].real > 1.0
+    tr = simulate(body, sc.model, eq.state, t_end=2.0, rtol=1e-12, samples=201)
+    assert np.ptp(tr.y[:, 14]) < 1e-8  # steady (an unstable one: a short run)

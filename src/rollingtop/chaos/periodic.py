@@ -39,23 +39,32 @@ a multiple of a shorter one, is reported once, with its least number of returns.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rollingtop._errors import InitialStateError, RollingTopError, ScenarioError
+from rollingtop._errors import RollingTopError, ScenarioError
 from rollingtop._figures import draw
 from rollingtop._html import Num, block, count, row_table, table
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
+from rollingtop.chaos._section_map import (
+    RANK_TOL,
+    SectionMap,
+    check_model,
+    free_key,
+    integral_gradients,
+    map_jacobian,
+    on_level,
+    section_coordinates,
+    section_state,
+)
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.chaos.section import poincare_section
+from rollingtop.chaos.steady import RelativeEquilibrium, relative_equilibria
 from rollingtop.contact import ContactModel, get_model
-from rollingtop.dynamics.integrals import evaluate
-from rollingtop.dynamics.state import initial_state
 
 __all__ = [
     "PeriodicOrbit",
@@ -76,16 +85,10 @@ NEWTON_TOL = 1e-10
 ACCEPT_TOL = 1e-8
 #: Newton's iterations at most.
 NEWTON_ITERATIONS = 12
-#: A crossing at a time up to this after the start is the start itself (it lies on the section).
-START_CROSSING = 1e-9
-#: Relative step of the central differences of the section map.
-FD_STEP = 1e-5
 #: The multipliers are computed again with this step; their difference is reported
 #: (``multiplier_spread``): the differences' error, large where the orbit passes close to the
 #: vertical (the flow's derivative there is steep and its round-off amplified).
 FD_CHECK_STEP = 1e-4
-#: Singular values of the integrals' gradients below this fraction of the largest count as 0.
-RANK_TOL = 1e-8
 #: Two fixed points are the same orbit when a crossing of one is this close to one of the other.
 SAME_ORBIT = 1e-6
 #: A multiplier this close to modulus 1 counts as on the unit circle (``neutral`` / ``elliptic``).
@@ -97,57 +100,6 @@ UNIT_CIRCLE = 1e-5
 VERTICAL_DISTANCE = 1e-2
 #: Samples along an orbit for :data:`VERTICAL_DISTANCE`.
 VERTICAL_SAMPLES = 4001
-
-
-def _free_key(model: ContactModel) -> str:
-    """The model's one scalar free velocity component (``ScenarioError`` for another model)."""
-    scalar = [k for k, n in model.free_velocity.items() if n == 1]
-    if len(model.free_velocity) != 1 or len(scalar) != 1 or model.own is not None:
-        raise ScenarioError(
-            f"periodic orbits: the {model.name} model's state on the section is not fixed by "
-            "(gamma3, w_n, w3) and one free velocity component (models: meridian, parallel)"
-        )
-    return scalar[0]
-
-
-def _check_model(body: SphericalTop, model: ContactModel) -> None:
-    if not body.symmetric:
-        raise ScenarioError(
-            "periodic orbits need a dynamically symmetric body (I1 = I2): the section "
-            "coordinates leave out the body's rotation about its axis"
-        )
-    _free_key(model)
-
-
-def section_coordinates(model: str | ContactModel, Y: ArrayLike) -> FloatArray:
-    """The section coordinates ``(gamma3, w_n, w3, u)`` of states ``Y`` (shape ``(..., 18)``),
-    shape ``(..., 4)``, in the geometric basis of the module docstring (NaN at a vertical
-    axis)."""
-    model = get_model(model)
-    Y = np.asarray(Y, dtype=float)
-    g = Y[..., 12:15]
-    s = np.hypot(g[..., 0], g[..., 1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        nu = (np.array([0.0, 0.0, 1.0]) - g[..., 2:3] * g) / s[..., None]
-    tau = np.cross(nu, g)
-    n = np.stack([-tau[..., 1], tau[..., 0], np.zeros_like(s)], axis=-1)
-    w = Y[..., 3:6]
-    key = _free_key(model)
-    u = np.sum(Y[..., 0:3] * (nu if key == "v_nu" else tau), axis=-1)
-    return np.stack([g[..., 2], np.sum(w * n, axis=-1), w[..., 2], u], axis=-1)
-
-
-def section_state(body: SphericalTop, model: str | ContactModel, x: ArrayLike) -> FloatArray:
-    """The state on the section with coordinates ``x = (gamma3, w_n, w3, u)`` (shape (4,)):
-    ``gamma = (0, s, gamma3)``, ``w = (0, -w_n, w3)`` (so ``w_tau = 0``), the free velocity
-    ``u`` (:func:`rollingtop.initial_state`). ``InitialStateError`` where ``|gamma3| >= 1``."""
-    model = get_model(model)
-    g3, w_n, w3, u = (float(v) for v in np.asarray(x, dtype=float))
-    if not abs(g3) < 1.0:
-        raise InitialStateError(f"gamma3 = {g3!r}: the section needs a tilted axis")
-    s = math.sqrt(1.0 - g3 * g3)
-    free = {_free_key(model): u}
-    return initial_state(body, model, gamma=[0.0, s, g3], omega=[0.0, -w_n, w3], free=free)
 
 
 @dataclass(frozen=True)
@@ -210,7 +162,7 @@ class PeriodicOrbit:
             "gamma": [0.0, math.sqrt(1.0 - g3 * g3), g3],
             "omega": [0.0, -w_n, w3],
         }
-        table[_free_key(model)] = u
+        table[free_key(model)] = u
         return table
 
     def to_dict(self, model: str | ContactModel) -> dict[str, Any]:
@@ -238,6 +190,9 @@ class PeriodicOrbits:
     level: dict[str, float]
     orbits: list[PeriodicOrbit] = field(default_factory=list)
     seeds: int = 0
+    #: The relative equilibria on the level (:func:`rollingtop.chaos.steady.relative_equilibria`;
+    #: a model with a reduction has them in closed form, ``rollingtop equilibria``: empty here).
+    steady: list[RelativeEquilibrium] = field(default_factory=list)
     #: The seeding trajectories' crossings, ``(gamma3, w_n)``, shape (trajectories, settle, 2).
     iterates: FloatArray = field(default_factory=lambda: np.empty((0, 0, 2)))
 
@@ -284,8 +239,9 @@ class PeriodicOrbits:
             )
         return block(
             "rollingtop.chaos.PeriodicOrbits",
-            f"{count(len(self.orbits), 'periodic orbit')} of the {self.model} model on its level "
-            f"({self.seeds} seeds)",
+            f"{count(len(self.orbits), 'periodic orbit')} and "
+            f"{count(len(self.steady), 'relative equilibrium', 'relative equilibria')} of the "
+            f"{self.model} model on its level ({self.seeds} seeds)",
             [("level", row_table(self.level)), ("", table(header, rows) if rows else "")],
         )
 
@@ -301,7 +257,7 @@ class PeriodicOrbits:
             "model": self.model,
             "level": dict(self.level),
             "orbits": [o.to_dict(self.model) for o in self.orbits],
-            "steady": [],
+            "steady": [e.to_dict(free_key(get_model(self.model))) for e in self.steady],
             "seeds": self.seeds,
         }
 
@@ -317,76 +273,16 @@ def _classify(mu: NDArray[np.complex128]) -> str:
     return "saddle"
 
 
-class _SectionMap:
-    """``P^K`` of batches of section coordinates, on the compiled section."""
-
-    def __init__(
-        self, body: SphericalTop, model: ContactModel, names: Sequence[str], rtol: float
-    ) -> None:
-        self.body, self.model, self.names, self.rtol = body, model, tuple(names), rtol
-
-    def states(self, X: FloatArray) -> FloatArray:
-        return np.array([section_state(self.body, self.model, x) for x in X])
-
-    def integrals(self, X: FloatArray) -> FloatArray:
-        """The held integrals at section coordinates ``X`` (n, 4): shape (n, len(names))."""
-        Y = self.states(X)
-        values = evaluate(self.body, Y, self.names, model=self.model)
-        return np.stack([np.asarray(values[k], dtype=float) for k in self.names], axis=-1)
-
-    def __call__(self, X: FloatArray, K: int) -> tuple[FloatArray, FloatArray]:
-        """``(P^1..K(X), t)``: the coordinates of the first ``K`` crossings, shape (n, K, 4),
-        and their times (n, K); NaN where a trajectory stopped before."""
-        ds = poincare_section(
-            self.body,
-            self.model,
-            self.states(X),
-            crossings=K + 1,
-            hold=self.names,
-            rtol=self.rtol,
-            atol=self.rtol * 1e-2,
-            max_gap_steps=20_000,
-            threads=None,
-        )
-        # a start on the section may count as its first crossing (w_tau = 0 at t = 0): skipped
-        t = ds["t"].values
-        first = (t[:, 0] <= START_CROSSING).astype(int)
-        rows = np.arange(t.shape[0])[:, None]
-        cols = first[:, None] + np.arange(K)[None, :]
-        coords = section_coordinates(self.model, ds["crossing_state"].values)
-        return coords[rows, cols], t[rows, cols]
-
-
-def _jacobian(
-    P: _SectionMap, x: FloatArray, K: int, step: float = FD_STEP
-) -> tuple[FloatArray, FloatArray, float]:
-    """``P^K(x)``, its Jacobian (4, 4) by central differences, and the period."""
-    h = step * np.maximum(1.0, np.abs(x))
-    X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
-    out, t = P(X, K)
-    F = out[:, K - 1]
-    J = (F[1:5] - F[5:9]).T / (2 * h)
-    return F[0], J, float(t[0, K - 1])
-
-
-def _gradients(P: _SectionMap, x: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """The held integrals at ``x`` and their gradients (len(names), 4), central differences."""
-    h = FD_STEP * np.maximum(1.0, np.abs(x))
-    X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
-    V = P.integrals(X)
-    return V[0], ((V[1:5] - V[5:9]) / (2 * h[:, None])).T
-
-
 def _newton(
-    P: _SectionMap, x0: FloatArray, K: int, target: FloatArray
+    P: SectionMap, x0: FloatArray, K: int, target: FloatArray
 ) -> tuple[FloatArray, FloatArray, float] | None:
     """Gauss-Newton on ``P^K(x) = x``, ``I(x) = target``; ``(x, DP^K, period)`` or None."""
     x = x0.copy()
     best: tuple[float, FloatArray, FloatArray, float] | None = None
     for _ in range(NEWTON_ITERATIONS):
         try:
-            F, J, period = _jacobian(P, x, K)
-            values, G = _gradients(P, x)
+            F, J, period = map_jacobian(P, x, K)
+            values, G = integral_gradients(P, x)
         except RollingTopError:
             break
         if not (np.all(np.isfinite(F)) and np.all(np.isfinite(J))):
@@ -423,60 +319,37 @@ def _seeds(iterates: FloatArray, returns: int) -> list[tuple[FloatArray, int]]:
     return out
 
 
-def _on_level(P: _SectionMap, target: FloatArray, g3: float, w_n: float) -> list[FloatArray]:
-    """The section coordinates ``(g3, w_n, w3, u)`` on the level: 0, 1 or 2 of them.
-
-    Written for a level of the energy (quadratic in the velocities) and one integral linear in
-    them (``parallel``'s energy and Jellett integral): both are fitted exactly in ``(w3, u)``
-    from six states, the linear one fixes a line, the energy a quadratic along it."""
-    base = np.array([g3, w_n, 0.0, 0.0])
-    probe = np.array([[0, 0], [1, 0], [0, 1], [-1, 0], [0, -1], [1, 1]], dtype=float)
-    X = np.repeat(base[None], len(probe), axis=0)
-    X[:, 2:] = probe
-    V = P.integrals(X)
-    e = P.names.index("energy")
-    lin = 1 - e
-    design = np.column_stack(
-        [np.ones(6), probe[:, 0], probe[:, 1], probe[:, 0] ** 2, probe[:, 1] ** 2, probe.prod(1)]
-    )
-    c0, c1, c2, c11, c22, c12 = np.linalg.solve(design, V[:, e])
-    j0, j1, j2 = V[0, lin], V[1, lin] - V[0, lin], V[2, lin] - V[0, lin]
-    # the line j0 + j1 w3 + j2 u = target: (w3, u) = p + t d
-    d = np.array([-j2, j1]) / math.hypot(j1, j2)
-    p = np.array([j1, j2]) * (target[lin] - j0) / (j1 * j1 + j2 * j2)
-    qa = c11 * d[0] ** 2 + c22 * d[1] ** 2 + c12 * d[0] * d[1]
-    qb = c1 * d[0] + c2 * d[1] + 2 * c11 * p[0] * d[0] + 2 * c22 * p[1] * d[1]
-    qb += c12 * (p[0] * d[1] + p[1] * d[0])
-    qc = c0 + c1 * p[0] + c2 * p[1] + c11 * p[0] ** 2 + c22 * p[1] ** 2 + c12 * p[0] * p[1]
-    qc -= target[e]
-    disc = qb * qb - 4 * qa * qc
-    if not (qa > 0 and disc >= 0):
-        return []
-    roots = {(-qb + sign * math.sqrt(disc)) / (2 * qa) for sign in (-1.0, 1.0)}
-    return [np.array([g3, w_n, *(p + t * d)]) for t in sorted(roots)]
-
-
-def _grid_seeds(
-    P: _SectionMap, target: FloatArray, iterates: FloatArray, returns: int, n: int
-) -> list[tuple[FloatArray, int]]:
-    """Seeds from an ``n`` x ``n`` grid of the section plane over the range of the iterates
-    (each grid point on each sheet of the level, :func:`_on_level`): for each ``K``, the points
-    whose ``|P^K(x) - x|`` is least among their grid neighbours and below the grid's spacing
-    (a fixed point of ``P^K`` nearby, whatever its stability)."""
-    if len(P.names) != 2 or "energy" not in P.names:
-        return []
+def _grid_axes(iterates: FloatArray, n: int) -> tuple[FloatArray, FloatArray] | None:
+    """The ``gamma3`` and ``w_n`` of an ``n`` x ``n`` grid over the iterates' range (padded by a
+    tenth); ``None`` without iterates."""
     pts = iterates[np.all(np.isfinite(iterates), axis=-1)]
-    if not len(pts):
-        return []
+    if not len(pts) or n < 1:
+        return None
     lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
     pad = 0.1 * (hi - lo) + 1e-3
     g3s = np.linspace(max(lo[0] - pad[0], -0.999), min(hi[0] + pad[0], 0.999), n)
     wns = np.linspace(lo[1] - pad[1], hi[1] + pad[1], n)
+    return g3s, wns
+
+
+def _grid_seeds(
+    P: SectionMap, target: FloatArray, iterates: FloatArray, returns: int, n: int
+) -> list[tuple[FloatArray, int]]:
+    """Seeds from an ``n`` x ``n`` grid of the section plane over the range of the iterates
+    (each grid point on each sheet of the level, :func:`on_level`): for each ``K``, the points
+    whose ``|P^K(x) - x|`` is least among their grid neighbours and below the grid's spacing
+    (a fixed point of ``P^K`` nearby, whatever its stability)."""
+    if len(P.names) != 2 or "energy" not in P.names:
+        return []
+    axes = _grid_axes(iterates, n)
+    if axes is None:
+        return []
+    g3s, wns = axes
     spacing = max(g3s[1] - g3s[0], wns[1] - wns[0]) if n > 1 else 1.0
     cells: list[tuple[int, int, int, FloatArray]] = []
     for i, g3 in enumerate(g3s):
         for j, w_n in enumerate(wns):
-            for sheet, x in enumerate(_on_level(P, target, float(g3), float(w_n))):
+            for sheet, x in enumerate(on_level(P, target, float(g3), float(w_n))):
                 cells.append((i, j, sheet, x))
     if not cells:
         return []
@@ -552,7 +425,7 @@ def periodic_orbits(
         In order of ``returns``, then of ``gamma3``.
     """
     model = get_model(model)
-    _check_model(body, model)
+    check_model(body, model)
     if isinstance(returns, bool) or not isinstance(returns, int) or not 1 <= returns <= 12:
         raise ScenarioError(f"returns = {returns!r} must be an integer from 1 to 12")
     for name, value, lo in (
@@ -565,7 +438,7 @@ def periodic_orbits(
     y0 = np.asarray(state, dtype=float)
     names = held_integrals(body, model, None)
     target = level_values(body, model, y0, names)
-    P = _SectionMap(body, model, names, rtol)
+    P = SectionMap(body, model, names, rtol)
     starts = level_states(body, model, y0, trajectories, seed=seed)
     ds = poincare_section(body, model, starts, crossings=settle, rtol=rtol, atol=rtol * 1e-2)
     iterates = section_coordinates(model, ds["crossing_state"].values)
@@ -575,6 +448,9 @@ def periodic_orbits(
     if grid:
         candidates += _grid_seeds(P, target, iterates, returns, grid)
     found.seeds = len(candidates)
+    axes = _grid_axes(iterates, grid)
+    if axes is not None:
+        found.steady = relative_equilibria(P, target, *axes)
     for x0, K in sorted(candidates, key=lambda c: c[1]):
         near = [o for o in found.orbits if K % o.returns == 0]
         if any(np.min(np.max(np.abs(o.points - x0), axis=-1)) < SEED_MATCH for o in near):
@@ -595,7 +471,7 @@ def periodic_orbits(
 
 
 def _orbit(
-    P: _SectionMap,
+    P: SectionMap,
     x: FloatArray,
     DP: FloatArray,
     K: int,
@@ -604,7 +480,7 @@ def _orbit(
     target: FloatArray,
 ) -> PeriodicOrbit:
     k = int(np.argmin(points[:, 0]))
-    _, G = _gradients(P, x)
+    _, G = integral_gradients(P, x)
     _, sv, vt = np.linalg.svd(G)
     rank = int(np.sum(sv > RANK_TOL * sv[0]))
     # orthonormal basis of the level's tangent plane on the section: empty where the level meets
@@ -618,7 +494,7 @@ def _orbit(
     mu = on_level(DP)
     spread = 0.0
     if mu.size:
-        spread = float(np.max(np.abs(mu - on_level(_jacobian(P, x, K, FD_CHECK_STEP)[1]))))
+        spread = float(np.max(np.abs(mu - on_level(map_jacobian(P, x, K, FD_CHECK_STEP)[1]))))
     every = list(np.linalg.eigvals(DP))
     for m in mu:  # the others are the trivial ones
         every.pop(int(np.argmin([abs(e - m) for e in every])))
@@ -639,7 +515,7 @@ def _orbit(
     )
 
 
-def _min_tilt(P: _SectionMap, x: FloatArray, period: float) -> float:
+def _min_tilt(P: SectionMap, x: FloatArray, period: float) -> float:
     """Least ``sqrt(gamma1^2 + gamma2^2)`` along one period from ``x`` (sampled)."""
     from rollingtop.integrate.driver import integrate
 

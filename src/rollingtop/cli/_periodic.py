@@ -61,7 +61,9 @@ def periodic(
     """Relative periodic orbits on the level of the scenario's state (its energy and the model's
     other integrals): fixed points of the Poincare section's map after 1 to --returns crossings,
     seeded by the section's trajectories, solved by Newton, with the section map's multipliers
-    on the level and their type (attracting, repelling, saddle, elliptic, neutral)."""
+    on the level and their type (attracting, repelling, saddle, elliptic, neutral); and the
+    relative equilibria (gamma3 constant) of a model without a reduction, with their
+    eigenvalues."""
     from rollingtop.chaos.periodic import periodic_orbits
     from rollingtop.cli._errors import BadInput
     from rollingtop.io import check_output_path
@@ -102,6 +104,12 @@ def periodic(
             f"  {k}: {o.returns} returns, period {o.period:.10g}, {o.type} (|multipliers| {mu}, "
             f"spread {o.multiplier_spread:.1g}), gamma3 = {o.x[0]:.6g}, w_n = {o.x[1]:.6g}, "
             f"closure {o.closure:.1g}{flag}"
+        )
+    for e in found.steady:
+        ev = ", ".join(f"{v.real:.4g}{v.imag:+.4g}i" for v in e.eigenvalues)
+        click.echo(
+            f"  steady: gamma3 = {e.z[0]:.6g}, w_n = {e.z[2]:.6g}, w3 = {e.z[3]:.6g}, "
+            f"{e.type} (eigenvalues {ev})"
         )
     if output is not None:
         click.echo(f"wrote {output}")
