@@ -382,3 +382,37 @@ def test_a_bad_or_unknown_query_key_is_a_message_and_the_scenarios_view_stays(fi
         finally:
             _settled(page)
             page.close()
+
+
+def test_the_url_follows_the_view_and_keeps_no_refused_or_unknown_value(fig5):
+    """Review of issue 37 item 5, with Panel's own Location (no server): the URL's values load
+    the view; an unknown key is reported and leaves the URL; a value refused after the load
+    (from a script) is a message and the URL keeps the last valid view; another model's keys
+    leave the URL; a closed page is unsynced and freed."""
+    import gc
+    import weakref
+
+    from panel.io.location import Location
+
+    from rollingtop.explore.app import ExplorePage
+
+    loc = Location(search="?C2=-1.0&foo=1")
+    page = ExplorePage(fig5, "plain", location=loc)
+    _settled(page)
+    assert page.state.level["C2"] == -1.0
+    assert "unknown parameter 'foo'" in page.message.object
+    assert "foo" not in loc.search and "C2=-1.0" in loc.search
+    page.param.update(C2="abc")
+    assert "C2 = 'abc' is not a number" in page.message.object
+    assert "abc" not in loc.search and "C2=-1.0" in loc.search
+    page.param.update(h=True)  # Panel reads ?h=true as a bool
+    assert "h = True is not a number" in page.message.object and page.state.h == fig5.h
+    page.param.update(model="rough")
+    assert "model=rough" in loc.search and "jellett=" in loc.search and "C2" not in loc.search
+    _settled(page)
+    page.close()
+    assert not loc._synced
+    ref = weakref.ref(page)
+    del page
+    gc.collect()
+    assert ref() is None

@@ -29,6 +29,7 @@ from rollingtop.dynamics.state import initial_state
 
 __all__ = [
     "SectionMap",
+    "grid_axes",
     "reduced_coordinates",
     "reduced_state",
     "check_model",
@@ -184,7 +185,8 @@ def integral_gradients(P: SectionMap, x: FloatArray) -> tuple[FloatArray, FloatA
 
 
 def on_level(P: SectionMap, target: FloatArray, g3: float, w_n: float) -> list[FloatArray]:
-    """The section coordinates ``(g3, w_n, w3, u)`` on the level: 0, 1 or 2 of them.
+    """The section coordinates ``(g3, w_n, w3, u)`` on the level: 0, 1 or 2 of them, in order
+    of ``u`` (the level's sheets).
 
     Written for a level of the energy (quadratic in the velocities) and one integral linear in
     them (``parallel``'s energy and Jellett integral): both are fitted exactly in ``(w3, u)``
@@ -216,4 +218,20 @@ def on_level(P: SectionMap, target: FloatArray, g3: float, w_n: float) -> list[F
     if not (qa > 0 and disc >= 0):
         return []
     roots = {(-qb + sign * math.sqrt(disc)) / (2 * qa) for sign in (-1.0, 1.0)}
-    return [np.array([g3, w_n, *(p + t * d)]) for t in sorted(roots)]
+    states = [np.array([g3, w_n, *(p + t * d)]) for t in roots]
+    # in order of u: the sheets keep their order across the grid (the line's direction d
+    # turns with the sign of the linear integral's coefficients)
+    return sorted(states, key=lambda x: float(x[3]))
+
+
+def grid_axes(iterates: FloatArray, n: int) -> tuple[FloatArray, FloatArray] | None:
+    """The ``gamma3`` and ``w_n`` of an ``n`` x ``n`` grid over the iterates' range (padded by a
+    tenth); ``None`` without iterates."""
+    pts = iterates[np.all(np.isfinite(iterates), axis=-1)]
+    if not len(pts) or n < 1:
+        return None
+    lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
+    pad = 0.1 * (hi - lo) + 1e-3
+    g3s = np.linspace(max(lo[0] - pad[0], -0.999), min(hi[0] + pad[0], 0.999), n)
+    wns = np.linspace(lo[1] - pad[1], hi[1] + pad[1], n)
+    return g3s, wns

@@ -55,6 +55,7 @@ from rollingtop.chaos._section_map import (
     SectionMap,
     check_model,
     free_key,
+    grid_axes,
     integral_gradients,
     map_jacobian,
     on_level,
@@ -63,7 +64,11 @@ from rollingtop.chaos._section_map import (
 )
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.chaos.section import poincare_section
-from rollingtop.chaos.steady import RelativeEquilibrium, relative_equilibria
+from rollingtop.chaos.steady import (
+    RelativeEquilibrium,
+    reduced_relative_equilibria,
+    relative_equilibria,
+)
 from rollingtop.contact import ContactModel, get_model
 
 __all__ = [
@@ -91,8 +96,13 @@ NEWTON_ITERATIONS = 12
 FD_CHECK_STEP = 1e-4
 #: Two fixed points are the same orbit when a crossing of one is this close to one of the other.
 SAME_ORBIT = 1e-6
-#: A multiplier this close to modulus 1 counts as on the unit circle (``neutral`` / ``elliptic``).
+#: A multiplier this close to modulus 1 counts as on the unit circle (``neutral`` / ``elliptic``),
+#: at least...
 UNIT_CIRCLE = 1e-5
+#: ... or this many times the multipliers' spread (:attr:`PeriodicOrbit.multiplier_spread`),
+#: or the trivial multipliers' distance from 1, where larger: the type is not decided inside
+#: the differences' own error.
+SPREAD_MARGIN = 3.0
 #: An orbit whose axis comes within this tilt of the vertical (``sqrt(gamma1^2 + gamma2^2)``,
 #: sampled along the orbit at :data:`VERTICAL_SAMPLES` points) is flagged ``through_vertical``:
 #: there the ``parallel`` model continues by its regularised rule
@@ -173,7 +183,9 @@ class PeriodicOrbit:
             "initial": self.initial_table(model),
             "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
             "trivial_multipliers_off_one": float(np.max(np.abs(self.trivial - 1.0))),
-            "multiplier_spread": self.multiplier_spread,
+            "multiplier_spread": (
+                self.multiplier_spread if math.isfinite(self.multiplier_spread) else None
+            ),
             "type": self.type,
             "through_vertical": self.through_vertical,
             "min_tilt": self.min_tilt,
@@ -191,7 +203,9 @@ class PeriodicOrbits:
     orbits: list[PeriodicOrbit] = field(default_factory=list)
     seeds: int = 0
     #: The relative equilibria on the level (:func:`rollingtop.chaos.steady.relative_equilibria`;
-    #: a model with a reduction has them in closed form, ``rollingtop equilibria``: empty here).
+    #: a model with a reduction: its closed-form steady motions at the level's energy,
+    #: :func:`~rollingtop.chaos.steady.reduced_relative_equilibria`; generically none, since the
+    #: energy of a level taken at random is not a critical value).
     steady: list[RelativeEquilibrium] = field(default_factory=list)
     #: The seeding trajectories' crossings, ``(gamma3, w_n)``, shape (trajectories, settle, 2).
     iterates: FloatArray = field(default_factory=lambda: np.empty((0, 0, 2)))
@@ -262,13 +276,16 @@ class PeriodicOrbits:
         }
 
 
-def _classify(mu: NDArray[np.complex128]) -> str:
+def _classify(mu: NDArray[np.complex128], margin: float = UNIT_CIRCLE) -> str:
+    """The type of multipliers ``mu``, a modulus within ``margin`` of 1 counting as on the unit
+    circle (the differences' error: :data:`UNIT_CIRCLE`, or more where the multipliers' spread
+    or the trivial ones' distance from 1 says so)."""
     r = np.abs(mu)
-    if np.all(np.abs(r - 1.0) <= UNIT_CIRCLE):
-        return "elliptic" if np.any(np.abs(mu.imag) > UNIT_CIRCLE) else "neutral"
-    if np.all(r < 1.0 + UNIT_CIRCLE):
+    if np.all(np.abs(r - 1.0) <= margin):
+        return "elliptic" if np.any(np.abs(mu.imag) > margin) else "neutral"
+    if np.all(r < 1.0 + margin):
         return "attracting"
-    if np.all(r > 1.0 - UNIT_CIRCLE):
+    if np.all(r > 1.0 - margin):
         return "repelling"
     return "saddle"
 
@@ -307,29 +324,17 @@ def _seeds(iterates: FloatArray, returns: int) -> list[tuple[FloatArray, int]]:
     iterates repeat, and the iterate with the least ``gamma3`` among its last ``K``."""
     out = []
     for traj in iterates:
-        traj = traj[np.all(np.isfinite(traj), axis=-1)]
-        if traj.shape[0] < 2 * returns + 1:
-            continue
-        last = traj[-1]
+        bad = np.flatnonzero(~np.all(np.isfinite(traj), axis=-1))
+        traj = traj[: bad[0]] if bad.size else traj  # up to its first undefined crossing
+        last = traj[-1] if len(traj) else None
         for K in range(1, returns + 1):
+            if last is None or traj.shape[0] < 2 * K + 1:
+                break
             if np.max(np.abs(traj[-1 - K] - last)) < SEED_MATCH:
                 cycle = traj[-K:]
                 out.append((cycle[int(np.argmin(cycle[:, 0]))], K))
                 break
     return out
-
-
-def _grid_axes(iterates: FloatArray, n: int) -> tuple[FloatArray, FloatArray] | None:
-    """The ``gamma3`` and ``w_n`` of an ``n`` x ``n`` grid over the iterates' range (padded by a
-    tenth); ``None`` without iterates."""
-    pts = iterates[np.all(np.isfinite(iterates), axis=-1)]
-    if not len(pts) or n < 1:
-        return None
-    lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
-    pad = 0.1 * (hi - lo) + 1e-3
-    g3s = np.linspace(max(lo[0] - pad[0], -0.999), min(hi[0] + pad[0], 0.999), n)
-    wns = np.linspace(lo[1] - pad[1], hi[1] + pad[1], n)
-    return g3s, wns
 
 
 def _grid_seeds(
@@ -341,7 +346,7 @@ def _grid_seeds(
     (a fixed point of ``P^K`` nearby, whatever its stability)."""
     if len(P.names) != 2 or "energy" not in P.names:
         return []
-    axes = _grid_axes(iterates, n)
+    axes = grid_axes(iterates, n)
     if axes is None:
         return []
     g3s, wns = axes
@@ -448,26 +453,46 @@ def periodic_orbits(
     if grid:
         candidates += _grid_seeds(P, target, iterates, returns, grid)
     found.seeds = len(candidates)
-    axes = _grid_axes(iterates, grid)
-    if axes is not None:
+    reduced = reduced_relative_equilibria(P, y0)
+    axes = grid_axes(iterates, grid)
+    if reduced is not None:
+        found.steady = reduced
+    elif axes is not None:
         found.steady = relative_equilibria(P, target, *axes)
     for x0, K in sorted(candidates, key=lambda c: c[1]):
         near = [o for o in found.orbits if K % o.returns == 0]
         if any(np.min(np.max(np.abs(o.points - x0), axis=-1)) < SEED_MATCH for o in near):
             continue  # a seed of an orbit found already
-        solved = _newton(P, x0, K, target)
-        if solved is None:
+        orbit = _solve(P, x0, K, target)
+        if orbit is None or any(_same(o, orbit.points) for o in found.orbits):
             continue
-        x, DP, period = solved
-        pts, _ = P(x[None, :], K)
-        points = np.vstack([x, pts[0, : K - 1]])
-        if K > 1 and np.min(np.max(np.abs(points[1:, :2] - x[:2]), axis=-1)) < SAME_ORBIT:
-            continue  # a shorter orbit, found with its own K
-        if any(_same(o, points) for o in found.orbits):
-            continue
-        found.orbits.append(_orbit(P, x, DP, K, period, points, target))
+        found.orbits.append(orbit)
     found.orbits.sort(key=lambda o: (o.returns, float(o.x[0])))
     return found
+
+
+def _solve(P: SectionMap, x0: FloatArray, K: int, target: FloatArray) -> PeriodicOrbit | None:
+    """The orbit Newton finds from ``x0`` with ``K`` returns, with its least number of returns
+    (a solution that recurs after ``d < K`` crossings is solved again with ``d``); ``None``
+    where Newton fails or the orbit cannot be measured."""
+    solved = _newton(P, x0, K, target)
+    if solved is None:
+        return None
+    x, DP, period = solved
+    try:
+        pts, _ = P(x[None, :], K)
+    except RollingTopError:
+        return None
+    points = np.vstack([x, pts[0, : K - 1]])
+    if K > 1:
+        gaps = np.max(np.abs(points[1:] - x), axis=-1)
+        recur = np.flatnonzero(gaps < SAME_ORBIT)
+        if recur.size:  # a shorter orbit: solved with its own number of returns
+            return _solve(P, x, int(recur[0]) + 1, target)
+    try:
+        return _orbit(P, x, DP, K, period, points, target)
+    except (RollingTopError, np.linalg.LinAlgError):
+        return None
 
 
 def _orbit(
@@ -494,10 +519,15 @@ def _orbit(
     mu = on_level(DP)
     spread = 0.0
     if mu.size:
-        spread = float(np.max(np.abs(mu - on_level(map_jacobian(P, x, K, FD_CHECK_STEP)[1]))))
+        check = map_jacobian(P, x, K, FD_CHECK_STEP)[1]
+        # a difference state that stopped (NaN): the spread is unknown, so is the type's margin
+        good = bool(np.all(np.isfinite(check)))
+        spread = float(np.max(np.abs(mu - on_level(check)))) if good else math.inf
     every = list(np.linalg.eigvals(DP))
     for m in mu:  # the others are the trivial ones
         every.pop(int(np.argmin([abs(e - m) for e in every])))
+    trivial = np.array(every, dtype=np.complex128)
+    off_one = float(np.max(np.abs(trivial - 1.0))) if trivial.size else 0.0
     end, _ = P(x[None, :], K)
     closure = float(np.max(np.abs(end[0, K - 1] - x)))
     return PeriodicOrbit(
@@ -507,8 +537,8 @@ def _orbit(
         state=section_state(P.body, P.model, points[k]),
         points=np.roll(points, -k, axis=0),
         multipliers=mu.astype(np.complex128),
-        trivial=np.array(every, dtype=np.complex128),
-        type=_classify(mu),
+        trivial=trivial,
+        type=_classify(mu, max(UNIT_CIRCLE, SPREAD_MARGIN * spread, off_one)),
         closure=closure,
         min_tilt=_min_tilt(P, x, period),
         multiplier_spread=spread,
@@ -516,11 +546,15 @@ def _orbit(
 
 
 def _min_tilt(P: SectionMap, x: FloatArray, period: float) -> float:
-    """Least ``sqrt(gamma1^2 + gamma2^2)`` along one period from ``x`` (sampled)."""
+    """Least ``sqrt(gamma1^2 + gamma2^2)`` along one period from ``x`` (sampled); 0 (counted
+    as through the vertical) where the integration fails."""
     from rollingtop.integrate.driver import integrate
 
     y0 = section_state(P.body, P.model, x)
     code = P.model.kernel_code(P.body, y0)
     t = np.linspace(0.0, period, VERTICAL_SAMPLES)
-    res = integrate(code, P.body.params, y0, t, rtol=P.rtol, atol=P.rtol * 1e-2)
+    try:
+        res = integrate(code, P.body.params, y0, t, rtol=P.rtol, atol=P.rtol * 1e-2)
+    except RollingTopError:
+        return 0.0
     return float(np.min(np.hypot(res.y[:, 12], res.y[:, 13])))

@@ -229,3 +229,46 @@ def _equilibrium(F: _Field, z: FloatArray) -> RelativeEquilibrium:
         residual=float(np.max(np.abs(F(z)))),
         trivial=float(np.max(np.abs(every[zero]))) if zero.any() else 0.0,
     )
+
+
+#: A steady motion of a reduced model lies on the level when its ``U`` is the level's ``h`` to
+#: this (relative to ``max(1, |h|)``).
+ON_LEVEL_RTOL = 1e-9
+#: The reduction's names of the steady motions' types.
+_TYPES = {"center": "centre", "saddle": "unstable", "degenerate": "degenerate"}
+
+
+def reduced_relative_equilibria(
+    P: SectionMap, state: FloatArray
+) -> list[RelativeEquilibrium] | None:
+    """The relative equilibria on the level of ``state`` of a model with a reduction, from its
+    closed-form steady motions (:func:`rollingtop.reduction.steady_motions`: those whose ``U``
+    is the level's ``h``), with the eigenvalues of the full equations linearised there;
+    ``None`` for a model without one."""
+    from rollingtop.reduction.models import REDUCTIONS, reduction_of
+    from rollingtop.reduction.steady import steady_motions
+
+    body, model = P.body, P.model
+    if model.name not in REDUCTIONS or not body.symmetric:
+        return None
+    reduction = reduction_of(model.name)
+    level = reduction.level_of_state(body, state)
+    h = float(reduction.reduced_energy(body, state))
+    out = []
+    for m in steady_motions(level):
+        if abs(m.U - h) > ON_LEVEL_RTOL * max(1.0, abs(h)) or not abs(m.gamma3) < 1.0:
+            continue
+        z = np.array([m.gamma3, 0.0, m.w_n, m.spin, m.v_tau])
+        every = np.array([complex(re, im) for re, im in m.eigenvalues], dtype=np.complex128)
+        scale = max(float(np.max(np.abs(every))), 1e-300) if every.size else 1.0
+        ev = every[np.abs(every) > ZERO_TOL * scale]  # the integrals' zeros, as above
+        out.append(
+            RelativeEquilibrium(
+                z=z,
+                state=reduced_state(body, model, z),
+                eigenvalues=ev,
+                type=_TYPES.get(m.type, m.type),
+                residual=0.0,
+            )
+        )
+    return out

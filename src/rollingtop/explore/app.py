@@ -18,10 +18,12 @@ a bad value is shown on the page and the previous valid view stays, in the widge
 
 from __future__ import annotations
 
+import contextlib
 import io
 from collections.abc import Callable
 from concurrent.futures import Executor
 from typing import Any
+from urllib.parse import parse_qsl, urlencode
 
 import numpy as np
 import panel as pn
@@ -103,6 +105,8 @@ class ExplorePage(pn.viewable.Viewer):
     executor : concurrent.futures.Executor, optional
         Where the page's work runs: the server's pool, shared by its sessions (default: a pool
         of the page's own, shut down by :meth:`close`).
+    location : panel.io.location.Location, optional
+        The URL kept in step with the view (default: the session's, ``pn.state.location``).
     """
 
     model = _query_value("the contact model's name")
@@ -127,10 +131,11 @@ class ExplorePage(pn.viewable.Viewer):
         look: str = "plain",
         query: dict[str, Any] | None = None,
         executor: Executor | None = None,
+        location: Any = None,
     ) -> None:
         super().__init__()  # type: ignore[no-untyped-call]
         self.doc = pn.state.curdoc
-        self.location = pn.state.location
+        self.location = pn.state.location if location is None else location
         self.muted = False
         self.state = base
         self.look = look
@@ -159,7 +164,9 @@ class ExplorePage(pn.viewable.Viewer):
         self.loading = True  # the URL's view is read: nothing drawn yet
         self.quiet = False  # the page sets its own parameters
         self._set_query(self.state)
-        self.param.watch(self._on_query, list(QUERY_KEYS))
+        # after Panel's own watcher (precedence 0), which writes each change into the URL: a
+        # value this page refuses and sets back is then written over, not left there
+        self.param.watch(self._on_query, list(QUERY_KEYS), precedence=1)
         if query is None and self.location is not None:  # the URL's values arrive (Panel)
             asked = dict(self.location.query_params)
             self._refuse_unknown(asked)
@@ -169,6 +176,7 @@ class ExplorePage(pn.viewable.Viewer):
             self.param.update(**{k: v for k, v in query.items() if k in QUERY_KEYS})
         self.loading = False
         self._set_query(self.state)
+        self._prune_url()
         self._sync_widgets()
         self.layout = self._layout()
         self._refresh(diagram=True)
@@ -201,6 +209,20 @@ class ExplorePage(pn.viewable.Viewer):
             self.location.unsync(self)
         self.synced = keys
         self.location.sync(self, keys, on_error=self._on_url_error)
+
+    def _prune_url(self) -> None:
+        """Drop the URL's keys that no view has (reported when the page loaded): Panel keeps
+        the keys it does not sync."""
+        if self.location is None:
+            return
+        query = dict(parse_qsl(self.location.search.lstrip("?"), keep_blank_values=True))
+        kept = {k: v for k, v in query.items() if k in QUERY_KEYS}
+        if kept != query:
+            self.quiet = True  # the same view: the parameters may take Panel's numbers
+            try:
+                self.location.search = "?" + urlencode(kept) if kept else ""
+            finally:
+                self.quiet = False
 
     def _refuse_unknown(self, query: dict[str, Any]) -> None:
         """A key of the URL that no view has: said by name (:func:`parse_query`'s message)."""
@@ -247,6 +269,11 @@ class ExplorePage(pn.viewable.Viewer):
         self.last_section = None
         self.plots.clear()
         _drop_js_callbacks(self.layout)
+        if self.location is not None and self.synced:  # the URL's watchers hold the page
+            # (Panel may have unsynced it already, as its session went: ValueError then)
+            with contextlib.suppress(ValueError):
+                self.location.unsync(self)
+            self.synced = []
         if self.own_executor:
             self.executor.shutdown(wait=False, cancel_futures=True)
 

@@ -171,7 +171,7 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
     )
 
 
-def parse_query(query: Mapping[str, str | list[str]], base: ExploreState) -> ExploreState:
+def parse_query(query: Mapping[str, Any], base: ExploreState) -> ExploreState:
     """The view a URL asks for, from ``base`` (the page's current view): ``model`` first (its
     level read off the reference state), then the body's and the level's numbers.
 
@@ -181,7 +181,7 @@ def parse_query(query: Mapping[str, str | list[str]], base: ExploreState) -> Exp
         One line naming the parameter: an unknown key, a value that is not a finite number, a
         body the model refuses.
     """
-    flat = {k: (v[-1] if isinstance(v, list) else v) for k, v in query.items()}
+    flat = dict(query)
     state = base
     if "model" in flat and flat["model"] != base.model:
         name = flat["model"]
@@ -198,6 +198,8 @@ def parse_query(query: Mapping[str, str | list[str]], base: ExploreState) -> Exp
                 f"unknown parameter {key!r} for the {state.model} model "
                 f"(allowed: {', '.join(allowed)})"
             )
+        if isinstance(text, bool | list | dict | tuple):  # Panel reads JSON and true/false
+            raise ScenarioError(f"{key} = {short_repr(text)} is not a number")
         try:
             value = float(text)
         except OverflowError:  # an integer beyond double precision (Panel reads digits as int)

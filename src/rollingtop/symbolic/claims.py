@@ -126,7 +126,7 @@ def _time_derivative(expr: Any, field: dict[Any, Any]) -> Any:
 def _manifold(model: str) -> dict[Any, Any]:
     """Rational parametrisation of the constraint manifold: substitutions for gamma, s, v,
     alpha, beta in terms of ``q, k`` (gamma), the free components and ``w``; and for ``w`` in
-    terms of :data:`spin` where the model constrains it (``symbolic_omega``)."""
+    terms of :data:`spin` where the model constrains it (``Symbolic.omega``)."""
     sq = 2 * q / (1 + q**2)
     cphi, sphi = (1 - k**2) / (1 + k**2), 2 * k / (1 + k**2)
     gamma = sp.Matrix([sq * cphi, sq * sphi, (1 - q**2) / (1 + q**2)])

@@ -28,7 +28,7 @@ inverse of ``M``: ``lambda = (J M^-1 J^T)^-1 (-b - J M^-1 F)``, ``b = (dc/dgamma
 
 **Manifold.** :func:`rollingtop.symbolic.claims.check` derives the *body's* equations
 (``derive('shell-rotor')`` is the rotor alone under the meridian rows, not the pair) and
-parametrises the model's manifold by its ``symbolic_velocity`` (the meridian one, free
+parametrises the model's manifold by its ``Symbolic.velocity`` (the meridian one, free
 ``v_tau``; the pair's ``delta`` is not in it). The pair's claims are therefore built here,
 already on the pair's manifold (:func:`on_manifold`: ``gamma`` rational in the ``q, k`` of
 :mod:`.claims`, ``v`` from ``(w, delta)`` by ``c = 0``, ``delta`` free), as ``"identity"``
