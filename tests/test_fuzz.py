@@ -811,7 +811,8 @@ CSV_TABLE = b"omega3,v_tau\n1.0,0.1\n2.0,-0.1\n"
 def scenario_example(command: str) -> bytes:
     """The example a command accepts (its help: the level-set commands read [level]; section
     and chaos take any model, here the parallel one), shortened like :func:`base_document`."""
-    name = {"section": "parallel", "chaos": "parallel", "equilibria": "fig5", "orbits": "fig5",
+    name = {"section": "parallel", "chaos": "parallel", "basins": "parallel",
+            "equilibria": "fig5", "orbits": "fig5",
             "portrait": "fig5", "bifurcation": "fig5", "rotation": "fig5"}  # fmt: skip
     return toml_text(base_document(name.get(command, "paper"))).encode()
 
@@ -833,10 +834,12 @@ SHORT_RUN = {"--t-end": "0.05", "--samples": "5", "--crossings": "3", "--traject
              "--fps": "2", "--speed": "0.05", "--workers": "1", "--processes": "1",
              "--grid": "omega3=1:3:2"}  # fmt: skip
 #: ... and per command (``verify``: sympy on every model takes about a minute; ``periodic``: a
-#: few crossings seed it).
+#: few crossings seed it; ``basins``: a 2 x 2 grid on one Dask worker).
 SHORT_RUN_BY_COMMAND = {"verify": {"--model": "meridian"}, "warmup": {"--model": "meridian"},
                         "periodic": {"--settle": "9", "--returns": "2",
-                                     "--grid-seeds": "3"}}  # fmt: skip
+                                     "--grid-seeds": "3"},
+                        "basins": {"--grid": "2", "--crossings": "3", "--settle": "9",
+                                   "--workers": "1"}}  # fmt: skip
 #: Drawing the key leaves out these short-run options (``--t-end`` overrides ``--periods``;
 #: ``ensemble`` takes exactly one of ``--initial`` and ``--grid``).
 LEFT_OUT_WITH = {"--periods": {"--t-end"}, "--initial": {"--grid"}}

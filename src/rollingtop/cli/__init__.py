@@ -14,6 +14,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._ensemble`: ``ensemble``;
 - :mod:`._chaos`: ``section``, ``chaos`` (Poincare sections, Lyapunov exponent and MEGNO);
 - :mod:`._periodic`: ``periodic`` (relative periodic orbits on a level, their multipliers);
+- :mod:`._basins`: ``basins`` (which attracting orbit each start of a section grid reaches);
 - :mod:`._verify`: ``verify``;
 - :mod:`._warmup`: ``warmup``.
 """
@@ -22,6 +23,7 @@ from __future__ import annotations
 
 from rollingtop.cli._app import cli
 from rollingtop.cli._atlas import atlas
+from rollingtop.cli._basins import basins
 from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._chaos import chaos, section
 from rollingtop.cli._classification import compare_classification
@@ -56,6 +58,7 @@ for _command in (
     section,
     chaos,
     periodic,
+    basins,
     explore,
     verify,
     warmup,
