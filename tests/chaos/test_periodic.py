@@ -236,3 +236,20 @@ def test_a_reduced_models_steady_motion_on_the_level_is_listed():
     np.testing.assert_allclose(steady.eigenvalues.real, 0.0, atol=1e-9)
     tr = simulate(sc.body, "meridian", steady.state, t_end=5.0, rtol=1e-12, samples=51)
     assert np.ptp(tr.y[:, 14]) < 1e-9
+
+
+def test_the_type_is_decided_outside_the_margin():
+    """A modulus within the margin of 1 counts as on the unit circle: the linearisation does not
+    decide there (neutral), unless every multiplier is on it (elliptic for a complex pair)."""
+    from rollingtop.chaos.periodic import _classify
+
+    c = np.array
+    assert _classify(c([0.5, 0.2 + 0j])) == "attracting"
+    assert _classify(c([2.0, 1.5 + 0j])) == "repelling"
+    assert _classify(c([2.0, 0.5 + 0j])) == "saddle"
+    assert _classify(c([np.exp(0.3j), np.exp(-0.3j)])) == "elliptic"
+    assert _classify(c([1.0, 1.0 + 0j])) == "neutral"
+    assert _classify(c([0.989, 0.185 + 0j]), margin=0.09) == "neutral"  # 0.989: undecided
+    assert _classify(c([0.989, 0.185 + 0j]), margin=0.001) == "attracting"
+    assert _classify(c([1.05, 0.5 + 0j]), margin=0.09) == "neutral"
+    assert _classify(c([], dtype=complex)) == "neutral"  # the integrable level's

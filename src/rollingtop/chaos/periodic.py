@@ -279,15 +279,22 @@ class PeriodicOrbits:
 def _classify(mu: NDArray[np.complex128], margin: float = UNIT_CIRCLE) -> str:
     """The type of multipliers ``mu``, a modulus within ``margin`` of 1 counting as on the unit
     circle (the differences' error: :data:`UNIT_CIRCLE`, or more where the multipliers' spread
-    or the trivial ones' distance from 1 says so)."""
+    or the trivial ones' distance from 1 says so): ``attracting`` (all inside the circle),
+    ``repelling`` (all outside), ``saddle`` (some of each), ``elliptic`` (all on it, complex),
+    else ``neutral`` (one on it: the linearisation does not decide)."""
+    if not mu.size:  # no multiplier on the level (an integrable level): nothing moves away
+        return "neutral"
     r = np.abs(mu)
-    if np.all(np.abs(r - 1.0) <= margin):
-        return "elliptic" if np.any(np.abs(mu.imag) > margin) else "neutral"
-    if np.all(r < 1.0 + margin):
+    inside, outside = r < 1.0 - margin, r > 1.0 + margin
+    if np.all(inside):
         return "attracting"
-    if np.all(r > 1.0 - margin):
+    if np.all(outside):
         return "repelling"
-    return "saddle"
+    if np.any(inside) and np.any(outside):
+        return "saddle"
+    if np.all(~inside & ~outside) and np.any(np.abs(mu.imag) > margin):
+        return "elliptic"
+    return "neutral"  # a multiplier on the unit circle within the margin, the rest not beyond
 
 
 def _newton(
