@@ -416,3 +416,19 @@ def test_the_url_follows_the_view_and_keeps_no_refused_or_unknown_value(fig5):
     del page
     gc.collect()
     assert ref() is None
+
+
+def test_the_section_view_marks_the_orbits_in_its_own_plane():
+    """Issue 38, item 6: the companion model's section on the page has the periodic orbits its
+    trajectories settle onto, typed, and drawn in the plane of the section's points (each
+    orbit's crossings lie among them: the same coordinates, not the carried direction's
+    signs)."""
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    view = section_view(state_from_scenario(sc))
+    assert view.orbits and "periodic orbits:" in view.readout
+    for returns, kind, points in view.orbits:
+        assert points.shape == (returns, 2) and kind == "attracting"
+        gaps = np.min(np.max(np.abs(view.points[None, :, :] - points[:, None, :]), axis=-1), 1)
+        # within the approach still left after the page's short runs (about 1e-2); the other
+        # sign convention of w_n would put them ~1 or more away
+        assert np.all(gaps < 0.05), (returns, gaps)

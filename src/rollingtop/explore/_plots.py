@@ -18,6 +18,14 @@ from rollingtop.explore.view import DiagramView, ExploreState, LevelView
 __all__ = ["Plots"]
 
 _CENTRE, _SADDLE, _CURRENT, _PATH = "#1b7837", "#762a83", "#d6604d", "#2166ac"
+#: The periodic orbits marked on a section, by type (rollingtop.plot.periodic's colours).
+_ORBIT_COLOURS = {
+    "attracting": "#2ca02c",
+    "repelling": "#d62728",
+    "saddle": "#ff7f0e",
+    "elliptic": "#1f77b4",
+    "neutral": "#7f7f7f",
+}
 
 
 def _figure(title: str, x_label: str, y_label: str, **kw: Any) -> Any:
@@ -48,10 +56,20 @@ class Plots:
             _source("x", "y"),
         )
         self.steady = _source("x", "y", "U", "colour")
+        self.orbits = _source("x", "y", "colour")
         self.start, self.clicked, self.U = _source("x", "y"), _source("x", "y"), _source("x", "y")
         p = self.portrait = _figure("phase portrait (click: start a trajectory)", "gamma3", "w_tau")
         p.line("x", "y", source=self.back, color="#9ab", line_width=1)
         p.scatter("x", "y", source=self.section, color=_PATH, size=3)
+        p.scatter(
+            "x",
+            "y",
+            source=self.orbits,
+            color="colour",
+            marker="diamond",
+            size=13,
+            line_color="black",
+        )
         p.line(
             "x", "y", source=self.current, color=_CURRENT, line_width=2.5, legend_label="current h"
         )
@@ -130,6 +148,7 @@ class Plots:
             self.back,
             self.current,
             self.section,
+            self.orbits,
             self.start,
             self.clicked,
             self.U,
@@ -164,6 +183,7 @@ class Plots:
         with the current ``h`` (cut a little above it, where U runs off to the walls)."""
         self.show_reduced(True)
         self.section.data = {"x": [], "y": []}
+        self.orbits.data = {"x": [], "y": [], "colour": []}
         self.back.data = {"x": view.background[0], "y": view.background[1]}
         self.current.data = {"x": view.current[0], "y": view.current[1]}
         colours = [_CENTRE if t == "center" else _SADDLE for _, _, t in view.steady]
@@ -201,6 +221,12 @@ class Plots:
     def show_section(self, view: SectionView) -> None:
         """A model without a reduction: its section's points in place of the portrait."""
         self.section.data = {"x": view.points[:, 0], "y": view.points[:, 1]}
+        marks = [(p, _ORBIT_COLOURS.get(t, _SADDLE)) for _, t, pts in view.orbits for p in pts]
+        self.orbits.data = {
+            "x": [float(p[0]) for p, _ in marks],
+            "y": [float(p[1]) for p, _ in marks],
+            "colour": [c for _, c in marks],
+        }
         for src in (self.back, self.current, self.clicked):
             src.data = {"x": [], "y": []}
         self.steady.data = {"x": [], "y": [], "U": [], "colour": []}
