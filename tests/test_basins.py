@@ -89,3 +89,17 @@ def test_bad_input_is_one_line(capsys, tmp_path):
     code, out, err = run_cli(capsys, "basins", str(EXAMPLES / "fig5.toml"), "-o",
                              str(tmp_path / "b.png"))  # fmt: skip
     assert code == 2 and "one more integral" in err and not (tmp_path / "b.png").exists()
+
+
+def test_the_library_refuses_what_the_command_line_cannot_send():
+    """basin_map's own checks (click's ranges keep these from the command line): a float or
+    bool sheet, a worker count beyond four per core; each before any orbit search."""
+    import os
+
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    y = sc.require_state()
+    for sheet in (1.0, np.float64(0.0), True):
+        with pytest.raises(ScenarioError, match="sheet"):
+            basin_map(sc.body, sc.model, y, sheet=sheet)
+    with pytest.raises(ScenarioError, match="per core"):
+        basin_map(sc.body, sc.model, y, workers=4 * (os.cpu_count() or 1) + 1)

@@ -18,6 +18,7 @@ scheduler's address to go wide); each chunk runs the compiled section in paralle
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -46,6 +47,8 @@ ATTRACTED = 1e-3
 LABELS = {-1: "none", -2: "stopped", -3: "not on the level"}
 #: Starts per Dask task.
 CHUNK = 32
+#: Worker processes of the local cluster per core, at most (as the atlas's).
+MAX_WORKERS_PER_CORE = 4
 
 
 def _settle(
@@ -64,6 +67,7 @@ def _settle(
         rtol=rtol,
         atol=rtol * 1e-2,
         max_gap_steps=20_000,
+        threads=1,  # one Dask worker process per core: its own threads would oversubscribe
     )
     found = ds["n_crossings"].values
     last = ds["crossing_state"].values[:, -1]
@@ -103,8 +107,8 @@ def basin_map(
     crossings : int
         Crossings each start runs before it is labelled.
     sheet : int
-        Which state of the level at a grid point: 0 (the lower root along the level's line in
-        ``(w3, u)``) or 1.
+        Which state of the level at a grid point, in order of the free velocity component ``u``
+        (:func:`rollingtop.chaos._section_map.on_level`): 0 or 1.
     rtol : float
         Tolerance of the integrations.
     client, workers, scheduler :
@@ -132,7 +136,13 @@ def basin_map(
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
         raise ScenarioError(f"workers = {short_repr(workers)} must be an integer >= 1")
-    if sheet not in (0, 1) or isinstance(sheet, bool):
+    cores = os.cpu_count() or 1
+    if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
+        raise ScenarioError(
+            f"workers = {workers} is more than {MAX_WORKERS_PER_CORE} per core ({cores} cores) "
+            "for the local cluster; use a scheduler to go wide"
+        )
+    if isinstance(sheet, bool) or not isinstance(sheet, int) or sheet not in (0, 1):
         raise ScenarioError(f"sheet = {short_repr(sheet)} must be 0 or 1")
     y0 = np.asarray(state, dtype=float)
     names = held_integrals(body, model, None)
@@ -171,12 +181,22 @@ def basin_map(
             from distributed import as_completed
 
             done = 0
-            for fut in as_completed(futures):
-                k = futures[fut]
-                results[k] = fut.result()
-                done += len(chunks[k])
-                if progress is not None:
-                    progress(done, len(Xa))
+            try:
+                for fut in as_completed(futures):
+                    k = futures[fut]
+                    try:
+                        results[k] = fut.result()
+                    except Exception as exc:  # a lost worker, an error on a worker
+                        why = str(exc).splitlines()[0] if str(exc) else ""
+                        raise ScenarioError(
+                            f"a Dask task failed ({type(exc).__name__}: {why})"
+                        ) from None
+                    done += len(chunks[k])
+                    if progress is not None:
+                        progress(done, len(Xa))
+            except BaseException:
+                c.cancel(list(futures))  # nothing left queued on a cluster that stays
+                raise
         ends = np.concatenate([results[k][0] for k in range(len(chunks))])
         counts = np.concatenate([results[k][1] for k in range(len(chunks))])
         for (i, j), end, n in zip(cells, ends, counts, strict=True):

@@ -88,6 +88,9 @@ SEED_MATCH = 1e-3
 NEWTON_TOL = 1e-10
 #: See :data:`NEWTON_TOL`.
 ACCEPT_TOL = 1e-8
+#: A solution whose period is not above this is a start counted as its own crossing (seen with
+#: the vertical rule's disk made 100 times smaller), not an orbit.
+MIN_PERIOD = 1e-6
 #: Newton's iterations at most.
 NEWTON_ITERATIONS = 12
 #: The multipliers are computed again with this step; their difference is reported
@@ -486,6 +489,8 @@ def _solve(P: SectionMap, x0: FloatArray, K: int, target: FloatArray) -> Periodi
     if solved is None:
         return None
     x, DP, period = solved
+    if not (math.isfinite(period) and period > MIN_PERIOD):  # a crossing at the start itself
+        return None
     try:
         pts, _ = P(x[None, :], K)
     except RollingTopError:

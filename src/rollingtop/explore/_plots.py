@@ -148,7 +148,6 @@ class Plots:
             self.back,
             self.current,
             self.section,
-            self.orbits,
             self.start,
             self.clicked,
             self.U,
@@ -161,6 +160,7 @@ class Plots:
         ):
             src.data = {"x": [], "y": []}
         self.steady.data = {"x": [], "y": [], "U": [], "colour": []}
+        self.orbits.data = {"x": [], "y": [], "colour": []}
         self.frame.object = None
 
     def move_mark(self, x: float, h: float) -> None:
