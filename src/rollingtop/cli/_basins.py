@@ -4,8 +4,6 @@ reaches (:func:`rollingtop.basins.basin_map`), on Dask."""
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
-from pathlib import Path
 
 import click
 
@@ -87,7 +85,7 @@ def basins(
     import numpy as np
 
     from rollingtop.basins import LABELS, basin_map
-    from rollingtop.io import check_output_path, netcdf_bytes, write_together
+    from rollingtop.io import check_output_path
     from rollingtop.plot import FIGURE_SUFFIXES
     from rollingtop.scenario import load_scenario
 
@@ -111,19 +109,7 @@ def basins(
         )
     from rollingtop.plot.basins import basins_figure
 
-    fig = basins_figure(ds)
-    fmt = output.rsplit(".", 1)[-1].lower()
-    writes: list[tuple[str, Callable[[Path], None]]] = [
-        (output, lambda tmp: fig.savefig(tmp, format=fmt, dpi=200))
-    ]
-    if netcdf is not None:
-        data = netcdf_bytes(ds)
-
-        def write_data(tmp: Path) -> None:
-            tmp.write_bytes(data)
-
-        writes.append((netcdf, write_data))
-    write_together(writes)
+    _output.write_figure_and_data(basins_figure(ds), output, ds, netcdf)  # both or neither
     label = ds["label"].values
     attractors = json.loads(ds.attrs["attractors"])
     counts = {str(k): int(np.sum(label == k)) for k in range(len(attractors))}

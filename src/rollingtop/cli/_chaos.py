@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import click
@@ -131,7 +129,7 @@ def section(
     other integrals of its model)."""
     from rollingtop.chaos import poincare_section, section_summary
     from rollingtop.chaos.section import MAX_GAP_STEPS
-    from rollingtop.io import check_output_path, netcdf_bytes, write_together
+    from rollingtop.io import check_output_path
     from rollingtop.plot import FIGURE_SUFFIXES
     from rollingtop.scenario import load_scenario
 
@@ -157,19 +155,8 @@ def section(
         )
     from rollingtop.plot.section import section_figure
 
-    fig = section_figure(ds)
-    fmt = output.rsplit(".", 1)[-1].lower()
-    writes: list[tuple[str, Callable[[Path], None]]] = [
-        (output, lambda tmp: fig.savefig(tmp, format=fmt, dpi=200))
-    ]
-    if netcdf is not None:
-        data = netcdf_bytes(ds)
-
-        def write_data(tmp: Path) -> None:
-            tmp.write_bytes(data)
-
-        writes.append((netcdf, write_data))
-    write_together(writes)  # the figure and the crossings, both or neither
+    # the figure and the crossings, both or neither
+    _output.write_figure_and_data(section_figure(ds), output, ds, netcdf)
     summary = section_summary(ds)
     if summary["contact_lost"]:
         click.echo(

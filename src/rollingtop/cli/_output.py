@@ -20,6 +20,8 @@ from rollingtop._errors import ContactLostWarning
 from rollingtop.cli._errors import one_line
 
 if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
     from rich.console import Console
     from rich.progress import Progress
 
@@ -165,3 +167,27 @@ def console(piped_width: int = PIPED_WIDTH) -> Console:
 
     stdout = Console()
     return stdout if stdout.is_terminal else Console(width=piped_width)
+
+
+def write_figure_and_data(
+    fig: Figure, output: str, ds: xr.Dataset | None = None, netcdf: str | None = None
+) -> None:
+    """Write ``fig`` to ``output`` (its format by suffix, 200 dpi) and, with ``netcdf``, ``ds``
+    as NetCDF: both or neither (:func:`rollingtop.io.write_together`; the commands that draw a
+    computed Dataset, ``section`` and ``basins``, and ``periodic``'s figure)."""
+    from pathlib import Path
+
+    from rollingtop.io import netcdf_bytes, write_together
+
+    fmt = output.rsplit(".", 1)[-1].lower()
+    writes: list[tuple[str, Callable[[Path], None]]] = [
+        (output, lambda tmp: fig.savefig(tmp, format=fmt, dpi=200))
+    ]
+    if netcdf is not None and ds is not None:
+        data = netcdf_bytes(ds)
+
+        def write_data(tmp: Path) -> None:
+            tmp.write_bytes(data)
+
+        writes.append((netcdf, write_data))
+    write_together(writes)

@@ -7,6 +7,7 @@ import json
 
 import click
 
+from rollingtop.cli import _output
 from rollingtop.cli._options import json_option, scenario_argument
 
 __all__ = ["periodic"]
@@ -86,12 +87,9 @@ def periodic(
         grid=grid_seeds,
     )
     if output is not None:
-        from rollingtop.io import write_together
         from rollingtop.plot.periodic import periodic_figure
 
-        fig = periodic_figure(found)
-        fmt = output.rsplit(".", 1)[-1].lower()
-        write_together([(output, lambda tmp: fig.savefig(tmp, format=fmt, dpi=200))])
+        _output.write_figure_and_data(periodic_figure(found), output)
     if as_json:
         click.echo(json.dumps(found.to_dict()))
         return
