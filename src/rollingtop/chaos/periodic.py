@@ -502,7 +502,8 @@ def _solve(P: SectionMap, x0: FloatArray, K: int, target: FloatArray) -> Periodi
         if recur.size:  # a shorter orbit: solved with its own number of returns
             return _solve(P, x, int(recur[0]) + 1, target)
     try:
-        return _orbit(P, x, DP, K, period, points, target)
+        closure = float(np.max(np.abs(pts[0, K - 1] - x)))  # P^K(x) - x, from the same run
+        return _orbit(P, x, DP, K, period, points, closure)
     except (RollingTopError, np.linalg.LinAlgError):
         return None
 
@@ -514,7 +515,7 @@ def _orbit(
     K: int,
     period: float,
     points: FloatArray,
-    target: FloatArray,
+    closure: float,
 ) -> PeriodicOrbit:
     k = int(np.argmin(points[:, 0]))
     _, G = integral_gradients(P, x)
@@ -540,8 +541,6 @@ def _orbit(
         every.pop(int(np.argmin([abs(e - m) for e in every])))
     trivial = np.array(every, dtype=np.complex128)
     off_one = float(np.max(np.abs(trivial - 1.0))) if trivial.size else 0.0
-    end, _ = P(x[None, :], K)
-    closure = float(np.max(np.abs(end[0, K - 1] - x)))
     return PeriodicOrbit(
         returns=K,
         period=period,
