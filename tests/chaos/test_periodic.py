@@ -41,6 +41,11 @@ PERIOD_RTOL = 1e-9
 #: Trivial multipliers' distance from 1 (central differences at step 1e-5 of a flow at
 #: rtol 1e-11).
 TRIVIAL_TOL = 1e-4
+#: The variational multipliers (rtol 1e-11) against central differences of the flow at rtol
+#: 1e-13, Richardson-extrapolated over the steps 2e-6 and 4e-6 (the issue's bound).
+MULTIPLIER_TOL = 1e-6
+#: Trivial multipliers' distance from 1 where they come from the variational equations.
+VARIATIONAL_TRIVIAL_TOL = 1e-7
 #: The steady motion's eigenvalues against those of the reference equations (both central
 #: differences of a difference).
 EIGENVALUE_TOL = 1e-5
@@ -98,6 +103,53 @@ def test_an_orbit_closes_under_scipy_on_the_reference_equations(parallel):
                         orbit.state, method="DOP853", rtol=1e-12, atol=1e-12)  # fmt: skip
         end = section_coordinates("parallel", sol.y[:, -1])
         np.testing.assert_allclose(end, orbit.x, atol=SCIPY_CLOSURE_TOL)
+
+
+def test_the_multipliers_come_from_the_variational_equations(parallel):
+    """Issue 38, item 2: the orbits away from the vertical have their multipliers from the
+    variational equations, equal to central differences of the section map (at a tighter
+    tolerance, the steps' h^2 error extrapolated away) to 1e-6, with trivial multipliers 1 to
+    1e-7; those through the vertical, where the flow has no derivative, say theirs come from
+    differences."""
+    from rollingtop.chaos._section_map import integral_gradients, map_jacobian
+
+    sc, found = parallel
+    names = held_integrals(sc.body, sc.model, None)
+    P = SectionMap(sc.body, sc.model, names, 1e-13)
+    for o in found:
+        if o.through_vertical:
+            assert o.multipliers_from == "differences"
+            continue
+        assert o.multipliers_from == "variational"
+        assert np.max(np.abs(o.trivial - 1.0)) < VARIATIONAL_TRIVIAL_TOL
+        h = 2e-6
+        D = (
+            4 * map_jacobian(P, o.x, o.returns, h)[1] - map_jacobian(P, o.x, o.returns, 2 * h)[1]
+        ) / 3
+        _, G = integral_gradients(P, o.x)
+        T = np.linalg.svd(G)[2][2:].T  # the level's tangent plane
+        want = np.linalg.eigvals(T.T @ D @ T)
+        assert len(want) == len(o.multipliers) == 2
+        for mu in o.multipliers:
+            assert np.min(np.abs(want - mu)) < MULTIPLIER_TOL
+        assert o.to_dict(sc.model)["multipliers_from"] == "variational"
+
+
+def test_the_variational_jacobian_is_the_maps_derivative_off_an_orbit():
+    """At a point of the section that is on no orbit, K = 2: the whole
+    4 x 4 derivative of P^2, section correction included, against central differences."""
+    from rollingtop.chaos._section_map import map_jacobian
+    from rollingtop.chaos._variational import variational_jacobian
+
+    sc = load_scenario(EXAMPLES / "parallel.toml")
+    names = held_integrals(sc.body, sc.model, None)
+    P = SectionMap(sc.body, sc.model, names, 1e-13)
+    x = np.array([0.45, -0.9, 2.0, 0.2])
+    _, t = P(x[None], 2)
+    J = variational_jacobian(P, x, float(t[0, 1]), stop_at_vertical=True)
+    h = 2e-6
+    D = (4 * map_jacobian(P, x, 2, h)[1] - map_jacobian(P, x, 2, 2 * h)[1]) / 3
+    np.testing.assert_allclose(J, D, atol=MULTIPLIER_TOL * max(1.0, np.max(np.abs(D))))
 
 
 def test_the_multipliers_give_the_rate_of_approach(parallel):

@@ -210,9 +210,11 @@ def _run_chunks(
     states: FloatArray,
     stats: FloatArray,
     stop: float,
-) -> None:
+) -> tuple[FloatArray, FloatArray]:
     """The compiled ``run_indicators`` of kernel ``code``, in calls of at most
-    :data:`CHUNK_STEPS` accepted steps (the same steps as one call)."""
+    :data:`CHUNK_STEPS` accepted steps (the same steps as one call); returns the final augmented
+    state ``z`` (shape ``(N_AUG,)``: the state, the unit tangent vector, ...) and ``ctrl``
+    (its ``LOG_SUM``: the tangent vector's growth, ``ln |delta(t)| - ln |delta(0)|``)."""
     kernels = for_code(code).tangent
     z, fz = np.zeros(N_AUG), np.zeros(N_AUG)
     ctrl = np.array([0.0, 0.0, rtol, atol, 0.0])
@@ -238,7 +240,7 @@ def _run_chunks(
             stop,
         )
         if stats[0] != BUDGET_EXHAUSTED or counts[STEPS] >= max_steps:
-            return
+            return z, ctrl
 
 
 def _compile_indicators(

@@ -20,11 +20,14 @@ sense (Gauss-Newton), the Jacobian of ``P^K`` by central differences of the comp
 difference state of an iteration integrated in one parallel batch). On the level the map has two
 *trivial* multipliers, 1 along the integrals' gradients ``G`` (``G DP = G``: ``I(P(x)) = I(x)``),
 and its *multipliers* are those of ``DP`` restricted to the level's tangent plane: with ``T`` an
-orthonormal basis of ``ker G``, the eigenvalues of ``T^T DP T`` (the tangent plane is invariant
-under ``DP``). The trivial multipliers are reported with their distance from 1, a quality figure
-of the differences. The multipliers come from the differences of the flow, not from its
-variational equations (:mod:`rollingtop._compiled._tangent` integrates those for the Lyapunov
-exponents; the section map's are future work, issue 38, item 2).
+orthonormal basis of ``ker G`` and ``Q`` one of ``G``'s rows, ``DP`` is block triangular, the
+multipliers are the eigenvalues of ``T^T DP T`` and the trivial ones those of ``Q^T DP Q``,
+reported with their distance from 1 (and the block ``Q^T DP T``'s size, 0 in exact arithmetic):
+the multipliers' quality figure. ``DP`` for the multipliers comes from the variational equations
+(:mod:`rollingtop.chaos._variational`), checked against Newton's last differences
+(``multiplier_spread``); for an orbit whose period passes through the vertical, where the flow
+has no derivative (the ``parallel`` model continues by a regularised rule), from the
+differences at two steps, flagged ``multipliers_from = "differences"``.
 
 **Seeds** are the section's own iterates: trajectories sampled on the level
 (:func:`rollingtop.chaos.level_states`) run ``settle`` crossings; where the last iterates of one
@@ -45,7 +48,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rollingtop._errors import RollingTopError, ScenarioError
+from rollingtop._errors import IntegrationError, RollingTopError, ScenarioError
 from rollingtop._figures import draw
 from rollingtop._html import Num, block, count, row_table, table
 from rollingtop._types import FloatArray
@@ -62,6 +65,7 @@ from rollingtop.chaos._section_map import (
     section_coordinates,
     section_state,
 )
+from rollingtop.chaos._variational import variational_jacobian
 from rollingtop.chaos.level import held_integrals, level_states, level_values
 from rollingtop.chaos.section import poincare_section
 from rollingtop.chaos.steady import (
@@ -145,8 +149,15 @@ class PeriodicOrbit:
     min_tilt : float
         Least ``sqrt(gamma1^2 + gamma2^2)`` along the orbit (sampled).
     multiplier_spread : float
-        Largest change of a multiplier between the difference steps :data:`FD_STEP` and
-        :data:`FD_CHECK_STEP`: the error of the differences (large near the vertical).
+        Largest difference between the multipliers and a second estimate: the central
+        differences of the flow (step :data:`FD_STEP`) for variational multipliers, the
+        differences at step :data:`FD_CHECK_STEP` for multipliers from differences (large near
+        the vertical).
+    multipliers_from : str
+        ``variational`` (the variational equations over one period,
+        :mod:`rollingtop.chaos._variational`) or ``differences`` (central differences of the
+        section map at step :data:`FD_STEP`: the period passes through the vertical, where the
+        flow has no derivative; they depend on the model's rule there).
     """
 
     returns: int
@@ -160,6 +171,7 @@ class PeriodicOrbit:
     closure: float
     min_tilt: float
     multiplier_spread: float = 0.0
+    multipliers_from: str = "variational"
 
     @property
     def through_vertical(self) -> bool:
@@ -189,6 +201,7 @@ class PeriodicOrbit:
             "multiplier_spread": (
                 self.multiplier_spread if math.isfinite(self.multiplier_spread) else None
             ),
+            "multipliers_from": self.multipliers_from,
             "type": self.type,
             "through_vertical": self.through_vertical,
             "min_tilt": self.min_tilt,
@@ -517,30 +530,48 @@ def _orbit(
     points: FloatArray,
     closure: float,
 ) -> PeriodicOrbit:
+    """The orbit through ``x``, its multipliers from the variational equations
+    (:func:`~rollingtop.chaos._variational.variational_jacobian`), checked against ``DP``, the
+    central differences Newton ended with; from the differences (at two steps) where one period
+    passes through the vertical, where the flow has no derivative."""
     k = int(np.argmin(points[:, 0]))
     _, G = integral_gradients(P, x)
     _, sv, vt = np.linalg.svd(G)
     rank = int(np.sum(sv > RANK_TOL * sv[0]))
-    # orthonormal basis of the level's tangent plane on the section: empty where the level meets
-    # the section in isolated points (an integrable level: every multiplier is trivial)
-    T = vt[rank:].T
+    # orthonormal bases of the level's tangent plane on the section (T: empty where the level
+    # meets the section in isolated points, an integrable level: every multiplier is trivial)
+    # and of the integrals' gradients (Q): G DP = G makes DP block triangular in (T, Q), the
+    # multipliers on the level are T^T DP T's eigenvalues, the trivial ones Q^T DP Q's
+    T, Q = vt[rank:].T, vt[:rank].T
 
     def on_level(D: FloatArray) -> NDArray[np.complex128]:
         mu = np.linalg.eigvals(T.T @ D @ T).astype(np.complex128)
         return mu[np.lexsort((mu.imag, -np.abs(mu)))]
 
-    mu = on_level(DP)
+    try:
+        D = variational_jacobian(P, x, period, stop_at_vertical=True)
+        source = "variational"
+    except IntegrationError:  # through the vertical: the map's difference quotients
+        D, source = DP, "differences"
+    mu = on_level(D)
+    trivial = np.linalg.eigvals(Q.T @ D @ Q).astype(np.complex128)
+    # the trivial multipliers' distance from 1 and the leak of the level's tangent plane into
+    # the gradients' directions (0 in exact arithmetic): the multipliers' own quality figure
+    off_one = float(np.max(np.abs(trivial - 1.0))) if trivial.size else 0.0
+    off_one = max(off_one, float(np.max(np.abs(Q.T @ D @ T), initial=0.0)))
     spread = 0.0
     if mu.size:
-        check = map_jacobian(P, x, K, FD_CHECK_STEP)[1]
-        # a difference state that stopped (NaN): the spread is unknown, so is the type's margin
+        # the other estimate: the differences Newton ended with (variational multipliers), or
+        # the differences at a second step (multipliers from the differences)
+        check = DP if source == "variational" else map_jacobian(P, x, K, FD_CHECK_STEP)[1]
+        # a difference state that stopped (NaN): the spread is unknown
         good = bool(np.all(np.isfinite(check)))
         spread = float(np.max(np.abs(mu - on_level(check)))) if good else math.inf
-    every = list(np.linalg.eigvals(DP))
-    for m in mu:  # the others are the trivial ones
-        every.pop(int(np.argmin([abs(e - m) for e in every])))
-    trivial = np.array(every, dtype=np.complex128)
-    off_one = float(np.max(np.abs(trivial - 1.0))) if trivial.size else 0.0
+    # the type is decided outside the multipliers' error: the trivial ones' distance from 1,
+    # and, for multipliers from differences, their change with the step
+    margin = max(UNIT_CIRCLE, SPREAD_MARGIN * off_one)
+    if source == "differences":
+        margin = max(margin, SPREAD_MARGIN * spread)
     return PeriodicOrbit(
         returns=K,
         period=period,
@@ -549,10 +580,11 @@ def _orbit(
         points=np.roll(points, -k, axis=0),
         multipliers=mu.astype(np.complex128),
         trivial=trivial,
-        type=_classify(mu, max(UNIT_CIRCLE, SPREAD_MARGIN * spread, off_one)),
+        type=_classify(mu, margin),
         closure=closure,
         min_tilt=_min_tilt(P, x, period),
         multiplier_spread=spread,
+        multipliers_from=source,
     )
 
 

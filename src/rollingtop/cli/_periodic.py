@@ -100,7 +100,7 @@ def periodic(
         flag = " (through the vertical: depends on the model's rule there)" * o.through_vertical
         click.echo(
             f"  {k}: {o.returns} returns, period {o.period:.10g}, {o.type} (|multipliers| {mu}, "
-            f"spread {o.multiplier_spread:.1g}), gamma3 = {o.x[0]:.6g}, w_n = {o.x[1]:.6g}, "
+            f"{o.multipliers_from}, spread {o.multiplier_spread:.1g}), gamma3 = {o.x[0]:.6g}, w_n = {o.x[1]:.6g}, "
             f"closure {o.closure:.1g}{flag}"
         )
     for e in found.steady:
