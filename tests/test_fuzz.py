@@ -802,6 +802,7 @@ TEXT_VALID = {
     "grid": ["omega3=1:3:2", "omega3=1:3:2,v_tau=0:0.5:2"],
     "hold": ["energy", "energy,jellett"],
     "h_levels": ["4.0,4.5", "4.2"],
+    "span": ["0.05,5"],
 }
 #: Input files of path options, by name (other path options are outputs).
 INPUT_FILES = {"initial": "ic.csv"}
@@ -812,6 +813,7 @@ def scenario_example(command: str) -> bytes:
     """The example a command accepts (its help: the level-set commands read [level]; section
     and chaos take any model, here the parallel one), shortened like :func:`base_document`."""
     name = {"section": "parallel", "chaos": "parallel", "basins": "parallel",
+            "continue": "parallel",
             "equilibria": "fig5", "orbits": "fig5",
             "portrait": "fig5", "bifurcation": "fig5", "rotation": "fig5"}  # fmt: skip
     return toml_text(base_document(name.get(command, "paper"))).encode()
@@ -838,6 +840,8 @@ SHORT_RUN = {"--t-end": "0.05", "--samples": "5", "--crossings": "3", "--traject
 SHORT_RUN_BY_COMMAND = {"verify": {"--model": "meridian"}, "warmup": {"--model": "meridian"},
                         "periodic": {"--settle": "9", "--returns": "2",
                                      "--grid-seeds": "3"},
+                        "continue": {"--settle": "9", "--returns": "2", "--grid-seeds": "3",
+                                     "--points": "3", "--orbit": "1"},
                         "basins": {"--grid": "2", "--crossings": "3", "--settle": "9",
                                    "--workers": "1"}}  # fmt: skip
 #: Drawing the key leaves out these short-run options (``--t-end`` overrides ``--periods``;

@@ -29,6 +29,7 @@ DRAWERS: dict[str, str] = {
     "drift": "rollingtop.plot.paths:draw_drift",
     "reactions": "rollingtop.plot.paths:draw_reactions",
     "periodic": "rollingtop.plot.periodic:draw_periodic",
+    "branch": "rollingtop.plot.continuation:draw_branch",
 }
 
 #: The kinds :meth:`rollingtop.Trajectory.plot` draws (the panels of ``rollingtop plot``).

@@ -293,7 +293,7 @@ def test_a_reduced_models_steady_motion_on_the_level_is_listed():
 def test_the_type_is_decided_outside_the_margin():
     """A modulus within the margin of 1 counts as on the unit circle: the linearisation does not
     decide there (neutral), unless every multiplier is on it (elliptic for a complex pair)."""
-    from rollingtop.chaos.periodic import _classify
+    from rollingtop.chaos._multipliers import classify as _classify
 
     c = np.array
     assert _classify(c([0.5, 0.2 + 0j])) == "attracting"

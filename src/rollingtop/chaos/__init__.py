@@ -11,11 +11,14 @@ to :mod:`rollingtop.contact` is served without code here:
 - :func:`indicator_map`: the indicators over many initial states, in parallel or on Dask
   (:mod:`.maps`);
 - :func:`periodic_orbits`: the relative periodic orbits on a level, fixed points of the
-  section's map with their multipliers (:mod:`.periodic`).
+  section's map with their multipliers (:mod:`.periodic`);
+- :func:`continue_orbit`: such an orbit followed in a body parameter or the energy, its
+  bifurcations located (:mod:`.continuation`).
 """
 
 from __future__ import annotations
 
+from rollingtop.chaos.continuation import Branch, continue_orbit
 from rollingtop.chaos.level import level_states
 from rollingtop.chaos.lyapunov import ChaosIndicators, chaos_indicators
 from rollingtop.chaos.maps import indicator_map
@@ -23,10 +26,12 @@ from rollingtop.chaos.periodic import PeriodicOrbit, PeriodicOrbits, periodic_or
 from rollingtop.chaos.section import poincare_section, section_summary
 
 __all__ = [
+    "Branch",
     "ChaosIndicators",
     "PeriodicOrbit",
     "PeriodicOrbits",
     "chaos_indicators",
+    "continue_orbit",
     "indicator_map",
     "level_states",
     "periodic_orbits",

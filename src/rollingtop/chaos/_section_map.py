@@ -45,10 +45,6 @@ __all__ = [
 START_CROSSING = 1e-9
 #: Relative step of the central differences of the section map.
 FD_STEP = 1e-5
-#: Relative step of the central differences of the section map.
-FD_STEP = 1e-5
-#: Singular values of the integrals' gradients below this fraction of the largest count as 0.
-RANK_TOL = 1e-8
 
 
 def free_key(model: ContactModel) -> str:

@@ -53,8 +53,8 @@ from rollingtop._figures import draw
 from rollingtop._html import Num, block, count, row_table, table
 from rollingtop._types import FloatArray
 from rollingtop.body import SphericalTop
+from rollingtop.chaos._multipliers import UNIT_CIRCLE, classify, level_bases
 from rollingtop.chaos._section_map import (
-    RANK_TOL,
     SectionMap,
     check_model,
     free_key,
@@ -103,10 +103,8 @@ NEWTON_ITERATIONS = 12
 FD_CHECK_STEP = 1e-4
 #: Two fixed points are the same orbit when a crossing of one is this close to one of the other.
 SAME_ORBIT = 1e-6
-#: A multiplier this close to modulus 1 counts as on the unit circle (``neutral`` / ``elliptic``),
-#: at least...
-UNIT_CIRCLE = 1e-5
-#: ... or this many times the multipliers' spread (:attr:`PeriodicOrbit.multiplier_spread`),
+#: The margin of the type (:data:`rollingtop.chaos._multipliers.UNIT_CIRCLE`), or this many
+#: times the multipliers' spread (:attr:`PeriodicOrbit.multiplier_spread`),
 #: or the trivial multipliers' distance from 1, where larger: the type is not decided inside
 #: the differences' own error.
 SPREAD_MARGIN = 3.0
@@ -290,27 +288,6 @@ class PeriodicOrbits:
             "steady": [e.to_dict(free_key(get_model(self.model))) for e in self.steady],
             "seeds": self.seeds,
         }
-
-
-def _classify(mu: NDArray[np.complex128], margin: float = UNIT_CIRCLE) -> str:
-    """The type of multipliers ``mu``, a modulus within ``margin`` of 1 counting as on the unit
-    circle (the differences' error: :data:`UNIT_CIRCLE`, or more where the multipliers' spread
-    or the trivial ones' distance from 1 says so): ``attracting`` (all inside the circle),
-    ``repelling`` (all outside), ``saddle`` (some of each), ``elliptic`` (all on it, complex),
-    else ``neutral`` (one on it: the linearisation does not decide)."""
-    if not mu.size:  # no multiplier on the level (an integrable level): nothing moves away
-        return "neutral"
-    r = np.abs(mu)
-    inside, outside = r < 1.0 - margin, r > 1.0 + margin
-    if np.all(inside):
-        return "attracting"
-    if np.all(outside):
-        return "repelling"
-    if np.any(inside) and np.any(outside):
-        return "saddle"
-    if np.all(~inside & ~outside) and np.any(np.abs(mu.imag) > margin):
-        return "elliptic"
-    return "neutral"  # a multiplier on the unit circle within the margin, the rest not beyond
 
 
 def _newton(
@@ -535,14 +512,9 @@ def _orbit(
     central differences Newton ended with; from the differences (at two steps) where one period
     passes through the vertical, where the flow has no derivative."""
     k = int(np.argmin(points[:, 0]))
-    _, G = integral_gradients(P, x)
-    _, sv, vt = np.linalg.svd(G)
-    rank = int(np.sum(sv > RANK_TOL * sv[0]))
-    # orthonormal bases of the level's tangent plane on the section (T: empty where the level
-    # meets the section in isolated points, an integrable level: every multiplier is trivial)
-    # and of the integrals' gradients (Q): G DP = G makes DP block triangular in (T, Q), the
-    # multipliers on the level are T^T DP T's eigenvalues, the trivial ones Q^T DP Q's
-    T, Q = vt[rank:].T, vt[:rank].T
+    # G DP = G makes DP block triangular in (T, Q): the multipliers on the level are T^T DP T's
+    # eigenvalues, the trivial ones Q^T DP Q's
+    T, Q = level_bases(integral_gradients(P, x)[1])
 
     def on_level(D: FloatArray) -> NDArray[np.complex128]:
         mu = np.linalg.eigvals(T.T @ D @ T).astype(np.complex128)
@@ -580,7 +552,7 @@ def _orbit(
         points=np.roll(points, -k, axis=0),
         multipliers=mu.astype(np.complex128),
         trivial=trivial,
-        type=_classify(mu, margin),
+        type=classify(mu, margin),
         closure=closure,
         min_tilt=_min_tilt(P, x, period),
         multiplier_spread=spread,

@@ -14,6 +14,7 @@ Every input error is reported as one line on stderr with exit status 2 and no tr
 - :mod:`._ensemble`: ``ensemble``;
 - :mod:`._chaos`: ``section``, ``chaos`` (Poincare sections, Lyapunov exponent and MEGNO);
 - :mod:`._periodic`: ``periodic`` (relative periodic orbits on a level, their multipliers);
+- :mod:`._continuation`: ``continue`` (an orbit followed in a parameter, its bifurcations);
 - :mod:`._basins`: ``basins`` (which attracting orbit each start of a section grid reaches);
 - :mod:`._verify`: ``verify``;
 - :mod:`._warmup`: ``warmup``.
@@ -27,6 +28,7 @@ from rollingtop.cli._basins import basins
 from rollingtop.cli._bifurcation import bifurcation
 from rollingtop.cli._chaos import chaos, section
 from rollingtop.cli._classification import compare_classification
+from rollingtop.cli._continuation import continue_
 from rollingtop.cli._ensemble import ensemble
 from rollingtop.cli._explore import explore
 from rollingtop.cli._figures import animate, compare, path, plot
@@ -58,6 +60,7 @@ for _command in (
     section,
     chaos,
     periodic,
+    continue_,
     basins,
     explore,
     verify,
