@@ -149,7 +149,8 @@ class SphericalTop:
     @property
     def params(self) -> NDArray[np.float64]:
         """Parameters ``(R, m, g, a3, I1, I2, I3, shell_mass, shell_inertia)`` for the compiled
-        kernels, shape (9,)."""
+        kernels, then the contact model's four slots at 0 (each model's defaults:
+        :meth:`rollingtop.contact.ContactModel.params` sets them), shape (13,)."""
         return np.array(
             [
                 self.R,
@@ -161,6 +162,10 @@ class SphericalTop:
                 self.I3,
                 self.shell_mass,
                 self.shell_inertia,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
             ],
             dtype=float,
         )

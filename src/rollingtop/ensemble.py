@@ -265,7 +265,7 @@ def simulate_ensemble(
     codes = np.array(
         [model.kernel_code(b, y) for b, y in zip(bodies, states, strict=True)], dtype=np.int64
     )
-    params = np.array([b.params for b in bodies])
+    params = np.array([model.params(b) for b in bodies])
     t_eval = np.linspace(0.0, t_end, samples) if samples else np.array([0.0, float(t_end)])
     if client is not None:
         compile_s = 0.0

@@ -4,7 +4,8 @@ A scenario names a body, a contact model, initial conditions and integration opt
 
     [body]        R, m, g, a3, I1, I3, optional I2
     [contact]     model = the name of a registered contact model (rollingtop.contact.MODELS;
-                  default DEFAULT_MODEL)
+                  default DEFAULT_MODEL), and the model's own parameters
+                  (ContactModel.parameters: parallel's pole_disk, relax, pass_relax)
     [shell]       mass, inertia: the spherical shell around the body, for a model with its
                   own inertia (ContactModel.own_inertia: shell-rotor, where it is required;
                   other models refuse it)
@@ -273,6 +274,8 @@ class Scenario:
         model = given.pop("model", self.model)
         if not isinstance(model, ContactModel):
             model = get_model(check_model_name("model", model))
+            if model.name == self.model.name:  # the scenario's own, with its [contact] values
+                model = self.model
         integration = replace(self.integration, **given) if given else self.integration
         return Scenario(self.body, model, self.initial, integration, self.source, self.level)
 
@@ -301,8 +304,11 @@ class Scenario:
         body = SphericalTop(**{k: number("body", k, body_t[k]) for k in _BODY_KEYS if k in body_t})
 
         contact_t = data.get("contact", {})
-        _reject_unknown("contact", contact_t, ("model",))
         model = get_model(check_model_name("contact.model", contact_t.get("model", DEFAULT_MODEL)))
+        own = tuple(r.name for r in model.parameters)
+        _reject_unknown("contact", contact_t, ("model", *own))
+        if any(k in contact_t for k in own):
+            model = model.with_parameters(**{k: contact_t[k] for k in own if k in contact_t})
         body = _with_shell(body, model, data.get("shell"))
 
         level: LevelSpec | None = None

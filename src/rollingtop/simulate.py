@@ -91,7 +91,13 @@ def _given_state(
     if model.own is not None:  # the model's own velocity must agree with v
         projected = y.copy()
         code = model.kernel_code(body, y)
-        call(for_code(code).dynamics.project, code, body.params, projected, call(new_workspace))
+        call(
+            for_code(code).dynamics.project,
+            code,
+            model.params(body),
+            projected,
+            call(new_workspace),
+        )
         gap = float(np.max(np.abs(projected[0:3] - y[0:3])))
         if gap > UNIT_TOLERANCE * max(1.0, float(np.max(np.abs(y[0:6])))):
             raise InitialStateError(
@@ -272,7 +278,7 @@ def _run(
         held = model.integrals_for(body)
     result = integrate(
         code,
-        body.params,
+        model.params(body),
         y0,
         opts.t_eval,
         rtol=opts.rtol,

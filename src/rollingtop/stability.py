@@ -88,7 +88,7 @@ def _generic_eigenvalues(
     x0[5] = omega3
     x0[8] = float(pole)
     code = model.kernel_code(body, _state(x0))
-    p = body.params
+    p = model.params(body)
     ws = call(new_workspace)
     dynamics = for_code(code).dynamics
 

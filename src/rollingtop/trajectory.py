@@ -152,7 +152,13 @@ class Trajectory(NetCDFOutput):
     def _diagnostics(self) -> FloatArray:
         out = np.empty((self.y.shape[0], 4 + MAX_ROWS))
         dynamics = for_code(self._code).dynamics
-        call(dynamics.diagnostics, self._code, self.body.params, np.ascontiguousarray(self.y), out)
+        call(
+            dynamics.diagnostics,
+            self._code,
+            self.model.params(self.body),
+            np.ascontiguousarray(self.y),
+            out,
+        )
         return out
 
     @property

@@ -34,8 +34,9 @@ def _generic_state():
     gamma = rng.normal(size=3)
     omega = rng.normal(size=3)
     v_nu = rng.normal() * 0.3
-    return initial_state(BODY, "parallel", gamma=gamma / np.linalg.norm(gamma), omega=omega,
-                         free={"v_nu": v_nu})  # fmt: skip
+    return initial_state(
+        BODY, "parallel", gamma=gamma / np.linalg.norm(gamma), omega=omega, free={"v_nu": v_nu}
+    )
 
 
 def test_integrals_claimed_are_proved_and_the_others_disproved():
@@ -78,8 +79,16 @@ def test_arrival_in_finite_time_with_a_finite_pole_rate():
         return math.hypot(y[12], y[13]) - 1e-7
 
     hit.terminal = True
-    sol = solve_ivp(_plain, (0.0, 20.0), y0, args=(BODY.params,), method="DOP853", rtol=1e-12,
-                    atol=1e-14, events=hit)  # fmt: skip
+    sol = solve_ivp(
+        _plain,
+        (0.0, 20.0),
+        y0,
+        args=(BODY.params,),
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-14,
+        events=hit,
+    )
     assert sol.status == 1
     t_pole, y = sol.t[-1], sol.y[:, -1]
     assert t_pole == pytest.approx(8.61053, abs=1e-4)
@@ -111,12 +120,24 @@ def _random_bodies_and_states(seed, n, i3_min=0.05):
     bodies, states = [], []
     for _ in range(n):
         I1 = rng.uniform(0.2, 1.0)
-        body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=rng.uniform(-0.5, 0.5), I1=I1,
-                            I3=rng.uniform(i3_min, min(2 * I1, 1.5)))  # fmt: skip
+        body = SphericalTop(
+            R=1.0,
+            m=1.0,
+            g=1.0,
+            a3=rng.uniform(-0.5, 0.5),
+            I1=I1,
+            I3=rng.uniform(i3_min, min(2 * I1, 1.5)),
+        )
         gamma = rng.normal(size=3)
-        states.append(initial_state(body, "parallel", gamma=gamma / np.linalg.norm(gamma),
-                                    omega=rng.normal(size=3),
-                                    free={"v_nu": rng.normal() * 0.5}))  # fmt: skip
+        states.append(
+            initial_state(
+                body,
+                "parallel",
+                gamma=gamma / np.linalg.norm(gamma),
+                omega=rng.normal(size=3),
+                free={"v_nu": rng.normal() * 0.5},
+            )
+        )
         bodies.append(body)
     return bodies, np.array(states)
 
@@ -126,8 +147,14 @@ def test_random_bodies_and_states_pass_their_poles():
     ~1000 pole passages in all, with energy and Jellett's integral conserved."""
     passages = 0
     for body, y0 in zip(*_random_bodies_and_states(5, 100, i3_min=0.2), strict=True):
-        res = integrate(MODELS["parallel"].code, body.params, y0, np.linspace(0.0, 50.0, 10001),
-                        rtol=1e-10, atol=1e-12)  # fmt: skip
+        res = integrate(
+            MODELS["parallel"].code,
+            body.params,
+            y0,
+            np.linspace(0.0, 50.0, 10001),
+            rtol=1e-10,
+            atol=1e-12,
+        )
         s = np.hypot(res.y[:, 12], res.y[:, 13])
         passages += np.count_nonzero((s[1:-1] < s[:-2]) & (s[1:-1] < s[2:]) & (s[1:-1] < 1e-2))
         for v in evaluate(body, res.y, ["energy", "jellett"]).values():
@@ -150,8 +177,9 @@ def test_long_runs_pass_the_vertical_without_an_underflow():
     bodies, states = _random_bodies_and_states(26, 20)
     failed_before = [0, 3, 6, 7, 9, 10, 11, 16, 18, 19]
     bodies, states = [bodies[k] for k in failed_before], states[failed_before]
-    res = simulate_ensemble(bodies, "parallel", states, t_end=1e4, rtol=1e-10, atol=1e-12,
-                            samples=20001, threads=2)  # fmt: skip
+    res = simulate_ensemble(
+        bodies, "parallel", states, t_end=1e4, rtol=1e-10, atol=1e-12, samples=20001, threads=2
+    )
     assert np.all(res.status == 0)
     passages = 0
     for body, y in zip(bodies, res.samples, strict=True):
@@ -206,8 +234,13 @@ def test_the_carried_rate_follows_the_axis_away_from_the_pole_and_is_bounded_nea
     rng = np.random.default_rng(3)
     for _ in range(20):
         gamma = rng.normal(size=3)
-        y = initial_state(BODY, "parallel", gamma=gamma / np.linalg.norm(gamma),
-                          omega=rng.normal(size=3), free={"v_nu": 0.2})  # fmt: skip
+        y = initial_state(
+            BODY,
+            "parallel",
+            gamma=gamma / np.linalg.norm(gamma),
+            omega=rng.normal(size=3),
+            free={"v_nu": 0.2},
+        )
         psi = math.atan2(y[11], y[8])
         rate, speed = _azimuth_rate(y)
         # the geometric rate of the plain model: n = e3 x tau, sigma = -(gamma, n) = s
@@ -232,8 +265,9 @@ def test_the_carried_rate_follows_the_axis_away_from_the_pole_and_is_bounded_nea
     S = parallel.S_POLE
     for s in (0.0, 1e-12, 1e-8, 3e-7, 0.99e-6, S * (1 - 1e-9), S * (1 + 1e-9)):
         g3 = math.sqrt(1.0 - s * s)
-        y = initial_state(BODY, "parallel", gamma=(s, 0.0, g3), omega=(0.4, 2.0, 1.0),
-                          free={"v_nu": 0.2})  # fmt: skip
+        y = initial_state(
+            BODY, "parallel", gamma=(s, 0.0, g3), omega=(0.4, 2.0, 1.0), free={"v_nu": 0.2}
+        )
         for psi_nu in (0.0, 0.7, 2.0):
             y[17] = psi_nu
             rate = call(parallel.carried_rate, BODY.params, y)
@@ -247,3 +281,68 @@ def test_the_carried_rate_follows_the_axis_away_from_the_pole_and_is_bounded_nea
             far = turn - 0.5 * k * math.sin(2 * (psi_nu - math.atan2(y[11], y[8])))
             assert rate == pytest.approx(u * (3 - 3 * u + u * u) * far, rel=NEAR_RTOL)
             assert abs(rate) <= 3.0 * (speed + 0.5 * k * S) / S
+
+
+#: Before the first passage the rule acts only on the round-off offset of the carried direction
+#: (and on ``k`` through ``S_POLE^2 / s^2``): runs under different rules agree to this.
+BEFORE_PASSAGE_TOL = 1e-10
+#: After a passage they differ by at least this (measured: 5e-2 between pole_disk 1e-6 and 1e-7
+#: just after the first passage of this state).
+AFTER_PASSAGE = 1e-4
+
+
+def test_the_passage_rule_is_the_models_own_parameter():
+    """Issue 38, item 5: ``pole_disk``, ``relax`` and ``pass_relax`` reach the compiled kernel
+    through ``p``'s contact slots: the registered values given explicitly run bit for bit as
+    the default; another disk leaves the motion before the first passage (t = 8.61) alone and
+    changes it after."""
+    from rollingtop import simulate
+
+    y0 = _generic_state()
+    model = MODELS["parallel"]
+    runs = {}
+    for key, rule in {
+        "default": {},
+        "explicit": {"pole_disk": 1e-6, "relax": 1.0, "pass_relax": 1.0},
+        "disk": {"pole_disk": 1e-7},
+        "relax": {"relax": 2.0, "pass_relax": 2.0},
+    }.items():
+        m = model.with_parameters(**rule) if rule else model
+        runs[key] = simulate(BODY, m, y0, t_end=12.0, samples=1201, rtol=1e-11, atol=1e-13).y
+    assert np.array_equal(runs["default"], runs["explicit"])
+    before, after = slice(0, 850), slice(880, None)  # t <= 8.49, t >= 8.80
+    for key in ("disk", "relax"):
+        gap = np.abs(runs[key][:, :15] - runs["default"][:, :15])
+        assert np.max(gap[before]) < BEFORE_PASSAGE_TOL, key
+        assert np.max(gap[after]) > AFTER_PASSAGE, key
+    p = model.with_parameters(pole_disk=1e-7).params(BODY)
+    assert p.shape == (13,) and p[9] == 1e-7 and np.array_equal(p[:9], BODY.params[:9])
+
+
+def test_the_passage_rule_in_a_scenario(tmp_path, capsys):
+    from rollingtop._errors import RollingTopError
+    from rollingtop.scenario import load_scenario
+
+    from ..conftest import EXAMPLES
+    from ..test_cli import run_cli
+
+    text = (EXAMPLES / "parallel.toml").read_text()
+    good = tmp_path / "rule.toml"
+    good.write_text(text.replace('model = "parallel"', 'model = "parallel"\npole_disk = 1e-7'))
+    sc = load_scenario(good)
+    assert sc.model.parameter_values == {"pole_disk": 1e-7, "relax": 1.0, "pass_relax": 1.0}
+    assert sc.with_overrides(t_end=1.0).model.parameter_values["pole_disk"] == 1e-7
+    cases = {
+        'model = "parallel"\npole_disk = -1': "pole_disk = -1 must be a positive number",
+        'model = "parallel"\npole_disk = "x"': "pole_disk = 'x' must be a positive number",
+        'model = "parallel"\nrelax = true': "relax = True must be a positive number",
+        'model = "parallel"\npole = 1e-7': "unknown key contact.pole",
+        'model = "meridian"\npole_disk = 1e-7': "unknown key contact.pole_disk",
+    }
+    for contact, message in cases.items():
+        bad = tmp_path / "bad.toml"
+        bad.write_text(text.replace('model = "parallel"', contact))
+        with pytest.raises(RollingTopError, match=message):
+            load_scenario(bad)
+        code, out, err = run_cli(capsys, "simulate", str(bad), "--t-end", "0.1")
+        assert code == 2 and len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -99,7 +99,7 @@ def variational_jacobian(
     """
     y0 = section_state(P.body, P.model, x)
     code = P.model.kernel_code(P.body, y0)
-    p = P.body.params
+    p = P.model.params(P.body)
     atol = P.rtol * 1e-2
     stop = 1.0 if stop_at_vertical else 0.0
     t = np.array([float(period)])

@@ -134,6 +134,9 @@ class Branch:
     stopped: tuple[str, str] = ("", "")
     #: The branch with twice the returns started at the first period doubling.
     doubled: Branch | None = None
+    #: The model's own parameters (its rule at the vertical), as in
+    #: :attr:`rollingtop.chaos.PeriodicOrbits.parameters`.
+    parameters: dict[str, float] = field(default_factory=dict)
 
     @property
     def max_unfolding(self) -> float:
@@ -154,6 +157,7 @@ class Branch:
             "max_unfolding": self.max_unfolding,
             "stopped": list(self.stopped),
             "doubled": self.doubled.to_dict() if self.doubled is not None else None,
+            "contact_parameters": dict(self.parameters),
         }
 
     def _repr_html_(self) -> str:
@@ -363,6 +367,7 @@ def continue_orbit(
         [Bifurcation(d.kind, _public(d.point, UNIT_CIRCLE), d.bracket) for d in detected],
         (down.stopped, up.stopped),
     )
+    out.parameters = model.parameter_values
     doublings = [d for d in detected if d.kind == "period-doubling"]
     if doubling and doublings:
         at = doublings[0].point

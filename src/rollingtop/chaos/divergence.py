@@ -125,7 +125,7 @@ def manifold_divergence(body: SphericalTop, model: str | ContactModel, y: ArrayL
     _refuse_own_inertia(model)
     y = check_state(body, model, y)
     code = model.kernel_code(body, y)
-    return _divergence(code, body.params, y, call(new_workspace))
+    return _divergence(code, model.params(body), y, call(new_workspace))
 
 
 def _divergence(code: int, p: FloatArray, y: FloatArray, ws: Any) -> float:
@@ -209,11 +209,11 @@ def phase_volume(
     atol_ = check_options(t_end, samples, rtol, atol)
     code = model.kernel_code(body, y0)
     t = np.linspace(0.0, float(t_end), int(samples))
-    traj = integrate(code, body.params, y0, t, rtol=rtol, atol=atol_)
+    traj = integrate(code, model.params(body), y0, t, rtol=rtol, atol=atol_)
     ws = call(new_workspace)
-    div = np.array([_divergence(code, body.params, y, ws) for y in traj.y])
+    div = np.array([_divergence(code, model.params(body), y, ws) for y in traj.y])
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (div[1:] + div[:-1]) * np.diff(t))])
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(t > 0.0, integral / t, np.nan)
-    dim = _tangent_basis(code, body.params, y0, ws).shape[1]
+    dim = _tangent_basis(code, model.params(body), y0, ws).shape[1]
     return PhaseVolume(t, div, mean, dim)

@@ -116,7 +116,7 @@ def _velocity_basis(body: SphericalTop, model: ContactModel, y: FloatArray) -> F
     """Orthonormal basis of the constraint subspace ``J u = 0`` at ``y``, shape (d, 6)."""
     J, bias, dirs, _, _ = call(new_workspace)
     code = model.kernel_code(body, y)
-    nc = call(for_code(code).dynamics.constraint_rows, code, body.params, y, J, bias, dirs)
+    nc = call(for_code(code).dynamics.constraint_rows, code, model.params(body), y, J, bias, dirs)
     if nc == 0:
         return np.eye(6)
     _, sv, vt = np.linalg.svd(J[:nc])

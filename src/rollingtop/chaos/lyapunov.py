@@ -340,10 +340,21 @@ def chaos_indicators(
             "by the state: the tangent dynamics (Lyapunov exponent, MEGNO) is undefined there; "
             "start with the axis tilted"
         )
-    compiled = _compile_indicators(code, body.params, y0, d0, rtol, atol, stop)
+    compiled = _compile_indicators(code, model.params(body), y0, d0, rtol, atol, stop)
     start = time.perf_counter()
     _run_chunks(
-        code, body.params, y0, d0, t, float(rtol), atol, int(max_steps), out, states, stats, stop
+        code,
+        model.params(body),
+        y0,
+        d0,
+        t,
+        float(rtol),
+        atol,
+        int(max_steps),
+        out,
+        states,
+        stats,
+        stop,
     )
     wall = time.perf_counter() - start
     status = int(stats[0])

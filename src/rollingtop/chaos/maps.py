@@ -135,7 +135,7 @@ def indicator_map(
     t = np.linspace(0.0, float(t_end), int(samples) + 1)[1:]
     args = (
         codes,
-        body.params,
+        model.params(body),
         Y,
         tangents,
         t,

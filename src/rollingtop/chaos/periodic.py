@@ -216,6 +216,9 @@ class PeriodicOrbits:
     level: dict[str, float]
     orbits: list[PeriodicOrbit] = field(default_factory=list)
     seeds: int = 0
+    #: The model's own parameters (its rule at the vertical: ``parallel``'s ``pole_disk``,
+    #: ``relax``, ``pass_relax``), which an orbit ``through_vertical`` depends on.
+    parameters: dict[str, float] = field(default_factory=dict)
     #: The relative equilibria on the level (:func:`rollingtop.chaos.steady.relative_equilibria`;
     #: a model with a reduction: its closed-form steady motions at the level's energy,
     #: :func:`~rollingtop.chaos.steady.reduced_relative_equilibria`; generically none, since the
@@ -280,13 +283,15 @@ class PeriodicOrbits:
         return draw("periodic", ax, self, **kw)
 
     def to_dict(self) -> dict[str, Any]:
-        """``{"model", "level", "orbits", "steady", "seeds"}`` (``rollingtop periodic --json``)."""
+        """``{"model", "level", "orbits", "steady", "seeds", "contact_parameters"}``
+        (``rollingtop periodic --json``)."""
         return {
             "model": self.model,
             "level": dict(self.level),
             "orbits": [o.to_dict(self.model) for o in self.orbits],
             "steady": [e.to_dict(free_key(get_model(self.model))) for e in self.steady],
             "seeds": self.seeds,
+            "contact_parameters": dict(self.parameters),
         }
 
 
@@ -448,6 +453,7 @@ def periodic_orbits(
     ds = poincare_section(body, model, starts, crossings=settle, rtol=rtol, atol=rtol * 1e-2)
     iterates = section_coordinates(model, ds["crossing_state"].values)
     found = PeriodicOrbits(model.name, dict(zip(names, map(float, target), strict=True)))
+    found.parameters = model.parameter_values
     found.iterates = iterates[..., :2]
     candidates = _seeds(iterates, returns)
     if grid:
@@ -569,7 +575,7 @@ def _min_tilt(P: SectionMap, x: FloatArray, period: float) -> float:
     code = P.model.kernel_code(P.body, y0)
     t = np.linspace(0.0, period, VERTICAL_SAMPLES)
     try:
-        res = integrate(code, P.body.params, y0, t, rtol=P.rtol, atol=P.rtol * 1e-2)
+        res = integrate(code, P.model.params(P.body), y0, t, rtol=P.rtol, atol=P.rtol * 1e-2)
     except RollingTopError:
         return 0.0
     return float(np.min(np.hypot(res.y[:, 12], res.y[:, 13])))

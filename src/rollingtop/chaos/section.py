@@ -217,7 +217,7 @@ def poincare_section(
                 kernels.chaos.section_batch,
                 (
                     codes[idx],
-                    body.params,
+                    model.params(body),
                     Y0[idx],
                     float(t_max),
                     float(rtol),

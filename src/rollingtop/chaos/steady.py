@@ -116,7 +116,7 @@ class _Field:
         y = reduced_state(body, model, z)
         code = model.kernel_code(body, y)
         dy = np.zeros(N_STATE)
-        call(for_code(code).dynamics.rhs, code, body.params, y, dy, self.ws)
+        call(for_code(code).dynamics.rhs, code, model.params(body), y, dy, self.ws)
         e = 1e-7 * max(1.0, float(np.max(np.abs(y[:15])))) / max(float(np.max(np.abs(dy))), 1e-300)
         ahead = reduced_coordinates(model, y + e * dy)
         behind = reduced_coordinates(model, y - e * dy)

@@ -123,9 +123,12 @@ def periodic(
         return
     level = ", ".join(f"{k} = {v:.6g}" for k, v in found.level.items())
     click.echo(f"{len(found)} periodic orbits of the {found.model} model on the level {level}")
+    rule = "".join(f", {k} = {v:g}" for k, v in found.parameters.items())
     for k, o in enumerate(found, 1):
         mu = ", ".join(f"{abs(m):.4g}" for m in o.multipliers) or "none on the level"
-        flag = " (through the vertical: depends on the model's rule there)" * o.through_vertical
+        flag = f" (through the vertical: depends on the model's rule there{rule})" * (
+            o.through_vertical
+        )
         click.echo(
             f"  {k}: {o.returns} returns, period {o.period:.10g}, {o.type} (|multipliers| {mu}, "
             f"{o.multipliers_from}, spread {o.multiplier_spread:.1g}), gamma3 = {o.x[0]:.6g}, "

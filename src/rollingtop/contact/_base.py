@@ -3,6 +3,7 @@ compiled kernels (model x variant) that integrate it."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import ModuleType
@@ -11,6 +12,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 import numpy as np
 
 from rollingtop._errors import ContactModelError
+from rollingtop._layout import CONTACT_PARAMS, N_CONTACT_PARAMS
 from rollingtop._types import ComplexArray, FloatArray
 
 if TYPE_CHECKING:
@@ -23,6 +25,30 @@ FreeVelocity: TypeAlias = Mapping[str, float | FloatArray]
 VelocityFunction: TypeAlias = Callable[
     ["SphericalTop", FloatArray, FloatArray, FloatArray, FloatArray, FreeVelocity], FloatArray
 ]
+
+
+@dataclass(frozen=True)
+class RuleParameter:
+    """A parameter of a contact model's own rule (not of the body), given in a scenario's
+    ``[contact]`` table and carried to the compiled kernels in a slot of ``p``
+    (:data:`rollingtop._layout.CONTACT_PARAMS`; a slot left 0 is :attr:`default`).
+
+    Attributes
+    ----------
+    name : str
+        The key in ``[contact]`` and the keyword of :meth:`ContactModel.with_parameters`.
+    default : float
+        The value the model is registered with (its module's constant).
+    description : str
+        One line.
+    positive : bool
+        Whether a value must be ``> 0`` (else any finite number).
+    """
+
+    name: str
+    default: float
+    description: str
+    positive: bool = True
 
 
 class VerticalDirection(Protocol):
@@ -262,6 +288,11 @@ class ContactModel:
         ``state_outputs(body, Y) -> {name: array (n, 3)}``: further per-sample quantities of
         the model's states ``Y`` (n, 18) for the outputs (``shell-rotor``: the shell's angular
         velocity and the bearing's reaction torque), body frame.
+    parameters : tuple of RuleParameter
+        The model's own parameters (the ``parallel`` model's passage through the vertical),
+        in the order of their slots of ``p``; :meth:`with_parameters` sets them.
+    values : tuple of float
+        This instance's values of :attr:`parameters` (empty: the defaults).
     colour : str
         Matplotlib colour of the model in figures that compare models.
     devices : tuple of str
@@ -284,8 +315,50 @@ class ContactModel:
     vertical: Vertical = Vertical()
     own: OwnVelocity | None = None
     state_outputs: Callable[[SphericalTop, FloatArray], dict[str, FloatArray]] | None = None
+    parameters: tuple[RuleParameter, ...] = ()
+    values: tuple[float, ...] = ()
     colour: str = "#7f7f7f"
     devices: tuple[str, ...] = ()
+
+    @property
+    def parameter_values(self) -> dict[str, float]:
+        """The model's own parameters (:attr:`parameters`) with this instance's values."""
+        values = self.values or tuple(r.default for r in self.parameters)
+        return {r.name: v for r, v in zip(self.parameters, values, strict=True)}
+
+    def with_parameters(self, **values: object) -> ContactModel:
+        """This model with some of its own parameters (:attr:`parameters`) set; each is
+        validated here (``ContactModelError`` naming the key for an unknown one or a bad
+        value). ``get_model("parallel").with_parameters(pole_disk=1e-7)``."""
+        from dataclasses import replace
+
+        known = {r.name: r for r in self.parameters}
+        current = self.parameter_values
+        for key, value in values.items():
+            if key not in known:
+                have = ", ".join(known) if known else "none"
+                raise ContactModelError(
+                    f"contact.{key}: the {self.name} model has no parameter {key!r} (its "
+                    f"parameters: {have})"
+                )
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+            number = float(value) if ok else math.nan  # type: ignore[arg-type]
+            if not (math.isfinite(number) and (number > 0 or not known[key].positive)):
+                need = "a positive number" if known[key].positive else "a finite number"
+                raise ContactModelError(f"contact.{key} = {value!r} must be {need}")
+            current[key] = number
+        if len(current) > N_CONTACT_PARAMS:  # pragma: no cover - a declaration error
+            raise ContactModelError(f"model {self.name!r} declares more than {N_CONTACT_PARAMS}")
+        return replace(self, values=tuple(current[r.name] for r in self.parameters))
+
+    def params(self, body: SphericalTop) -> FloatArray:
+        """The compiled kernels' parameter vector ``p`` for ``body`` under this model: the
+        body's (:attr:`rollingtop.SphericalTop.params`) with the model's own parameters in
+        their slots (:data:`rollingtop._layout.CONTACT_PARAMS`), shape (13,)."""
+        p: FloatArray = body.params
+        for i, value in enumerate(self.values):
+            p[CONTACT_PARAMS + i] = value
+        return p
 
     @property
     def own_inertia(self) -> bool:

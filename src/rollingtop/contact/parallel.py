@@ -78,8 +78,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from rollingtop._jit import inline, kernel
+from rollingtop._layout import CONTACT_PARAMS
 from rollingtop._types import ComplexArray, Float3, Float6, FloatArray, Workspace
-from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
+from rollingtop.contact._base import (
+    ContactModel,
+    FreeVelocity,
+    RuleParameter,
+    Symbolic,
+    Vertical,
+    contact_arm,
+)
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import (
     contact_arm_rate,
@@ -102,6 +110,23 @@ RELAX = 1.0
 #: Relaxation per unit of the axis's turn ``|e3'_h| / s`` near the vertical: a passage's offset
 #: decays like ``(S_POLE / s)^PASS_RELAX`` as the axis moves away (module docstring).
 PASS_RELAX = 1.0
+#: The rule's constants as the model's own parameters: a scenario's ``[contact]`` keys
+#: (``pole_disk``, ``relax``, ``pass_relax``), in their slots of ``p`` in this order
+#: (:meth:`rollingtop.contact.ContactModel.with_parameters`).
+PARAMETERS = (
+    RuleParameter(
+        "pole_disk",
+        S_POLE,
+        "radius (in s = sqrt(1 - gamma3^2)) of the disk about the vertical "
+        "inside which the carried constraint direction turns at a bounded rate",
+    ),
+    RuleParameter(
+        "relax", RELAX, "rate at which the carried direction relaxes to the axis azimuth"
+    ),
+    RuleParameter(
+        "pass_relax", PASS_RELAX, "relaxation per unit of the axis's turn near the vertical"
+    ),
+)
 
 
 @inline
@@ -202,6 +227,20 @@ def pole_rate(p: FloatArray, y: FloatArray) -> float:
 
 
 @inline
+def rule(p: FloatArray) -> tuple[float, float, float]:
+    """The passage rule's ``(S_POLE, RELAX, PASS_RELAX)`` from ``p``'s contact slots
+    (:data:`PARAMETERS`; a slot left 0 is the module's constant)."""
+    s_pole = p[CONTACT_PARAMS]
+    relax = p[CONTACT_PARAMS + 1]
+    pass_relax = p[CONTACT_PARAMS + 2]
+    return (
+        S_POLE if s_pole == 0.0 else s_pole,
+        RELAX if relax == 0.0 else relax,
+        PASS_RELAX if pass_relax == 0.0 else pass_relax,
+    )
+
+
+@inline
 def carried_rate(p: FloatArray, y: FloatArray) -> float:
     """``psi_nu'``: the rate of the axis azimuth ``psi = atan2(beta3, alpha3)``, with the offset
     ``delta = psi_nu - psi`` (modulo ``pi``) relaxed, both weighted down inside the disk
@@ -215,6 +254,7 @@ def carried_rate(p: FloatArray, y: FloatArray) -> float:
     with ``s^2 psi' = alpha3 beta3' - beta3 alpha3'`` and ``s^2 sin(2 delta)`` as polynomials in
     ``alpha3, beta3``, it has no ``atan2`` and no division by ``s``: smooth everywhere, the
     vertical included."""
+    s_pole, relax, pass_relax = rule(p)
     w1, w2 = y[3], y[4]
     a3_, b3 = y[8], y[11]
     a3d = y[6] * w2 - y[7] * w1  # alpha' = alpha x w (body frame), third component
@@ -224,14 +264,14 @@ def carried_rate(p: FloatArray, y: FloatArray) -> float:
     c2, n2 = math.cos(2.0 * y[17]), math.sin(2.0 * y[17])
     offset = n2 * (a3_ * a3_ - b3 * b3) - c2 * (2.0 * a3_ * b3)  # s^2 sin(2 delta)
     k = math.sqrt(
-        RELAX * RELAX + PASS_RELAX * PASS_RELAX * (a3d * a3d + b3d * b3d) / (s2 + S_POLE * S_POLE)
+        relax * relax + pass_relax * pass_relax * (a3d * a3d + b3d * b3d) / (s2 + s_pole * s_pole)
     )
     numerator = turn - 0.5 * k * offset
-    if s2 >= S_POLE * S_POLE:
+    if s2 >= s_pole * s_pole:
         far: float = numerator / s2
         return far
-    u = s2 / (S_POLE * S_POLE)
-    near: float = numerator * (3.0 - 3.0 * u + u * u) / (S_POLE * S_POLE)  # W(u) / s^2
+    u = s2 / (s_pole * s_pole)
+    near: float = numerator * (3.0 - 3.0 * u + u * u) / (s_pole * s_pole)  # W(u) / s^2
     return near
 
 
@@ -353,4 +393,5 @@ MODEL = ContactModel(
     ),
     colour="#9467bd",
     particular_integrals=_particular,
+    parameters=PARAMETERS,
 )

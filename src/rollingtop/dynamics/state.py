@@ -117,7 +117,13 @@ def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: Array
     state = np.asarray(y, dtype=float)
     J, bias, dirs, _, _ = call(new_workspace)
     nc = call(
-        for_code(model.code).dynamics.constraint_rows, model.code, body.params, state, J, bias, dirs
+        for_code(model.code).dynamics.constraint_rows,
+        model.code,
+        model.params(body),
+        state,
+        J,
+        bias,
+        dirs,
     )
     residuals: FloatArray = J[:nc] @ state[:6]
     return residuals
@@ -251,7 +257,7 @@ def initial_state(
     code = _start_code(body, model, y)
     kernels = for_code(code)  # the model's own package, or its variants'
     with compiling(kernels, "integrator"):  # the projection: a model's first compiled kernel
-        call(kernels.dynamics.project, code, body.params, y, call(new_workspace))
+        call(kernels.dynamics.project, code, model.params(body), y, call(new_workspace))
     return y
 
 
@@ -306,7 +312,7 @@ def project_state(
     dynamics = for_code(code).dynamics
     with compiling(for_code(code), "integrator"):
         if model.own is not None:  # the rows' projection of (v, w), then the model's slot
-            call(dynamics.project_velocity_rows, code, body.params, y, ws)
+            call(dynamics.project_velocity_rows, code, model.params(body), y, ws)
             y[17] = model.own.value(body, y)
-        call(dynamics.project, code, body.params, y, ws)
+        call(dynamics.project, code, model.params(body), y, ws)
     return y

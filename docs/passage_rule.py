@@ -1,0 +1,55 @@
+"""Regenerate docs/passage_rule.json: how the periodic orbits of examples/parallel.toml's level
+depend on the parallel model's rule at the vertical (``[contact] pole_disk``, ``relax``,
+``pass_relax``; rollingtop.contact.parallel), and print the table the models guide quotes.
+Run: python docs/passage_rule.py   (about 4 minutes on 2 cores)"""
+
+import json
+import time
+from pathlib import Path
+
+from rollingtop.chaos import periodic_orbits
+from rollingtop.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+#: The rules tried: the registered one first.
+RULES = [
+    {},
+    {"pole_disk": 1e-5},
+    {"pole_disk": 1e-7},
+    {"pole_disk": 1e-8},
+    {"relax": 0.5, "pass_relax": 0.5},
+    {"relax": 2.0, "pass_relax": 2.0},
+]
+
+
+def main():
+    sc = load_scenario(ROOT / "examples" / "parallel.toml")
+    rows = []
+    for rule in RULES:
+        model = sc.model.with_parameters(**rule)
+        t0 = time.perf_counter()
+        found = periodic_orbits(sc.body, model, sc.require_state())
+        orbits = [
+            {
+                "returns": o.returns,
+                "period": round(o.period, 6),
+                "type": o.type,
+                "through_vertical": o.through_vertical,
+                "moduli": [round(float(abs(m)), 4) for m in o.multipliers],
+            }
+            for o in found
+        ]
+        rows.append({"rule": model.parameter_values, "orbits": orbits})
+        print(f"{model.parameter_values} ({time.perf_counter() - t0:.0f} s)")
+        for o in orbits:
+            flag = " through the vertical" if o["through_vertical"] else ""
+            print(
+                f"  {o['returns']} returns, period {o['period']}, {o['type']} {o['moduli']}{flag}"
+            )
+    out = ROOT / "docs" / "passage_rule.json"
+    out.write_text(json.dumps(rows, indent=1) + "\n")
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
