@@ -168,8 +168,9 @@ def integrate_c(
         return None
     p = np.ascontiguousarray(params, dtype=float)
     y = np.array(y0, dtype=float)
-    if p.shape not in ((7,), (9,)) or y.shape != (N_STATE,):  # (9,): a body's, shell included
-        raise ValueError("params must have shape (7,) or (9,) and y0 shape (18,)")
+    # (13,): a body's, shell and the contact model's slots included
+    if p.shape not in ((7,), (9,), (13,)) or y.shape != (N_STATE,):
+        raise ValueError("params must have shape (7,), (9,) or (13,) and y0 shape (18,)")
     p = np.ascontiguousarray(p[:7])  # the C code knows the single body (meridian model)
     t_eval = np.array([t0, t_end], dtype=float)
     out = np.full((2, N_STATE), np.nan)

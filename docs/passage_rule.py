@@ -1,9 +1,11 @@
 """Regenerate docs/passage_rule.json: how the periodic orbits of examples/parallel.toml's level
 depend on the parallel model's rule at the vertical (``[contact] pole_disk``, ``relax``,
 ``pass_relax``; rollingtop.contact.parallel), and print the table the models guide quotes.
-Run: python docs/passage_rule.py   (about 4 minutes on 2 cores)"""
+Run: python docs/passage_rule.py   (about 6 minutes on 2 cores; ``--docs-only``: rewrite the
+guide's table from the JSON)"""
 
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -11,6 +13,10 @@ from rollingtop.chaos import periodic_orbits
 from rollingtop.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
+JSON = ROOT / "docs" / "passage_rule.json"
+GUIDE = ROOT / "docs" / "guide" / "models.md"
+START = "<!-- passage-rule:start (written by docs/passage_rule.py) -->"
+END = "<!-- passage-rule:end -->"
 #: The rules tried: the registered one first.
 RULES = [
     {},
@@ -46,10 +52,38 @@ def main():
             print(
                 f"  {o['returns']} returns, period {o['period']}, {o['type']} {o['moduli']}{flag}"
             )
-    out = ROOT / "docs" / "passage_rule.json"
-    out.write_text(json.dumps(rows, indent=1) + "\n")
-    print(f"wrote {out}")
+    JSON.write_text(json.dumps(rows, indent=1) + "\n")
+    print(f"wrote {JSON}")
+    write_guide(rows)
+
+
+def _orbit(o):
+    mods = ", ".join(f"{m:.3g}" for m in o["moduli"])
+    mark = "*" if o["through_vertical"] else ""
+    return f"{o['returns']}: {o['period']:.6f}{mark} {o['type']} ({mods})"
+
+
+def write_guide(rows):
+    """The table between START and END in the models guide."""
+    lines = [
+        START,
+        "| rule (`[contact]`) | orbits: returns: period, type (multipliers' moduli); "
+        "`*` through the vertical |",
+        "|---|---|",
+    ]
+    for row in rows:
+        rule = ", ".join(f"{k} = {v:g}" for k, v in row["rule"].items())
+        lines.append(f"| {rule} | " + "<br>".join(_orbit(o) for o in row["orbits"]) + " |")
+    lines.append(END)
+    text = GUIDE.read_text()
+    head, rest = text.split(START, 1)
+    tail = rest.split(END, 1)[1]
+    GUIDE.write_text(head + "\n".join(lines) + tail)
+    print(f"wrote the table in {GUIDE}")
 
 
 if __name__ == "__main__":
-    main()
+    if "--docs-only" in sys.argv:
+        write_guide(json.loads(JSON.read_text()))
+    else:
+        main()

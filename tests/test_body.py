@@ -10,7 +10,8 @@ from .conftest import PAPER_BODY
 def test_defaults_and_derived(paper_body):
     assert paper_body.I2 == paper_body.I1 == 0.3
     assert paper_body.symmetric
-    assert list(paper_body.params) == [1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5, 0.0, 0.0]  # no shell
+    # no shell, the contact model's slots at 0 (its defaults)
+    assert list(paper_body.params) == [1.0, 1.0, 1.0, 0.1, 0.3, 0.3, 0.5, 0.0, 0.0, 0, 0, 0, 0]
     # rho(gamma3) = I1 + m (a3^2 + R^2 + 2 a3 R gamma3)  (paper eq. 3.3)
     assert paper_body.rho(0.5) == pytest.approx(0.3 + 1.0 * (0.01 + 1.0 + 0.1))
     assert not SphericalTop(**PAPER_BODY, I2=0.4).symmetric

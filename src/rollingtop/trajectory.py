@@ -263,6 +263,9 @@ class Trajectory(NetCDFOutput):
             held = {"projection": verdict}
         return {
             "model": self.model.name,
+            **(
+                {"contact_parameters": self.model.parameter_values} if self.model.parameters else {}
+            ),
             "t_end": float(self.t[-1]),
             "final": final,
             "integrals": integrals,
@@ -323,6 +326,8 @@ class Trajectory(NetCDFOutput):
     # ---- export -----------------------------------------------------------------------------
     def _attrs(self) -> dict[str, str | float]:
         attrs: dict[str, str | float] = {f"body_{k}": v for k, v in self.body.to_dict().items()}
+        # the model's own parameters (the parallel model's rule at the vertical)
+        attrs.update({f"contact_{k}": v for k, v in self.model.parameter_values.items()})
         attrs.update(
             model=self.model.name,
             model_description=self.model.description,
