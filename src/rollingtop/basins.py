@@ -52,13 +52,15 @@ MAX_WORKERS_PER_CORE = 4
 
 
 def _settle(
-    body: SphericalTop, model: str, X: FloatArray, crossings: int, rtol: float
+    body: SphericalTop, model: ContactModel, X: FloatArray, crossings: int, rtol: float
 ) -> tuple[FloatArray, FloatArray]:
     """The last crossing's section coordinates of each start ``X`` (n, 4) after ``crossings``
-    crossings (NaN where it stopped before) and the number found: a Dask task."""
+    crossings (NaN where it stopped before) and the number found: a Dask task. ``model`` is the
+    instance (pickled with its own parameters: by name a worker would run the registered
+    rule)."""
     from rollingtop.chaos.section import poincare_section
 
-    P = SectionMap(body, get_model(model), held_integrals(body, model, None), rtol)
+    P = SectionMap(body, model, held_integrals(body, model, None), rtol)
     ds = poincare_section(
         body,
         model,
@@ -175,7 +177,7 @@ def basin_map(
         results: dict[int, tuple[FloatArray, FloatArray]] = {}
         with _client(client, workers, scheduler, 10.0) as c:
             futures = {
-                c.submit(_settle, body, model.name, part, crossings, rtol, pure=False): k
+                c.submit(_settle, body, model, part, crossings, rtol, pure=False): k
                 for k, part in enumerate(chunks)
             }
             from distributed import as_completed
