@@ -93,7 +93,8 @@ def test_the_logistic_maps_first_two_period_doublings():
     fm = Logistic()
     branch = _follow(fm, np.array([0.6, 2.6]), 1, (2.5, 3.6), 0.05)
     (pd,) = [d for d in branch.detected if d.kind == "period-doubling"]
-    assert pd.point.lam == pytest.approx(3.0, abs=PD_TOL)
+    assert pd.point.lam == pytest.approx(3.0, abs=PD_TOL) and pd.converged
+    assert min(pd.bracket) <= pd.point.lam <= max(pd.bracket)
     first = arc.switch_to_doubled(fm, pd.point, 1, 1e-3)
     assert first is not None and first.lam > 3.0
     doubled = arc.continue_branch(
@@ -115,6 +116,55 @@ def test_the_henon_maps_fixed_point_doubles_where_henon_says():
     kinds = [d.kind for d in branch.detected]
     assert kinds == ["period-doubling"]
     assert branch.detected[0].point.lam == pytest.approx(3 * (1 - fm.b) ** 2 / 4, abs=PD_TOL)
+
+
+class DelayedLogistic(Henon):
+    """``(x, y) -> (lam x (1 - y), x)``: the fixed point ``x = y = 1 - 1/lam`` has the
+    multipliers ``mu^2 - mu + (lam - 1) = 0``, a complex pair of modulus ``sqrt(lam - 1)``:
+    a Neimark-Sacker point at ``lam = 2`` (its pair ``(1 +- i sqrt(3)) / 2``)."""
+
+    def iterate(self, X, lam, K):
+        x, y = X[:, 0], X[:, 1]
+        for _ in range(K):
+            x, y = lam * x * (1 - y), x
+        return np.stack([x, y], axis=-1), np.full(len(X), float(K))
+
+
+def test_a_neimark_sacker_point_is_found_and_placed_inside_its_bracket():
+    fm = DelayedLogistic()
+    branch = _follow(fm, np.array([1 - 1 / 1.6, 1 - 1 / 1.6, 1.6]), 1, (1.5, 2.4), 0.05)
+    (ns,) = branch.detected
+    assert ns.kind == "neimark-sacker" and ns.converged
+    assert ns.point.lam == pytest.approx(2.0, abs=PD_TOL)
+    assert min(ns.bracket) <= ns.point.lam <= max(ns.bracket)
+    np.testing.assert_allclose(
+        np.sort(np.angle(ns.point.multipliers)), [-np.pi / 3, np.pi / 3], atol=1e-6
+    )
+
+
+class Pinned(Logistic):
+    """``x -> 0.5 + (2 - lam) (x - 0.5)``: the fixed point 0.5 for every ``lam``, its multiplier
+    ``2 - lam`` through -1 at ``lam = 3``; the branch is a line in ``lam``, so steps of 0.1 from
+    2.6 put a point on the period doubling itself."""
+
+    def iterate(self, X, lam, K):
+        for _ in range(K):
+            X = 0.5 + (2 - lam) * (X - 0.5)
+        return X, np.full(len(X), float(K))
+
+
+def test_a_bifurcation_on_a_branch_point_is_not_lost():
+    """A point within the test's noise of the period doubling does not hide it: the sign is
+    compared between the points clear of the noise either side."""
+    fm = Pinned()
+    e = np.array([0.0, 1.0])
+    start = arc.correct(fm, np.array([0.5, 2.6]), e, 1)
+    branch = arc.continue_branch(
+        fm, start, 1, (2.5, 3.45), orient=e, ds=0.1, ds_max=0.1, max_points=50
+    )
+    assert any(abs(p.lam - 3.0) < 1e-9 for p in branch.points)  # a point on it
+    (pd,) = branch.detected
+    assert pd.kind == "period-doubling" and pd.point.lam == pytest.approx(3.0, abs=PD_TOL)
 
 
 def test_an_integral_is_held_by_its_unfolding_parameter():
@@ -148,7 +198,7 @@ def test_the_example_levels_three_cycle_is_followed_across_a_fold(three_cycle, t
     )
     assert branch.max_unfolding < UNFOLDING_TOL
     (fold,) = [b for b in branch.bifurcations if b.kind == "fold"]
-    assert 0.1015 < fold.point.param < 0.1023
+    assert 0.1015 < fold.point.param < 0.1023 and fold.converged
     assert np.min(np.abs(fold.point.multipliers - 1.0)) < 1e-3
     before = [p for p in branch.points if p.param < fold.point.param - 1e-4]
     assert before and all(p.type == "attracting" for p in before)

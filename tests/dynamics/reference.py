@@ -32,6 +32,18 @@ def directions(model, alpha, beta, gamma, w):
         p = np.cross(E3, gamma)
         pdot = np.cross(E3, gdot)
         dirs.append((p / s, pdot / s - p * sdot / s**2))
+    elif model.startswith("oblique:"):
+        # no slip along d = cos(phi) nu + sin(phi) tau (issue 39), away from the pole; the angle
+        # follows the colon ("oblique:0.7"): the reference does not read the package's p
+        phi = float(model.split(":", 1)[1])
+        g3, g3dot = gamma[2], gdot[2]
+        s = np.sqrt(1.0 - g3**2)
+        sdot = -g3 * g3dot / s
+        pn, pndot = E3 - g3 * gamma, -g3dot * gamma - g3 * gdot
+        pt, ptdot = np.cross(E3, gamma), np.cross(E3, gdot)
+        p = np.cos(phi) * pn + np.sin(phi) * pt
+        pdot = np.cos(phi) * pndot + np.sin(phi) * ptdot
+        dirs.append((p / s, pdot / s - p * sdot / s**2))
     elif model in ("rough", "rubber"):
         # vp = 0 as f1 plus (vp, alpha) = (vp, beta) = 0 (docs/model.md; the package uses body axes)
         dirs += [(alpha, np.cross(alpha, w)), (beta, np.cross(beta, w))]
@@ -128,7 +140,7 @@ def shell_rotor_rhs(p, y):
     momentum and angular momentum, the derivative of the rolling condition
     ``v - a3 w x e3 - R Omega x gamma = 0``).
     """
-    R, m, g, a3, I1, I2, I3, ms, Js = p
+    R, m, g, a3, I1, I2, I3, ms, Js = p[:9]  # the body's (the contact slots follow)
     v, w, gamma, d = y[0:3], y[3:6], y[12:15], y[17]
     a = a3 * E3
     inertia = np.diag([I1, I2, I3])

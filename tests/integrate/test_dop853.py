@@ -285,8 +285,8 @@ def test_a_short_parameter_vector_never_reaches_a_kernel():
 
     sc = scenario(t_end=1.0, rtol=1e-10)
     assert len(WARMUP_PARAMS) == N_PARAMS == sc.body.params.shape[0]
-    with pytest.raises(ValueError, match=r"params must have shape \(9,\)"):
+    with pytest.raises(ValueError, match=r"params must have shape \(13,\)"):
         integrate(MERIDIAN, sc.body.params[:7], sc.y0, [0.0, 1.0], rtol=1e-8, atol=1e-10)
-    with pytest.raises(ValueError, match=r"params must have shape \(1, 9\)"):
+    with pytest.raises(ValueError, match=r"params must have shape \(1, 13\)"):
         integrate_batch(np.zeros(1, dtype=np.int64), sc.body.params[None, :7], sc.y0[None, :],
                         np.array([0.0, 1.0]), rtol=1e-8, atol=1e-10)  # fmt: skip

@@ -21,12 +21,15 @@ curve (the null vector of ``DH``, oriented as the previous one); the next is pre
 :data:`GROW` after each accepted point. ``DH`` is central differences (the map in one batch
 of ``2 n + 1`` points and two more for ``lam``).
 
-**Bifurcations** are sign changes, between two points, of the multipliers' test functions
+**Bifurcations** are sign changes of the multipliers' test functions between two points where
+each is clear of the differences' noise (:data:`TEST_NOISE`; the points need not be neighbours)
 (``mu`` the eigenvalues of ``DP^K`` on the level's tangent plane, the null space of ``G``):
 ``prod (mu_i - 1)`` (a *fold*: a real multiplier through +1), ``prod (mu_i + 1)`` (a *period
 doubling*: through -1) and ``prod_{i<j} (mu_i mu_j - 1)`` where a complex pair is on the circle's
-either side (a *Neimark-Sacker* point: the pair through modulus 1). Each is located by regula
-falsi on its test function along the chord between the two points (:func:`_locate`).
+either side (a *Neimark-Sacker* point: the pair through modulus 1), and turns of the curve in
+``lam`` (the tangent's ``lam`` component changes sign: a fold, whose multiplier +1 may come as a
+complex pair meeting at +1). Each is located by regula falsi on its test function along the
+chord between the two points (:func:`_locate`), or reported unconverged with its bracket.
 At a period doubling the branch of the orbit with twice the returns starts along the eigenvector
 of the multiplier -1 (:func:`switch_to_doubled`).
 
@@ -40,7 +43,7 @@ AUTO-07p for the same reason).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
@@ -73,8 +76,11 @@ GROW = 1.4
 #: Secant steps at most to locate a bifurcation.
 LOCATE_ITERATIONS = 12
 #: A located bifurcation's test function is this small relative to its values at the two
-#: points it lies between.
+#: points it lies between...
 LOCATE_TOL = 1e-7
+#: ... or its bracket this narrow relative to the two points' distance (the test function's
+#: own noise, the differences', may stay above the first).
+LOCATE_WIDTH = 1e-7
 #: A correction is refused (the step halved) where it moves the point more than this times the
 #: step from the prediction, or turns the tangent by more than ``acos(MIN_COS)``: the corrector
 #: would have jumped to another branch (seen near a sharp turn of a branch).
@@ -131,12 +137,14 @@ class BranchPoint:
 @dataclass(frozen=True)
 class Detected:
     """A located bifurcation: its kind (:data:`KINDS`), the point, the index of the branch
-    point after it, and the parameters of the two branch points it lies between."""
+    point after it, the parameters of the two branch points it lies between, and whether its
+    location converged (else ``point`` is the one of the two with the smaller test value)."""
 
     kind: str
     point: BranchPoint
     index: int
     bracket: tuple[float, float]
+    converged: bool = True
 
 
 @dataclass
@@ -164,7 +172,8 @@ def _evaluate(
     h = _step(fm) * np.maximum(1.0, np.abs(x))
     X = np.vstack([x, x + np.diag(h), x - np.diag(h)])
     out, times = fm.iterate(X, lam, K)
-    hl = _step(fm) * max(1.0, abs(lam))
+    lam_step = getattr(fm, "lam_step", None)
+    hl = float(lam_step(lam)) if lam_step is not None else _step(fm) * max(1.0, abs(lam))
     out_l = np.vstack([fm.iterate(x[None], lam + s * hl, K)[0] for s in (1.0, -1.0)])
     if not (np.all(np.isfinite(out)) and np.all(np.isfinite(out_l))):
         return None
@@ -269,37 +278,94 @@ def _is_pair_crossing(a: BranchPoint, b: BranchPoint) -> bool:
     )
 
 
-def _locate(fm: FamilyMap, a: BranchPoint, b: BranchPoint, kind: str, K: int) -> BranchPoint:
-    """The point between ``a`` and ``b`` where test ``kind`` vanishes: regula falsi (Illinois)
-    in the distance ``s`` along the chord from ``a`` to ``b``, each trial corrected in the
-    hyperplane normal to the chord at ``s`` (which meets the branch between the two points);
-    a correction that fails or lands off the chord's stretch ends the search. Returns the best
-    point (``a`` or ``b`` where none was found between them: the one with the smaller test
-    value), which the caller reports with the bracket."""
+def _value(kind: str, p: BranchPoint) -> float:
+    """Test ``kind`` at ``p``: :func:`tests`' for the multipliers, and for a ``turn`` (a fold
+    found by the curve turning back in ``lam``) the tangent's ``lam`` component."""
+    return float(p.tangent[-1]) if kind == "turn" else tests(p.multipliers)[kind]
+
+
+def _locate(
+    fm: FamilyMap, a: BranchPoint, b: BranchPoint, kind: str, K: int
+) -> tuple[BranchPoint, bool]:
+    """The point between ``a`` and ``b`` where test ``kind`` vanishes, and whether the search
+    converged there: regula falsi (Illinois) in the distance ``s`` along the chord from ``a``
+    to ``b``, each trial corrected in the hyperplane normal to the chord at ``s``. A trial is
+    refused (the search ends) where its correction moves it more than ``MAX_CORRECTION`` times
+    the chord's length, its tangent turns away from the chord, or its ``lam`` leaves the
+    bracket: it would be on another branch (a reversible system's symmetric orbits cross its
+    orbits). Where the search does not converge, the end with the smaller test value is
+    returned, not converged."""
     chord = b.u - a.u
     length = float(np.linalg.norm(chord))
     d = chord / length
-    lo, hi = (0.0, tests(a.multipliers)[kind]), (length, tests(b.multipliers)[kind])
+    lo, hi = (0.0, _value(kind, a)), (length, _value(kind, b))
     scale = max(abs(lo[1]), abs(hi[1]))
-    found = a if abs(lo[1]) < abs(hi[1]) else b
+    lam_lo, lam_hi = sorted((a.lam, b.lam))
+    slack = 1e-9 * max(1.0, abs(lam_lo), abs(lam_hi))
+    nearer = a if abs(lo[1]) < abs(hi[1]) else b
+    side = 0
+    turn = kind == "turn"  # a fold's lam lies beyond both points' and its tangent turns
     for _ in range(LOCATE_ITERATIONS):
         if hi[1] == lo[1]:
             break
         s = lo[0] - lo[1] * (hi[0] - lo[0]) / (hi[1] - lo[1])
         guess = a.u + s * d
         p = correct(fm, guess, d, K)
-        if p is None or float(np.linalg.norm(p.u - guess)) > length:
+        if (
+            p is None
+            or float(np.linalg.norm(p.u - guess)) > MAX_CORRECTION * length
+            or abs(float(p.tangent @ d)) < (0.5 if turn else MIN_COS)
+            or not (turn or lam_lo - slack <= p.lam <= lam_hi + slack)
+        ):
             break
-        found = p
-        value = tests(p.multipliers)[kind]
-        if abs(value) < LOCATE_TOL * scale:
-            break
-        # keep the bracket; halve the value of the end that stays (Illinois)
+        value = _value(kind, p)
+        if abs(value) < LOCATE_TOL * scale or hi[0] - lo[0] < LOCATE_WIDTH * length:
+            return p, True
+        # keep the bracket; where one end stays twice in a row, halve its value (Illinois)
         if (value > 0) == (lo[1] > 0):
-            lo, hi = (s, value), (hi[0], hi[1] / 2)
+            lo = (s, value)
+            if side == 1:
+                hi = (hi[0], hi[1] / 2)
+            side = 1
         else:
-            hi, lo = (s, value), (lo[0], lo[1] / 2)
-    return found
+            hi = (s, value)
+            if side == -1:
+                lo = (lo[0], lo[1] / 2)
+            side = -1
+    return nearer, False
+
+
+def _detect(
+    fm: FamilyMap, branch: RawBranch, clear: dict[str, BranchPoint], new: BranchPoint, K: int
+) -> None:
+    """Append to ``branch`` the bifurcations between the last point where each test was clear
+    of the noise (``clear``, updated) and ``new``. A turn of the curve in ``lam`` is a fold
+    (its multiplier +1 may come as a complex pair meeting at +1, where the multipliers' fold test
+    touches 0 without changing sign): a Neimark-Sacker sign change across a turn is that pair,
+    not a Neimark-Sacker point, and is not reported."""
+    before = branch.points[-1]
+    found: list[tuple[str, BranchPoint]] = []
+    if before.tangent[-1] * new.tangent[-1] < 0:  # oriented alike by the continuation
+        found.append(("turn", before))
+    for kind in KINDS:
+        value = _value(kind, new)
+        if abs(value) < TEST_NOISE:
+            continue
+        old = clear.get(kind)
+        clear[kind] = new
+        if old is None or (_value(kind, old) > 0) == (value > 0):
+            continue
+        if kind == "neimark-sacker" and (found or not _is_pair_crossing(old, new)):
+            continue
+        if kind == "fold" and found:  # the same fold, seen by both tests
+            continue
+        found.append((kind, old))
+    for kind, a in found:
+        located, converged = _locate(fm, a, new, kind, K)
+        name = "fold" if kind == "turn" else kind
+        branch.detected.append(
+            Detected(name, located, len(branch.points), (a.lam, new.lam), converged)
+        )
 
 
 def continue_branch(
@@ -314,18 +380,21 @@ def continue_branch(
     max_points: int,
     keep: Callable[[BranchPoint], str] | None = None,
 ) -> RawBranch:
-    """Continue from ``start`` (a corrected point) while ``lam`` stays in ``bounds``.
+    """Continue from ``start`` (a corrected point) while ``lam`` stays in ``bounds`` (a point
+    beyond them ends the branch and is not kept).
 
     ``orient``: the first step's direction has a positive product with it (``(0, ..., 0, 1)``:
     towards growing ``lam``). ``keep``: a check of each new point, returning a reason to stop
     (``""``: go on).
     """
-    branch = RawBranch(K, [start])
     t = start.tangent if float(start.tangent @ orient) >= 0 else -start.tangent
-    point = start
+    start = replace(start, tangent=t)
+    branch = RawBranch(K, [start])
+    clear = {k: start for k in KINDS if abs(_value(k, start)) >= TEST_NOISE}
     lo, hi = min(bounds), max(bounds)
     step = ds
     while len(branch.points) < max_points:
+        point = branch.points[-1]
         pred = point.u + step * t
         nxt = correct(fm, pred, t, K)
         if nxt is not None and (
@@ -343,21 +412,13 @@ def continue_branch(
         if reason:
             branch.stopped = reason
             return branch
-        before = tests(point.multipliers)
-        after = tests(nxt.multipliers)
-        for kind in KINDS:
-            crossed = before[kind] * after[kind] < 0
-            clear = min(abs(before[kind]), abs(after[kind])) >= TEST_NOISE
-            if crossed and clear and (kind != "neimark-sacker" or _is_pair_crossing(point, nxt)):
-                located = _locate(fm, point, nxt, kind, K)
-                bracket = (point.lam, nxt.lam)
-                branch.detected.append(Detected(kind, located, len(branch.points), bracket))
-        branch.points.append(nxt)
-        t = nxt.tangent if float(nxt.tangent @ t) >= 0 else -nxt.tangent
-        point = nxt
         if not lo <= nxt.lam <= hi:
             branch.stopped = "the parameter left its range"
             return branch
+        t = nxt.tangent if float(nxt.tangent @ t) >= 0 else -nxt.tangent
+        nxt = replace(nxt, tangent=t)
+        _detect(fm, branch, clear, nxt, K)
+        branch.points.append(nxt)
         step = min(ds_max, step * GROW)
     branch.stopped = f"{max_points} points"
     return branch

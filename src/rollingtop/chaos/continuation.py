@@ -97,18 +97,19 @@ class BranchPoint:
 @dataclass(frozen=True)
 class Bifurcation:
     """A located bifurcation: ``kind`` (``fold``, ``period-doubling``, ``neimark-sacker``),
-    the orbit there (where the location converged: its test function is ``1e-7`` of its
-    values at the branch points either side; else the nearer of them), and the parameter
-    values of those two points."""
+    the orbit there, the parameter values of the two branch points it lies between, and
+    whether its location converged (its test function ``1e-7`` of its values at those points;
+    else :attr:`point` is the one of them with the smaller value)."""
 
     kind: str
     point: BranchPoint
     bracket: tuple[float, float]
+    converged: bool = True
 
     @property
     def test(self) -> float:
-        """The bifurcation's test function at :attr:`point`
-        (:func:`rollingtop.chaos._arclength.tests`): its distance from the exact point."""
+        """The multipliers' test function of its kind at :attr:`point`
+        (:func:`rollingtop.chaos._arclength.tests`; 0 at the exact bifurcation)."""
         return arc.tests(self.point.multipliers)[self.kind]
 
     def to_dict(self, model: ContactModel) -> dict[str, Any]:
@@ -116,6 +117,7 @@ class Bifurcation:
             "kind": self.kind,
             **self.point.to_dict(model),
             "bracket": list(self.bracket),
+            "converged": self.converged,
             "test": self.test,
         }
 
@@ -137,6 +139,8 @@ class Branch:
     #: The model's own parameters (its rule at the vertical), as in
     #: :attr:`rollingtop.chaos.PeriodicOrbits.parameters`.
     parameters: dict[str, float] = field(default_factory=dict)
+    #: What became of the switch onto the doubled branch ("": none was tried).
+    doubling: str = ""
 
     @property
     def max_unfolding(self) -> float:
@@ -158,6 +162,7 @@ class Branch:
             "stopped": list(self.stopped),
             "doubled": self.doubled.to_dict() if self.doubled is not None else None,
             "contact_parameters": dict(self.parameters),
+            "doubling": self.doubling,
         }
 
     def _repr_html_(self) -> str:
@@ -246,6 +251,51 @@ class _TopFamily:
         return out
 
 
+class _Scaled:
+    """A family in ``mu = (lam - lam0) scale``: the arclength's norm weighs the parameter by
+    ``scale`` (chosen so that the branch leaves its start at 45 degrees between ``x`` and
+    ``mu``: unweighted, ``x`` moved 50-80 times faster than ``a3`` and the steps crept in it).
+    The parameter's difference step stays the family's own, in ``lam``."""
+
+    def __init__(self, family: _TopFamily, lam0: float, scale: float) -> None:
+        self.family, self.lam0, self.scale = family, lam0, scale
+        self.n, self.m, self.fd_step = family.n, family.m, family.fd_step
+
+    def lam(self, mu: float) -> float:
+        return self.lam0 + mu / self.scale
+
+    def lam_step(self, mu: float) -> float:
+        return MAP_STEP * max(1.0, abs(self.lam(mu))) * self.scale
+
+    def iterate(self, X: FloatArray, mu: float, K: int) -> tuple[FloatArray, FloatArray]:
+        return self.family.iterate(X, self.lam(mu), K)
+
+    def integrals(self, X: FloatArray, mu: float) -> FloatArray:
+        return self.family.integrals(X, self.lam(mu))
+
+    def target(self, mu: float) -> FloatArray:
+        return self.family.target(self.lam(mu))
+
+
+#: Bounds of the parameter's weight in the arclength (:class:`_Scaled`).
+SCALE_RANGE = (1.0, 1e4)
+
+
+def _check_range(body: SphericalTop, param: str, lo: float, hi: float) -> None:
+    """``ScenarioError`` where an end of the range (with the difference step beyond it) is not
+    an admissible body."""
+    if param == "energy":
+        return
+    for value in (lo - MAP_STEP * max(1.0, abs(lo)), hi + MAP_STEP * max(1.0, abs(hi))):
+        try:
+            body_with(body, param, value)
+        except RollingTopError as err:
+            end = lo if value < lo else hi
+            raise ScenarioError(
+                f"the range's end {param} = {end:g} is not inside the admissible bodies ({err})"
+            ) from None
+
+
 def body_with(body: SphericalTop, param: str, value: float) -> SphericalTop:
     """``body`` with ``param`` set to ``value`` (``I1`` sets ``I2`` too); the energy leaves it."""
     if param == "energy":
@@ -254,13 +304,13 @@ def body_with(body: SphericalTop, param: str, value: float) -> SphericalTop:
     return dataclasses.replace(body, **changes)
 
 
-def _public(p: arc.BranchPoint, unit: float) -> BranchPoint:
+def _public(p: arc.BranchPoint, param: float) -> BranchPoint:
     return BranchPoint(
-        param=p.lam,
+        param=param,
         period=p.period,
         x=p.x,
         multipliers=p.multipliers,
-        type=classify(p.multipliers, unit),
+        type=classify(p.multipliers, UNIT_CIRCLE),
         unfolding=float(np.max(np.abs(p.beta), initial=0.0)),
     )
 
@@ -324,15 +374,22 @@ def continue_orbit(
         raise ScenarioError(
             f"the range {lo:g},{hi:g} must hold the orbit's own {param} = {lam0:.6g}"
         )
+    _check_range(body, param, lo, hi)
     family = _TopFamily(body, model, tuple(names), param, np.asarray(level, float), rtol)
     e = np.zeros(4 + len(names) + 1)
     e[-1] = 1.0
-    start = arc.correct(
-        family, np.concatenate([orbit.x, np.zeros(len(names)), [lam0]]), e, orbit.returns
-    )
+    u0 = np.concatenate([orbit.x, np.zeros(len(names)), [lam0]])
+    plain = arc.correct(family, u0, e, orbit.returns)
+    if plain is None:
+        raise ScenarioError("the orbit does not solve the continuation's system at its start")
+    tx, tl = float(np.linalg.norm(plain.tangent[:4])), abs(float(plain.tangent[-1]))
+    scale = float(np.clip(tx / tl if tl > 0 else SCALE_RANGE[1], *SCALE_RANGE))
+    scaled = _Scaled(family, lam0, scale)
+    u0[-1] = 0.0
+    start = arc.correct(scaled, u0, e, orbit.returns)
     if start is None:
         raise ScenarioError("the orbit does not solve the continuation's system at its start")
-    ds = float(step) if step is not None else (hi - lo) / 20
+    ds = float(step) * scale if step is not None else (hi - lo) * scale / 20
     if not (math.isfinite(ds) and ds > 0):
         raise ScenarioError(f"step = {step!r} must be a positive number")
 
@@ -343,47 +400,67 @@ def continue_orbit(
 
     def follow(s: arc.BranchPoint, K: int, orient: FloatArray) -> arc.RawBranch:
         return arc.continue_branch(
-            family,
+            scaled,
             s,
             K,
-            (lo, hi),
+            ((lo - lam0) * scale, (hi - lam0) * scale),
             orient=orient,
             ds=ds,
-            ds_max=4 * ds,
+            ds_max=(hi - lo) * scale / 8,
             max_points=max_points,
             keep=keep,
         )
 
+    def public(raw: arc.RawBranch) -> tuple[list[BranchPoint], list[Bifurcation]]:
+        points = [_public(p, scaled.lam(p.lam)) for p in raw.points]
+        found = [
+            Bifurcation(
+                d.kind,
+                _public(d.point, scaled.lam(d.point.lam)),
+                (scaled.lam(d.bracket[0]), scaled.lam(d.bracket[1])),
+                d.converged,
+            )
+            for d in raw.detected
+        ]
+        return points, found
+
     down = follow(start, orbit.returns, -e)
     up = follow(start, orbit.returns, e)
-    raw = down.points[::-1] + up.points[1:]
-    detected = sorted(down.detected + up.detected, key=lambda d: d.point.lam)
+    down_points, down_found = public(down)
+    up_points, up_found = public(up)
     out = Branch(
         model.name,
         param,
         orbit.returns,
         dict(zip(names, map(float, level), strict=True)),
-        [_public(p, UNIT_CIRCLE) for p in raw],
-        [Bifurcation(d.kind, _public(d.point, UNIT_CIRCLE), d.bracket) for d in detected],
+        down_points[::-1] + up_points[1:],
+        sorted(down_found + up_found, key=lambda b: b.point.param),
         (down.stopped, up.stopped),
     )
     out.parameters = model.parameter_values
-    doublings = [d for d in detected if d.kind == "period-doubling"]
-    if doubling and doublings:
-        at = doublings[0].point
-        first = arc.switch_to_doubled(family, at, orbit.returns, SWITCH_SIZE)
-        if first is not None:
-            raw2 = follow(first, 2 * orbit.returns, first.u - at.u)
-            out.doubled = Branch(
-                model.name,
-                param,
-                2 * orbit.returns,
-                out.level,
-                [_public(p, UNIT_CIRCLE) for p in raw2.points],
-                [
-                    Bifurcation(d.kind, _public(d.point, UNIT_CIRCLE), d.bracket)
-                    for d in raw2.detected
-                ],
-                ("", raw2.stopped),
-            )
+    doublings = [
+        d
+        for d in sorted(down.detected + up.detected, key=lambda d: abs(d.point.lam))
+        if d.kind == "period-doubling"
+    ]
+    if not doubling or not doublings:
+        return out
+    at = doublings[0]
+    if not at.converged:
+        out.doubling = "not tried: the period doubling's location did not converge"
+        return out
+    first = arc.switch_to_doubled(scaled, at.point, orbit.returns, SWITCH_SIZE)
+    if first is None:
+        out.doubling = (
+            "failed: from the multiplier -1's eigenvector the corrector returned to the "
+            f"{orbit.returns}-return branch or did not converge"
+        )
+        return out
+    raw2 = follow(first, 2 * orbit.returns, first.u - at.point.u)
+    points2, found2 = public(raw2)
+    out.doubled = Branch(
+        model.name, param, 2 * orbit.returns, out.level, points2, found2, ("", raw2.stopped)
+    )
+    out.doubled.parameters = out.parameters
+    out.doubling = f"followed from {param} = {scaled.lam(at.point.lam):.8g}"
     return out

@@ -529,8 +529,8 @@ def _orbit(
     try:
         D = variational_jacobian(P, x, period, stop_at_vertical=True)
         source = "variational"
-    except IntegrationError:  # through the vertical: the map's difference quotients
-        D, source = DP, "differences"
+    except IntegrationError:  # ThroughVertical (the flow has no derivative there), or the
+        D, source = DP, "differences"  # variational run failed: the map's difference quotients
     mu = on_level(D)
     trivial = np.linalg.eigvals(Q.T @ D @ Q).astype(np.complex128)
     # the trivial multipliers' distance from 1 and the leak of the level's tangent plane into

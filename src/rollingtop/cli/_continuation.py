@@ -29,6 +29,26 @@ def _range(text: str) -> tuple[float, float]:
     return lo, hi
 
 
+def _check_own_value(scenario: str, param: str, bounds: tuple[float, float]) -> None:
+    """``BadInput`` unless the range holds the scenario's own value of ``param`` (its body's, or
+    its state's energy: the level the orbits lie on)."""
+    from rollingtop.chaos.continuation import body_with
+    from rollingtop.cli._errors import BadInput
+    from rollingtop.dynamics.integrals import evaluate
+    from rollingtop.scenario import load_scenario
+
+    sc = load_scenario(scenario)
+    if param == "energy":
+        y = sc.require_state()
+        own = float(evaluate(sc.body, y[None], ["energy"], model=sc.model)["energy"][0])
+    else:
+        own = float(getattr(body_with(sc.body, "energy", 0.0), param))
+    if not bounds[0] <= own <= bounds[1]:
+        raise BadInput(
+            f"--range {bounds[0]:g},{bounds[1]:g} must hold the scenario's own {param} = {own:.6g}"
+        )
+
+
 @click.command("continue")
 @scenario_argument
 @click.option(
@@ -100,6 +120,9 @@ def continue_(
     bounds = _range(span)
     if output is not None:
         check_output_path(output, FIGURE_SUFFIXES)
+    if step is not None and not math.isfinite(step):
+        raise BadInput(f"--step {step!r} must be a finite positive number")
+    _check_own_value(scenario, param, bounds)  # before the search for orbits (seconds)
     sc, found = find_orbits(scenario, returns, trajectories, settle, seed, grid_seeds)
     if number > len(found):
         raise BadInput(f"--orbit {number}: the level has {len(found)} orbits (rollingtop periodic)")
@@ -135,9 +158,12 @@ def continue_(
             click.echo(f"  the doubled branch ({br.returns} returns): {len(br.points)} points")
         for b in br.bifurcations:
             mu = ", ".join(f"{m.real:.6g}{m.imag:+.6g}i" for m in b.point.multipliers)
+            where = "" if b.converged else ", not converged: the nearer end"
             click.echo(
                 f"  {b.kind} at {param} = {b.point.param:.8g} (between {b.bracket[0]:.8g} and "
-                f"{b.bracket[1]:.8g}), period {b.point.period:.8g}, multipliers {mu}"
+                f"{b.bracket[1]:.8g}{where}), period {b.point.period:.8g}, multipliers {mu}"
             )
+    if branch.doubling:
+        click.echo(f"  the doubled branch: {branch.doubling}")
     if output is not None:
         click.echo(f"wrote {output}")
