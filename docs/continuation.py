@@ -35,7 +35,8 @@ def main():
         )
         print(
             f"  {b.kind} at a3 = {b.point.param:.8g} (between {b.bracket[0]:.8g} and "
-            f"{b.bracket[1]:.8g}; converged: {b.converged}), period {b.point.period:.6g}, multipliers {mu}"
+            f"{b.bracket[1]:.8g}; converged: {b.converged}), period {b.point.period:.6g}, "
+            f"multipliers {mu}"
         )
     print("  types along the branch:", dict(Counter(p.type for p in branch.points)))
     save_figure(branch_figure(branch), ROOT / "docs" / "continuation.png", dpi=150)

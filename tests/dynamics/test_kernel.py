@@ -29,6 +29,7 @@ def random_state(rng, body, model):
         "rough": {},
         "parallel": {"v_nu": rng.normal()},
         "rubber": {},
+        "oblique": {"v_slip": rng.normal()},
     }[model]
     a = rng.normal(size=3)
     alpha = a - (a @ gamma) * gamma

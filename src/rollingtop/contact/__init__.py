@@ -28,7 +28,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 from rollingtop._errors import ContactModelError
-from rollingtop.contact import meridian, parallel, rough, rubber, shell_rotor, smooth
+from rollingtop.contact import meridian, oblique, parallel, rough, rubber, shell_rotor, smooth
 from rollingtop.contact._base import (
     ContactModel,
     Kernel,
@@ -51,6 +51,7 @@ MODULES: tuple[ModuleType, ...] = (
     parallel,
     rubber,
     shell_rotor,
+    oblique,
 )
 
 MODELS: dict[str, ContactModel] = {m.MODEL.name: m.MODEL for m in MODULES}

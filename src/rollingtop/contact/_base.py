@@ -293,6 +293,9 @@ class ContactModel:
         in the order of their slots of ``p``; :meth:`with_parameters` sets them.
     values : tuple of float
         This instance's values of :attr:`parameters` (empty: the defaults).
+    bind : callable or None
+        ``bind(values) -> {field: value}``: the fields that follow the parameters' values
+        (``oblique``: its initial ``velocity`` for the angle), applied by :meth:`with_parameters`.
     colour : str
         Matplotlib colour of the model in figures that compare models.
     devices : tuple of str
@@ -317,6 +320,7 @@ class ContactModel:
     state_outputs: Callable[[SphericalTop, FloatArray], dict[str, FloatArray]] | None = None
     parameters: tuple[RuleParameter, ...] = ()
     values: tuple[float, ...] = ()
+    bind: Callable[[dict[str, float]], dict[str, Any]] | None = None
     colour: str = "#7f7f7f"
     devices: tuple[str, ...] = ()
 
@@ -349,7 +353,8 @@ class ContactModel:
             current[key] = number
         if len(current) > N_CONTACT_PARAMS:  # pragma: no cover - a declaration error
             raise ContactModelError(f"model {self.name!r} declares more than {N_CONTACT_PARAMS}")
-        return replace(self, values=tuple(current[r.name] for r in self.parameters))
+        bound = self.bind(current) if self.bind is not None else {}
+        return replace(self, values=tuple(current[r.name] for r in self.parameters), **bound)
 
     def params(self, body: SphericalTop) -> FloatArray:
         """The compiled kernels' parameter vector ``p`` for ``body`` under this model: the

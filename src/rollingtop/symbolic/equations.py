@@ -25,6 +25,7 @@ contact point, which the normal multiplier absorbs -- the accelerations agree (t
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
@@ -35,7 +36,7 @@ import sympy as sp
 from rollingtop._types import FloatArray
 from rollingtop.contact import get_model
 
-__all__ = ["Symbols", "SYMBOLS", "derive", "Derivation"]
+__all__ = ["PHI_T", "Symbols", "SYMBOLS", "derive", "Derivation"]
 
 
 @dataclass(frozen=True)
@@ -80,6 +81,11 @@ def _make_symbols() -> Symbols:
 
 
 SYMBOLS = _make_symbols()
+#: ``t = tan(phi / 2)``: the oblique model's constraint angle as a rational parameter
+#: (``cos(phi) = (1 - t^2) / (1 + t^2)``, ``sin(phi) = 2 t / (1 + t^2)``;
+#: :mod:`rollingtop.contact.oblique`), a symbol of every derivation that model's directions
+#: enter.
+PHI_T = sp.Symbol("t_phi", real=True)
 
 
 def _cross(a: Any, b: Any) -> Any:
@@ -160,14 +166,16 @@ def rhs_function(
     model: str, symmetric: bool = True
 ) -> Callable[[FloatArray, FloatArray], list[float]]:
     """A NumPy function ``f(params, y) -> y'[:15]`` of the derived field (``y`` in the kernel's
-    layout ``(v, w, alpha, beta, gamma, ...)``), for comparison with the compiled kernel."""
+    layout ``(v, w, alpha, beta, gamma, ...)``), for comparison with the compiled kernel. The
+    oblique model's angle is read from its slot of ``params`` (13 entries; 0 where absent)."""
     S = SYMBOLS
     d = derive(model, symmetric)
     exprs = [d.field[x] for x in S.state]
-    f = sp.lambdify([S.params, S.state], exprs, "numpy")
+    f = sp.lambdify([S.params, S.state, PHI_T], exprs, "numpy")
 
     def rhs(params: FloatArray, y: FloatArray) -> list[float]:
-        values: list[float] = f(tuple(params[:7]), tuple(y[:15]))  # the body's own
+        t = math.tan(params[12] / 2) if len(params) > 12 else 0.0  # the oblique angle's slot
+        values: list[float] = f(tuple(params[:7]), tuple(y[:15]), t)  # the body's own
         return values
 
     return rhs
