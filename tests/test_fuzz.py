@@ -802,7 +802,7 @@ TEXT_VALID = {
     "grid": ["omega3=1:3:2", "omega3=1:3:2,v_tau=0:0.5:2"],
     "hold": ["energy", "energy,jellett"],
     "h_levels": ["4.0,4.5", "4.2"],
-    "span": ["0.05,5"],
+    "span": ["0.5,2"],
 }
 #: Input files of path options, by name (other path options are outputs).
 INPUT_FILES = {"initial": "ic.csv"}

@@ -224,14 +224,15 @@ def test_cli_stability_other_model_and_every_model(capsys):
     assert code == 0, err
     every = json.loads(out)["models"]
     assert [s["model"] for s in every] == [m.name for m in models_for(PAPER)]
-    assert [s["model"] for s in every] == ["meridian", "smooth", "rough", "parallel", "rubber"]
+    assert [s["model"] for s in every] == ["meridian", "smooth", "rough", "parallel", "rubber",
+                                           "oblique"]  # fmt: skip
     south = {s["model"]: s["vertical_spin"][0]["omega3_critical"]
              for s in every if "vertical_spin" in s}  # fmt: skip
     # the README's rates: 0.31 (meridian), 0.69 (smooth), 0.49 (rough)
     assert south == pytest.approx({"meridian": 0.30881101, "smooth": 0.69282032,
                                    "rough": 0.48573398}, abs=1e-8)  # fmt: skip
     refused = {s["model"]: s["refused"] for s in every if "refused" in s}
-    assert set(refused) == {"parallel", "rubber"}
+    assert set(refused) == {"parallel", "rubber", "oblique"}
     assert "has no vertical spin" in refused["rubber"]
     code, out, err = run_cli(capsys, "stability", paper, "--model", "all")
     assert code == 0 and err == ""

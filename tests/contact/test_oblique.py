@@ -178,7 +178,7 @@ v_slip = 0.25
     path.write_text(text.format(angle=0.7))
     sc = load_scenario(path)
     assert sc.model.parameter_values["angle"] == 0.7 and sc.model.name == "oblique"
-    assert get_model("oblique").parameter_values["angle"] == 0.0
+    assert get_model("oblique").parameter_values["angle"] == pytest.approx(math.pi / 4)
     path.write_text(text.format(angle='"x"'))
     with pytest.raises(RollingTopError, match="angle = 'x' must be a finite number"):
         load_scenario(path)

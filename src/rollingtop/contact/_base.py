@@ -31,7 +31,8 @@ VelocityFunction: TypeAlias = Callable[
 class RuleParameter:
     """A parameter of a contact model's own rule (not of the body), given in a scenario's
     ``[contact]`` table and carried to the compiled kernels in a slot of ``p``
-    (:data:`rollingtop._layout.CONTACT_PARAMS`; a slot left 0 is :attr:`default`).
+    (:data:`rollingtop._layout.CONTACT_PARAMS`) as its offset from :attr:`default` (a slot left
+    0 is the default).
 
     Attributes
     ----------
@@ -359,10 +360,12 @@ class ContactModel:
     def params(self, body: SphericalTop) -> FloatArray:
         """The compiled kernels' parameter vector ``p`` for ``body`` under this model: the
         body's (:attr:`rollingtop.SphericalTop.params`) with the model's own parameters in
-        their slots (:data:`rollingtop._layout.CONTACT_PARAMS`), shape (13,)."""
+        their slots (:data:`rollingtop._layout.CONTACT_PARAMS`) as their offsets from their
+        defaults, shape (13,): the kernels add the defaults back, so a body's ``params`` alone
+        (slots 0) runs every model with its defaults."""
         p: FloatArray = body.params
-        for i, value in enumerate(self.values):
-            p[CONTACT_PARAMS + i] = value
+        for i, (r, value) in enumerate(zip(self.parameters, self.values, strict=False)):
+            p[CONTACT_PARAMS + i] = value - r.default  # the kernel adds its default back
         return p
 
     @property

@@ -10,8 +10,8 @@ gamma / s`` the horizontal direction across it (``s = sqrt(1 - gamma3^2)``, body
 slips freely along ``d x gamma = -sin(phi) nu + cos(phi) tau``; the free velocity component is
 the centre of mass's along it, ``v_slip`` (at ``phi = 0`` the meridian model's ``v_tau``, at
 ``phi = pi/2`` minus the ``parallel`` model's ``v_nu``). ``phi`` is the model's parameter
-``angle`` (``[contact] angle`` in radians, any real; ``phi`` and ``phi + pi`` are one
-constraint): ``phi = 0`` is the paper's constraint (:mod:`rollingtop.contact.meridian`),
+``angle`` (``[contact] angle`` in radians, any real, default ``pi/4``; ``phi`` and ``phi + pi``
+are one constraint): ``phi = 0`` is the paper's constraint (:mod:`rollingtop.contact.meridian`),
 ``phi = pi/2`` the companion paper's (:mod:`rollingtop.contact.parallel`).
 
 The constraint is ideal for every ``phi`` (its reaction, along ``gamma`` and ``d``, does no work
@@ -60,6 +60,10 @@ if TYPE_CHECKING:
 
 #: The slot of ``p`` (after the passage rule's three) that holds ``phi``.
 ANGLE = CONTACT_PARAMS + 3
+#: The angle of the registered model (``[contact] model = "oblique"`` without ``angle``): half
+#: way between the paper's constraint and the companion paper's, so that the model's own name
+#: is neither of them (``rollingtop compare`` runs it beside both).
+DEFAULT_ANGLE = math.pi / 4
 
 #: The model's own parameters: the passage rule's (:data:`rollingtop.contact.parallel.PARAMETERS`)
 #: and the angle ``phi`` (default 0, the paper's constraint).
@@ -67,7 +71,7 @@ PARAMETERS = (
     *PASSAGE,
     RuleParameter(
         "angle",
-        0.0,
+        DEFAULT_ANGLE,
         "phi in radians: no slip along cos(phi) nu + sin(phi) tau (0: the paper's constraint, "
         "pi/2: the companion paper's)",
         positive=False,
@@ -79,7 +83,7 @@ PARAMETERS = (
 def d_carried(p: FloatArray, y: FloatArray) -> Float3:
     """``d = cos(psi_nu - phi) alpha + sin(psi_nu - phi) beta``: the carried ``nu`` turned by
     ``-phi`` about the vertical, ``cos(phi) nu + sin(phi) tau``."""
-    th = y[17] - p[ANGLE]
+    th = y[17] - (DEFAULT_ANGLE + p[ANGLE])  # the slot holds the offset from the default
     c, s = math.cos(th), math.sin(th)
     return c * y[6] + s * y[9], c * y[7] + s * y[10], c * y[8] + s * y[11]
 
@@ -210,7 +214,7 @@ MODEL = ContactModel(
     free_velocity={"v_slip": 1},
     integrals_symmetric=("energy", "jellett"),
     integrals_general=("energy",),
-    velocity=_velocity_for(0.0),
+    velocity=_velocity_for(DEFAULT_ANGLE),
     symbolic=Symbolic(
         _symbolic_directions, _symbolic_velocity, claims="rollingtop.symbolic.oblique:claims"
     ),
@@ -220,7 +224,7 @@ MODEL = ContactModel(
         carries_direction=True,
         determined=False,
     ),
-    colour="#8c564b",
+    colour="#e377c2",
     parameters=PARAMETERS,
     bind=_bind,
 )

@@ -228,15 +228,13 @@ def pole_rate(p: FloatArray, y: FloatArray) -> float:
 
 @inline
 def rule(p: FloatArray) -> tuple[float, float, float]:
-    """The passage rule's ``(S_POLE, RELAX, PASS_RELAX)`` from ``p``'s contact slots
-    (:data:`PARAMETERS`; a slot left 0 is the module's constant)."""
-    s_pole = p[CONTACT_PARAMS]
-    relax = p[CONTACT_PARAMS + 1]
-    pass_relax = p[CONTACT_PARAMS + 2]
+    """The passage rule's ``(S_POLE, RELAX, PASS_RELAX)``: the module's constants plus ``p``'s
+    contact slots, their offsets (:data:`PARAMETERS`,
+    :meth:`rollingtop.contact.ContactModel.params`; 0: the constants)."""
     return (
-        S_POLE if s_pole == 0.0 else s_pole,
-        RELAX if relax == 0.0 else relax,
-        PASS_RELAX if pass_relax == 0.0 else pass_relax,
+        S_POLE + p[CONTACT_PARAMS],
+        RELAX + p[CONTACT_PARAMS + 1],
+        PASS_RELAX + p[CONTACT_PARAMS + 2],
     )
 
 

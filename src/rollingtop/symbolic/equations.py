@@ -172,9 +172,12 @@ def rhs_function(
     d = derive(model, symmetric)
     exprs = [d.field[x] for x in S.state]
     f = sp.lambdify([S.params, S.state, PHI_T], exprs, "numpy")
+    # the oblique model's angle: its default plus its slot of ``params`` (the offset)
+    own = {r.name: r.default for r in get_model(model).parameters}
+    angle = own.get("angle", 0.0)
 
     def rhs(params: FloatArray, y: FloatArray) -> list[float]:
-        t = math.tan(params[12] / 2) if len(params) > 12 else 0.0  # the oblique angle's slot
+        t = math.tan((angle + (params[12] if len(params) > 12 else 0.0)) / 2)
         values: list[float] = f(tuple(params[:7]), tuple(y[:15]), t)  # the body's own
         return values
 
