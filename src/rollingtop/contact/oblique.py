@@ -30,6 +30,7 @@ continuation, as for ``parallel``, and the tools that flag it (``through_vertica
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import TYPE_CHECKING, Any
 
@@ -134,32 +135,35 @@ def sync_direction(y: FloatArray, variant: int) -> None:
     return
 
 
-def _velocity_for(angle: float) -> VelocityFunction:
+def _velocity(
+    angle: float,
+    body: SphericalTop,
+    gamma: FloatArray,
+    omega: FloatArray,
+    alpha: FloatArray,
+    beta: FloatArray,
+    free: FreeVelocity,
+) -> FloatArray:
     """The initial velocity for ``phi = angle``: ``v = -w x r + (v_slip + (w x r, e)) e`` with
     ``e = d x gamma = -sin(phi) nu + cos(phi) tau`` (so ``vp = v + w x r`` is along ``e``)."""
     c, s = math.cos(angle), math.sin(angle)
+    if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction
+        psi_nu = vertical_direction(omega, alpha, beta)
+        nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
+        tau = np.cross(nu, gamma)
+    else:
+        tau, nu = tau_nu(gamma)
+    e = -s * nu + c * tau
+    wxr = np.cross(omega, contact_arm(body, gamma))
+    slip = free["v_slip"] + wxr @ e
+    out: FloatArray = -wxr + slip * e
+    return out
 
-    def velocity(
-        body: SphericalTop,
-        gamma: FloatArray,
-        omega: FloatArray,
-        alpha: FloatArray,
-        beta: FloatArray,
-        free: FreeVelocity,
-    ) -> FloatArray:
-        if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction
-            psi_nu = vertical_direction(omega, alpha, beta)
-            nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
-            tau = np.cross(nu, gamma)
-        else:
-            tau, nu = tau_nu(gamma)
-        e = -s * nu + c * tau
-        wxr = np.cross(omega, contact_arm(body, gamma))
-        slip = free["v_slip"] + wxr @ e
-        out: FloatArray = -wxr + slip * e
-        return out
 
-    return velocity
+def _velocity_for(angle: float) -> VelocityFunction:
+    """:func:`_velocity` at ``angle`` (a ``partial`` of a module function: it pickles, for a
+    model instance sent to a Dask worker)."""
+    return functools.partial(_velocity, float(angle))
 
 
 def _vertical_eigenvalues(body: SphericalTop, omega3: float, pole: int) -> ComplexArray:
