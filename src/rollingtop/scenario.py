@@ -5,7 +5,8 @@ A scenario names a body, a contact model, initial conditions and integration opt
     [body]        R, m, g, a3, I1, I3, optional I2
     [contact]     model = the name of a registered contact model (rollingtop.contact.MODELS;
                   default DEFAULT_MODEL), and the model's own parameters
-                  (ContactModel.parameters: parallel's pole_disk, relax, pass_relax)
+                  (ContactModel.parameters: parallel's pole_disk, relax, pass_relax;
+                  oblique's angle and the same three)
     [shell]       mass, inertia: the spherical shell around the body, for a model with its
                   own inertia (ContactModel.own_inertia: shell-rotor, where it is required;
                   other models refuse it)

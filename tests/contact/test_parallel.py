@@ -338,6 +338,7 @@ def test_the_passage_rule_in_a_scenario(tmp_path, capsys):
         'model = "parallel"\npole_disk = "x"': "pole_disk = 'x' must be a positive number",
         'model = "parallel"\nrelax = true': "relax = True must be a positive number",
         'model = "parallel"\npole = 1e-7': "unknown key contact.pole",
+        'model = "parallel"\npole_disk = 2.0': "pole_disk = 2.0 must be a positive number below 1",
         'model = "meridian"\npole_disk = 1e-7': "unknown key contact.pole_disk",
     }
     for contact, message in cases.items():

@@ -44,12 +44,16 @@ class RuleParameter:
         One line.
     positive : bool
         Whether a value must be ``> 0`` (else any finite number).
+    maximum : float
+        A value must be below this (the ``parallel`` model's disk about the vertical: below 1,
+        the largest tilt).
     """
 
     name: str
     default: float
     description: str
     positive: bool = True
+    maximum: float = math.inf
 
 
 class VerticalDirection(Protocol):
@@ -348,9 +352,15 @@ class ContactModel:
                 )
             ok = isinstance(value, (int, float)) and not isinstance(value, bool)
             number = float(value) if ok else math.nan  # type: ignore[arg-type]
-            if not (math.isfinite(number) and (number > 0 or not known[key].positive)):
-                need = "a positive number" if known[key].positive else "a finite number"
-                raise ContactModelError(f"contact.{key} = {value!r} must be {need}")
+            rule = known[key]
+            if not (
+                math.isfinite(number)
+                and (number > 0 or not rule.positive)
+                and number < rule.maximum
+            ):
+                need = "a positive number" if rule.positive else "a finite number"
+                below = f" below {rule.maximum:g}" if math.isfinite(rule.maximum) else ""
+                raise ContactModelError(f"contact.{key} = {value!r} must be {need}{below}")
             current[key] = number
         if len(current) > N_CONTACT_PARAMS:  # pragma: no cover - a declaration error
             raise ContactModelError(f"model {self.name!r} declares more than {N_CONTACT_PARAMS}")

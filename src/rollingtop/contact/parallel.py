@@ -119,6 +119,7 @@ PARAMETERS = (
         S_POLE,
         "radius (in s = sqrt(1 - gamma3^2)) of the disk about the vertical "
         "inside which the carried constraint direction turns at a bounded rate",
+        maximum=1.0,
     ),
     RuleParameter(
         "relax", RELAX, "rate at which the carried direction relaxes to the axis azimuth"
