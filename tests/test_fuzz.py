@@ -847,8 +847,9 @@ SHORT_RUN_BY_COMMAND = {"verify": {"--model": "meridian"}, "warmup": {"--model":
 #: Drawing the key leaves out these short-run options (``--t-end`` overrides ``--periods``;
 #: ``ensemble`` takes exactly one of ``--initial`` and ``--grid``).
 LEFT_OUT_WITH = {"--periods": {"--t-end"}, "--initial": {"--grid"}}
-#: Valid choices too slow to draw: sympy takes 6-16 s a model (tests/symbolic verify them).
-SLOW_CHOICES = {("verify", "--model"): {"smooth", "parallel", "rubber", "shell-rotor"}}
+#: Valid choices too slow to draw: sympy takes 6-16 s a model, oblique 22 s and over the
+#: fuzz's 60 s on a loaded machine (tests/symbolic verify them all).
+SLOW_CHOICES = {("verify", "--model"): {"smooth", "parallel", "rubber", "shell-rotor", "oblique"}}
 
 
 def output_names(param: click.Parameter) -> list[str]:

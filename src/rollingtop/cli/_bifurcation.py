@@ -3,32 +3,15 @@
 from __future__ import annotations
 
 import json
-import math
 from typing import Any
 
 import click
 
 from rollingtop.cli import _output
 from rollingtop.cli._errors import BadInput
-from rollingtop.cli._options import json_option, scenario_argument
+from rollingtop.cli._options import json_option, parse_range, scenario_argument
 
 __all__ = ["bifurcation"]
-
-
-def _range(flag: str, text: str | None) -> tuple[float, float] | None:
-    """``"LO,HI"`` as two finite, increasing numbers (``None`` for no option)."""
-    from rollingtop._checks import short_repr
-
-    if text is None:
-        return None
-    parts = text.split(",")
-    try:
-        lo, hi = (float(x) for x in parts)
-    except ValueError:
-        raise BadInput(f"{flag} {short_repr(text)}: expected two numbers LO,HI") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-        raise BadInput(f"{flag} {short_repr(text)}: expected finite LO < HI")
-    return lo, hi
 
 
 def _table(summary: dict[str, Any]) -> Any:
@@ -111,9 +94,9 @@ def bifurcation(
     from rollingtop.scenario import load_scenario
 
     ranges = {
-        "C2": _range("--c2-range", c2_range),
-        "h": _range("--h-range", h_range),
-        "C1": _range("--c1-range", c1_range),
+        "C2": parse_range("--c2-range", c2_range),
+        "h": parse_range("--h-range", h_range),
+        "C1": parse_range("--c1-range", c1_range),
     }
     if output is not None:
         from rollingtop.io import check_output_path
@@ -134,7 +117,7 @@ def bifurcation(
                 f"{', '.join(given)}: the paper's model's windows; the "
                 f"{sc.model.name} model's is --axis-range"
             )
-        _other_model(sc, as_json, output, _range("--axis-range", axis_range))
+        _other_model(sc, as_json, output, parse_range("--axis-range", axis_range))
         return
     if axis_range is not None:
         raise BadInput(

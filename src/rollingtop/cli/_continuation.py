@@ -10,23 +10,10 @@ import click
 
 from rollingtop.chaos.continuation import PARAMETERS
 from rollingtop.cli import _output
-from rollingtop.cli._options import json_option, scenario_argument
+from rollingtop.cli._options import json_option, parse_range, scenario_argument
 from rollingtop.cli._periodic import find_orbits, seeding_options
 
 __all__ = ["continue_"]
-
-
-def _range(text: str) -> tuple[float, float]:
-    from rollingtop.cli._errors import BadInput
-
-    parts = text.split(",")
-    try:
-        lo, hi = (float(p) for p in parts)
-    except ValueError:
-        raise BadInput(f"--range {text!r} must be two numbers A,B") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-        raise BadInput(f"--range {text!r} must be two finite numbers A,B with A < B")
-    return lo, hi
 
 
 def _check_own_value(scenario: str, param: str, bounds: tuple[float, float]) -> None:
@@ -117,7 +104,9 @@ def continue_(
     from rollingtop.io import check_output_path
     from rollingtop.plot import FIGURE_SUFFIXES
 
-    bounds = _range(span)
+    bounds = parse_range("--range", span)
+    if bounds is None:  # pragma: no cover - click requires the option
+        raise BadInput("--range is required")
     if output is not None:
         check_output_path(output, FIGURE_SUFFIXES)
     if step is not None and not math.isfinite(step):

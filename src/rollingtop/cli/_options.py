@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import click
@@ -14,6 +15,7 @@ __all__ = [
     "atol_option",
     "figure_output",
     "json_option",
+    "parse_range",
     "rtol_option",
     "scenario_argument",
     "t_end_option",
@@ -60,3 +62,20 @@ atol_option = click.option("--atol", type=float, default=None, help="Absolute to
 figure_output = click.option(
     "-o", "--output", type=click.Path(), required=True, help="FIG.png, .svg or .pdf."
 )
+
+
+def parse_range(flag: str, text: str | None) -> tuple[float, float] | None:
+    """``"LO,HI"`` as two finite, increasing numbers (``None`` for no option); ``BadInput``
+    naming ``flag`` otherwise (``bifurcation``'s ranges, ``continue --range``)."""
+    from rollingtop.cli._errors import BadInput
+
+    if text is None:
+        return None
+    parts = text.split(",")
+    try:
+        lo, hi = (float(x) for x in parts)
+    except ValueError:
+        raise BadInput(f"{flag} {short_repr(text)}: expected two numbers LO,HI") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise BadInput(f"{flag} {short_repr(text)}: expected finite LO < HI")
+    return lo, hi

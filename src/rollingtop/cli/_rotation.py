@@ -8,9 +8,8 @@ from typing import Any
 import click
 
 from rollingtop.cli import _output
-from rollingtop.cli._bifurcation import _range
 from rollingtop.cli._errors import BadInput
-from rollingtop.cli._options import json_option, scenario_argument
+from rollingtop.cli._options import json_option, parse_range, scenario_argument
 
 __all__ = ["rotation"]
 
@@ -74,7 +73,7 @@ def rotation(
 
     if not 3 <= resolution <= 1000:
         raise BadInput(f"--resolution {resolution}: must be between 3 and 1000")
-    c2_window, h_window = _range("--c2-range", c2_range), _range("--h-range", h_range)
+    c2_window, h_window = parse_range("--c2-range", c2_range), parse_range("--h-range", h_range)
     if output is not None:
         from rollingtop.io import check_output_path
         from rollingtop.plot import FIGURE_SUFFIXES
@@ -89,7 +88,9 @@ def rotation(
                 f"--c2-range: the paper's model's window; the {sc.model.name} "
                 "model's is --axis-range"
             )
-        _other_model(sc, as_json, output, _range("--axis-range", axis_range), h_window, resolution)
+        _other_model(
+            sc, as_json, output, parse_range("--axis-range", axis_range), h_window, resolution
+        )
         return
     if axis_range is not None:
         raise BadInput(

@@ -274,6 +274,20 @@ def tau_nu(gamma: FloatArray) -> tuple[FloatArray, FloatArray]:
     return np.array([-g2, g1, 0.0]) / s, np.array([-g3 * g1 / s, -g3 * g2 / s, s])
 
 
+def horizontal_basis(
+    gamma: FloatArray, omega: FloatArray, alpha: FloatArray, beta: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """``(tau, nu)`` of a state being built (:func:`tau_nu`); at a vertical axis, where they are
+    undefined, ``nu`` is the carried direction the axis leaves in
+    (:func:`vertical_direction`) and ``tau = nu x gamma``. The initial velocity of every model
+    with a direction in the plane of ``nu`` and ``tau`` (meridian, parallel, oblique)."""
+    if gamma[0] == 0.0 and gamma[1] == 0.0:
+        psi_nu = vertical_direction(omega, alpha, beta)
+        nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
+        return np.cross(nu, gamma), nu
+    return tau_nu(gamma)
+
+
 def vertical_direction(
     omega: FloatArray, alpha: FloatArray, beta: FloatArray, psi_nu: float = 0.0
 ) -> float:
@@ -312,12 +326,7 @@ def _velocity(
     beta: FloatArray,
     free: FreeVelocity,
 ) -> FloatArray:
-    if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction (module docstring)
-        psi_nu = vertical_direction(omega, alpha, beta)
-        nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
-        tau = np.cross(nu, gamma)
-    else:
-        tau, _ = tau_nu(gamma)
+    tau, _ = horizontal_basis(gamma, omega, alpha, beta)
     wxr = np.cross(omega, contact_arm(body, gamma))
     slip = free["v_tau"] + wxr @ tau  # contact-point velocity vp = slip * tau
     return -wxr + slip * tau

@@ -50,7 +50,7 @@ from rollingtop.contact._base import (
 )
 from rollingtop.contact._closed import project_contact, rhs_contact
 from rollingtop.contact._rows import contact_row, normal_row
-from rollingtop.contact.meridian import tau_nu, vertical_direction
+from rollingtop.contact.meridian import horizontal_basis, vertical_direction
 from rollingtop.contact.parallel import PARAMETERS as PASSAGE
 from rollingtop.contact.parallel import carried_rate, tau_rate
 
@@ -147,12 +147,7 @@ def _velocity(
     """The initial velocity for ``phi = angle``: ``v = -w x r + (v_slip + (w x r, e)) e`` with
     ``e = d x gamma = -sin(phi) nu + cos(phi) tau`` (so ``vp = v + w x r`` is along ``e``)."""
     c, s = math.cos(angle), math.sin(angle)
-    if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction
-        psi_nu = vertical_direction(omega, alpha, beta)
-        nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
-        tau = np.cross(nu, gamma)
-    else:
-        tau, nu = tau_nu(gamma)
+    tau, nu = horizontal_basis(gamma, omega, alpha, beta)  # at the vertical: the carried ones
     e = -s * nu + c * tau
     wxr = np.cross(omega, contact_arm(body, gamma))
     slip = free["v_slip"] + wxr @ e

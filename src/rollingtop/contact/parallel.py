@@ -96,7 +96,7 @@ from rollingtop.contact._rows import (
     normal_row,
     row_bias,
 )
-from rollingtop.contact.meridian import tau_nu, vertical_direction
+from rollingtop.contact.meridian import horizontal_basis, vertical_direction
 
 if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
@@ -328,11 +328,7 @@ def _velocity(
     beta: FloatArray,
     free: FreeVelocity,
 ) -> FloatArray:
-    if gamma[0] == 0.0 and gamma[1] == 0.0:  # vertical: the carried direction (module docstring)
-        psi_nu = vertical_direction(omega, alpha, beta)
-        nu = math.cos(psi_nu) * np.asarray(alpha) + math.sin(psi_nu) * np.asarray(beta)
-    else:
-        _, nu = tau_nu(gamma)
+    _, nu = horizontal_basis(gamma, omega, alpha, beta)  # at the vertical: the carried one
     wxr = np.cross(omega, contact_arm(body, gamma))
     slip = free["v_nu"] + wxr @ nu  # contact-point velocity vp = slip * nu
     out: FloatArray = -wxr + slip * nu
