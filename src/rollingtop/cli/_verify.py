@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import re
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -70,6 +70,63 @@ def _table(results: list[ClaimResult]) -> Table:
     return table
 
 
+#: The paper's body: what ``verify --search`` searches without ``--body``.
+PAPER_BODY = {"R": 1.0, "m": 1.0, "g": 1.0, "a3": 0.1, "I1": 0.3, "I3": 0.5}
+
+
+def _search_table(result: Any) -> Table:
+    from rich.table import Table
+
+    body = ", ".join(f"{n} = {v}" for n, v in result.body)
+    roots = ", ".join(f"{a:.6g}" for a in result.density_angles) or "none"
+    table = Table(
+        title=f"oblique family, {body}",
+        caption=(
+            f"a density of gamma3 alone: only where {result.obstruction.as_expr()} = 0 "
+            f"(phi = {roots}), symbolically in t = tan(phi/2). Columns: upper bound / what the "
+            "classical integrals account for (equal: nothing else in that class; density "
+            "bound 0: none); coefficients any functions of gamma3"
+        ),
+    )
+    for col in ("phi", "t", "density deg 0..N", "linear", "quadratic", "integrals"):
+        table.add_column(col, no_wrap=col != "integrals")
+    for a in result.angles:
+        dens = [a.bounds[k] for k in sorted(a.bounds) if k.startswith("density")]
+        table.add_row(
+            f"{a.angle:.4f}",
+            str(a.t),
+            " ".join(map(str, dens)),
+            f"{a.bounds['linear']} / {a.known['linear']}",
+            f"{a.bounds['quadratic']} / {a.known['quadratic']}",
+            ", ".join(a.integrals),
+        )
+    return table
+
+
+def _search(bodies: tuple[str, ...], as_json: bool) -> None:
+    """``verify --search``: :func:`rollingtop.symbolic.oblique_search.search` for each body."""
+    from rollingtop.scenario import load_scenario
+    from rollingtop.symbolic.oblique_search import DEFAULT_T, search
+
+    chosen = []
+    for path in bodies:
+        body = load_scenario(path).body
+        if body.I1 != body.I2:
+            raise BadInput(f"{path}: the search needs a dynamically symmetric body (I1 = I2)")
+        chosen.append({k: getattr(body, k) for k in PAPER_BODY})
+    results = []
+    for values in chosen or [PAPER_BODY]:
+        with _output.counting("angles searched", len(DEFAULT_T)) as progress:
+            done = (lambda k: progress(k, len(DEFAULT_T))) if progress else None
+            results.append(search(values, progress=done))
+    if as_json:
+        click.echo(json.dumps({"search": [r.to_dict() for r in results]}))
+        return
+    console = _output.console(piped_width=PIPED_WIDTH)
+    for r in results:
+        console.print(_search_table(r))
+
+
 @click.command()
 @click.option(
     "--model",
@@ -78,11 +135,40 @@ def _table(results: list[ClaimResult]) -> Table:
     multiple=True,
     help="Model(s) to verify (default: all).",
 )
+@click.option(
+    "--search",
+    "search",
+    is_flag=True,
+    help="Search the oblique family (every constraint angle phi) for an invariant measure and "
+    "integrals linear or quadratic in the velocities, instead of checking the claims.",
+)
+@click.option(
+    "--body",
+    "bodies",
+    type=click.Path(exists=True, dir_okay=False),
+    multiple=True,
+    help="With --search: a scenario file whose [body] to search (repeatable; default: the "
+    "paper's body).",
+)
 @json_option
 @click.pass_context
-def verify(ctx: click.Context, models: tuple[ContactModel, ...], as_json: bool) -> None:
+def verify(
+    ctx: click.Context,
+    models: tuple[ContactModel, ...],
+    search: bool,
+    bodies: tuple[str, ...],
+    as_json: bool,
+) -> None:
     """Machine-check the equations' claims with sympy: first integrals, identities, the reduced
-    system (3.3) and its invariant measure."""
+    system (3.3) and its invariant measure. With --search, search the oblique family for an
+    invariant measure and integrals, by angle."""
+    if bodies and not search:
+        raise BadInput("--body is an option of --search")
+    if search:
+        if models:
+            raise BadInput("--search searches the oblique family: leave out --model")
+        _search(bodies, as_json)
+        return
     try:
         from rollingtop.symbolic import verify as run_claims
     except ImportError as exc:  # pragma: no cover - sympy missing
