@@ -3,6 +3,7 @@ slider, a click, the URL, a bad URL, the redraw's latency, and the server's star
 
 import io
 import json
+import math
 import signal
 import statistics
 import subprocess
@@ -25,8 +26,10 @@ pytestmark = pytest.mark.xdist_group("browser")
 #: benchmarks/explore_page.py measures it -- speed is never asserted as a time in a test).
 HANG_S = 10.0
 
-#: The text inputs of the sliders, in order: the body's R, m, a3, I1, I3, g, then the level's.
+#: The text inputs of the sliders, in order: the body's R, m, a3, I1, I3, g, then the contact
+#: model's parameters (the oblique model's angle), then the level's.
 C2_INPUT = 8
+ANGLE_INPUT = 6
 
 
 def _equilibria_count(capsys, path):
@@ -153,6 +156,26 @@ def test_another_model_is_chosen_on_the_page(page, served):
     assert "C2=" not in page.url and "M3=" not in page.url and "routh=" in page.url
     page.goto(page.url)  # and loads it again: the same view
     page.get_by_text("rough model: jellett = ").first.wait_for(timeout=30_000)
+    assert not page.locator(".rt-message").first.is_visible()
+
+
+def test_the_oblique_model_has_an_angle_slider(page, served, tmp_path):
+    """Issue 39, item 4: choosing oblique shows its angle (the registered pi/4) as a slider;
+    moving it redraws the section under the new angle and the URL follows."""
+    _, url = served
+    page.goto(url)
+    page.get_by_text("steady motions: 3").first.wait_for(timeout=30_000)
+    page.locator("select").first.select_option("oblique")
+    page.get_by_text("oblique model, angle = 0.785398").first.wait_for(timeout=60_000)
+    page.wait_for_url("**angle=0.785398**", timeout=10_000)
+    assert page.get_by_text("contact", exact=True).count() == 1
+    field = page.locator("input").nth(ANGLE_INPUT)
+    assert float(field.input_value()) == pytest.approx(math.pi / 4, abs=1e-6)
+    field.fill("0.3")
+    field.press("Enter")
+    page.get_by_text("oblique model, angle = 0.3:").first.wait_for(timeout=60_000)
+    page.wait_for_url("**angle=0.3**", timeout=10_000)
+    page.screenshot(path=str(tmp_path / "oblique.png"))
     assert not page.locator(".rt-message").first.is_visible()
 
 

@@ -432,3 +432,34 @@ def test_the_section_view_marks_the_orbits_in_its_own_plane():
         # within the approach still left after the page's short runs (about 2e-2); in the
         # carried direction's signs (the plane before) the 4-cycles' points were 0.12 away
         assert np.all(gaps < 0.05), (returns, gaps)
+
+
+def test_the_oblique_models_angle_is_a_parameter_of_the_view(fig5):
+    """Issue 39, item 4: choosing ``oblique`` gives its registered angle; the URL's ``angle``
+    sets it (the section runs under that angle: its crossings hold the energy of the state
+    built under it, and a different angle gives different crossings); a bad angle is one
+    line; another model has no ``angle``."""
+    from rollingtop.contact.oblique import DEFAULT_ANGLE, oblique
+    from rollingtop.dynamics.integrals import energy
+
+    state = fig5.with_model("oblique")
+    assert state.contact == (("angle", DEFAULT_ANGLE),) and not state.reduces
+    tilted = parse_query({"angle": "0.3"}, state)
+    assert tilted.contact_model.parameter_values["angle"] == 0.3
+    assert tilted.to_query()["angle"] == repr(0.3)
+    assert parse_query(tilted.to_query(), fig5.with_model("oblique")) == tilted
+    view = section_view(tilted)
+    y = tilted.reference_state()
+    np.testing.assert_allclose(energy(fig5.body, view.states[:10]), energy(fig5.body, y), rtol=1e-8)
+    assert "angle = 0.3" in view.readout
+    other = section_view(parse_query({"angle": "1.2"}, state))
+    assert other.points.shape != view.points.shape or not np.allclose(
+        other.points[:20], view.points[:20]
+    )
+    # the state's field is the model's at that angle: the model the section ran is oblique(0.3)
+    assert tilted.contact_model.parameter_values == oblique(0.3).parameter_values
+    with pytest.raises(ScenarioError, match="angle = 'x' is not a number"):
+        parse_query({"angle": "x"}, state)
+    with pytest.raises(ScenarioError, match="unknown parameter 'angle' for the meridian"):
+        parse_query({"angle": "0.3"}, fig5)
+    assert fig5.with_model("oblique").with_model("meridian").contact == ()

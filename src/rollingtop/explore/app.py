@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import math
 from collections.abc import Callable
 from concurrent.futures import Executor
 from typing import Any
@@ -39,6 +40,7 @@ from rollingtop.explore.path import PATH_SAMPLES, PATH_T_END, path_view
 from rollingtop.explore.section import section_view
 from rollingtop.explore.view import (
     BODY_KEYS,
+    CONTACT_KEYS,
     H_KEY,
     ExploreState,
     cached_diagram_view,
@@ -54,6 +56,7 @@ __all__ = ["ExplorePage", "LOOKS", "QUERY_KEYS"]
 QUERY_KEYS: tuple[str, ...] = (
     "model",
     *BODY_KEYS,
+    *CONTACT_KEYS,
     *dict.fromkeys(k for m in MODELS.values() for k in m.reduction),
     H_KEY,
 )
@@ -116,6 +119,7 @@ class ExplorePage(pn.viewable.Viewer):
     I1 = _query_value("the body's equatorial moment of inertia (I2 = I1)")
     I3 = _query_value("the body's axial moment of inertia")
     g = _query_value("gravity")
+    angle = _query_value("the oblique model's constraint angle phi (radians)")
     M3 = _query_value("level: Lagrange's integral I3 w3")
     C1 = _query_value("level: the area integral")
     C2 = _query_value("level: the paper's F6 (meridian, shell-rotor)")
@@ -311,6 +315,21 @@ class ExplorePage(pn.viewable.Viewer):
         self.level_box = pn.Column()
         self.level_sliders: dict[str, Any] = {}
         self._build_level_sliders()
+        self.contact_box = pn.Column()
+        self.contact_sliders: dict[str, Any] = {}
+        self._build_contact_sliders()
+
+    def _build_contact_sliders(self) -> None:
+        """A slider for each of the model's parameters on the page (the oblique model's angle,
+        over ``[-pi/2, pi/2]``: ``phi`` and ``phi + pi`` are one constraint)."""
+        self.contact_sliders = {
+            key: self._slider(key, v, -math.pi / 2, math.pi / 2) for key, v in self.state.contact
+        }
+        self.contact_box.objects = (
+            [pn.pane.Markdown("**contact**"), *self.contact_sliders.values()]
+            if self.contact_sliders
+            else []
+        )
 
     def _build_level_sliders(self) -> None:
         self.level_sliders = {}
@@ -318,7 +337,8 @@ class ExplorePage(pn.viewable.Viewer):
         for key, v in items.items():
             span = max(1.0, 2.0 * abs(v))
             self.level_sliders[key] = self._slider(key, v, v - span, v + span)
-        self.level_box.objects = list(self.level_sliders.values())
+        header = [pn.pane.Markdown("**level**")] if self.level_sliders else []
+        self.level_box.objects = [*header, *self.level_sliders.values()]
 
     def _sync_widgets(self) -> None:
         """The widgets set to :attr:`state`, without their callbacks."""
@@ -327,6 +347,12 @@ class ExplorePage(pn.viewable.Viewer):
             self.model_select.value = self.state.model
             for key, w in self.body_sliders.items():
                 w.value = float(getattr(self.state.body, key))
+            if set(dict(self.state.contact)) != set(self.contact_sliders):
+                self._build_contact_sliders()
+            for key, v in self.state.contact:
+                w = self.contact_sliders[key]
+                w.start, w.end = min(w.start, v), max(w.end, v)
+                w.value = float(v)
             items = {**self.state.level, **({"h": self.state.h} if self.state.level else {})}
             if set(items) != set(self.level_sliders):
                 self._build_level_sliders()
@@ -345,7 +371,7 @@ class ExplorePage(pn.viewable.Viewer):
             self.look_select,
             pn.pane.Markdown("**body**"),
             *self.body_sliders.values(),
-            pn.pane.Markdown("**level**"),
+            self.contact_box,
             self.level_box,
             width=290,
         )
@@ -362,7 +388,8 @@ class ExplorePage(pn.viewable.Viewer):
         """The widgets' values as a URL query (an emptied text field: ``""``, which
         :func:`parse_query` refuses by name)."""
         query = {"model": self.state.model}
-        for k, w in (*self.body_sliders.items(), *self.level_sliders.items()):
+        sliders = (self.body_sliders, self.contact_sliders, self.level_sliders)
+        for k, w in (item for group in sliders for item in group.items()):
             query[k] = "" if w.value is None else repr(float(w.value))
         return query
 
@@ -378,6 +405,7 @@ class ExplorePage(pn.viewable.Viewer):
         axis = self._axis()
         diagram = (
             state.model != self.state.model
+            or state.contact != self.state.contact
             or state.body != self.state.body
             or {k: v for k, v in state.level.items() if k != axis}
             != {k: v for k, v in self.state.level.items() if k != axis}
@@ -499,7 +527,8 @@ class ExplorePage(pn.viewable.Viewer):
 
             with warnings.catch_warnings():  # in the page's summary instead
                 warnings.simplefilter("ignore", ContactLostWarning)
-                traj = simulate(state.body, state.model, x, t_end=PATH_T_END, samples=PATH_SAMPLES)
+                model = state.contact_model
+                traj = simulate(state.body, model, x, t_end=PATH_T_END, samples=PATH_SAMPLES)
             return traj, None
         view = path_view(state, x, w)
         return view.trajectory, view

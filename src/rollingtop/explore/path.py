@@ -66,7 +66,7 @@ def path_view(
     y0 = state_from_level(level, h, gamma3, branch=branch, theta=theta)
     with warnings.catch_warnings():  # the loss of contact is in the page's summary instead
         warnings.simplefilter("ignore", ContactLostWarning)
-        traj = simulate(state.body, state.model, y0, t_end=t_end, samples=PATH_SAMPLES)
+        traj = simulate(state.body, state.contact_model, y0, t_end=t_end, samples=PATH_SAMPLES)
     pos = traj.y[:, 15:17]
     summary = f"h = {h:.6g}"
     found = [o for o in orbits(level, h) if o.theta_min - 1e-9 <= theta <= o.theta_max + 1e-9]

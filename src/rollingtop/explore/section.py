@@ -52,7 +52,7 @@ def section_view(state: ExploreState) -> SectionView:
     y = state.reference_state()
     ds = poincare_section(
         state.body,
-        state.model,
+        state.contact_model,
         y,
         crossings=SECTION_CROSSINGS,
         trajectories=SECTION_TRAJECTORIES,
@@ -65,12 +65,13 @@ def section_view(state: ExploreState) -> SectionView:
     else:
         from rollingtop.chaos._section_map import section_coordinates
 
-        x = section_coordinates(state.model, ys)
+        x = section_coordinates(state.contact_model, ys)
         g3, wn = x[:, 0], x[:, 1]
     ok = np.isfinite(g3) & np.isfinite(wn)
     held = ds.attrs["held"].replace(",", ", ")
+    angle = "".join(f", {k} = {v:.6g}" for k, v in state.contact)
     readout = (
-        f"{state.model} model: no reduction; Poincare section of the level of the "
+        f"{state.model} model{angle}: no reduction; Poincare section of the level of the "
         f"scenario's state (held: {held}) | {int(ok.sum())} crossings"
     )
     if orbits:
@@ -90,7 +91,7 @@ def _orbits(state: ExploreState, y: FloatArray) -> list[tuple[int, str, FloatArr
     try:
         found = periodic_orbits(
             state.body,
-            state.model,
+            state.contact_model,
             y,
             returns=ORBIT_RETURNS,
             trajectories=SECTION_TRAJECTORIES,

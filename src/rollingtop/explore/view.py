@@ -25,6 +25,7 @@ from rollingtop.scenario import Scenario
 
 __all__ = [
     "BODY_KEYS",
+    "CONTACT_KEYS",
     "ExploreState",
     "LevelView",
     "DiagramView",
@@ -42,6 +43,14 @@ __all__ = [
 BODY_KEYS = ("R", "m", "a3", "I1", "I3", "g")
 #: Reduced energy's key in the URL.
 H_KEY = "h"
+#: The contact models' parameters the page offers as sliders (where the model has them): the
+#: oblique family's constraint angle (rollingtop.contact.oblique).
+CONTACT_KEYS = ("angle",)
+
+
+def _contact_defaults(name: str) -> tuple[tuple[str, float], ...]:
+    """The registered values of the model ``name``'s parameters among :data:`CONTACT_KEYS`."""
+    return tuple((r.name, r.default) for r in get_model(name).parameters if r.name in CONTACT_KEYS)
 
 
 @dataclass(frozen=True)
@@ -51,7 +60,8 @@ class ExploreState:
     ``start`` is the reference state's ``(gamma, omega)`` (body frame): the scenario's initial
     state, or its start on the level; a model chosen on the page takes its level from it.
     ``level`` is empty for a model without a reduction (the page then shows a Poincare section
-    of the reference state's level).
+    of the reference state's level). ``contact`` holds the model's parameters among
+    :data:`CONTACT_KEYS` (the oblique model's ``angle``), as ``(name, value)`` pairs.
     """
 
     model: str
@@ -62,27 +72,41 @@ class ExploreState:
     #: The scenario's own model, body and full state (its free velocity components included):
     #: used as it is while the page shows that model and body.
     own: tuple[str, SphericalTop, tuple[float, ...]] | None = None
+    contact: tuple[tuple[str, float], ...] = ()
+    #: The scenario's own values of :attr:`contact` (its state is used as it is only with them).
+    own_contact: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def contact_model(self) -> Any:
+        """The :class:`~rollingtop.contact.ContactModel` of this view: the model with the
+        values of :attr:`contact`."""
+        model = get_model(self.model)
+        return model.with_parameters(**dict(self.contact)) if self.contact else model
 
     def reference_state(self) -> FloatArray:
         """The full state of the reference state under this view's model and body: the
         scenario's own where they are its own, else built from :attr:`start`
         (:func:`rollingtop.initial_state`, the free velocity components 0, rubber's ``omega``
         projected as ``compare-classification`` does)."""
-        if self.own is not None and self.own[:2] == (self.model, self.body):
+        if (
+            self.own is not None
+            and self.own[:2] == (self.model, self.body)
+            and self.contact == self.own_contact
+        ):
             return np.array(self.own[2], dtype=float)
         from rollingtop.dynamics.state import initial_state
         from rollingtop.reduction.classify import admissible_omega
 
         gamma, omega = self.start
         w, _ = admissible_omega(self.model, gamma, omega)
-        y: FloatArray = initial_state(self.body, self.model, gamma=gamma, omega=w)
+        y: FloatArray = initial_state(self.body, self.contact_model, gamma=gamma, omega=w)
         return y
 
     def __hash__(self) -> int:
         """Equal views hash alike (the level's order does not matter, as in ``==``): the page
         caches its views on the state (:func:`cached_level_view`)."""
         level = tuple(sorted(self.level.items()))
-        return hash((self.model, self.body, level, self.h, self.start, self.own))
+        return hash((self.model, self.body, level, self.h, self.start, self.own, self.contact))
 
     @property
     def reduces(self) -> bool:
@@ -102,6 +126,7 @@ class ExploreState:
         loaded URL restores the same doubles)."""
         query = {"model": self.model}
         query |= {k: repr(float(getattr(self.body, k))) for k in BODY_KEYS}
+        query |= {k: repr(float(v)) for k, v in self.contact}
         query |= {k: repr(float(v)) for k, v in self.level.items()}
         if self.reduces:
             query[H_KEY] = repr(float(self.h))
@@ -114,16 +139,21 @@ class ExploreState:
         from rollingtop.reduction.models import REDUCTIONS
 
         model = get_model(name)
+        contact = _contact_defaults(model.name)
         if model.name not in REDUCTIONS:
-            return replace(self, model=model.name, level={}, h=math.nan)
+            return replace(self, model=model.name, level={}, h=math.nan, contact=contact)
         from rollingtop.reduction.models import reduction_of
 
-        y = replace(self, model=model.name).reference_state()
+        y = replace(self, model=model.name, contact=contact).reference_state()
         reduction = reduction_of(model.name)
         level = reduction.level_of_state(self.body, y)
         values = {k: float(v) for k, v in level.values().items()}
         return replace(
-            self, model=model.name, level=values, h=float(reduction.reduced_energy(self.body, y))
+            self,
+            model=model.name,
+            level=values,
+            h=float(reduction.reduced_energy(self.body, y)),
+            contact=contact,
         )
 
 
@@ -157,8 +187,20 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
     omega = tuple(float(v) for v in y[W])
     start = (gamma, omega)
     own = (sc.model.name, body, tuple(float(v) for v in y))
+    contact = tuple(
+        (k, float(v)) for k, v in sc.model.parameter_values.items() if k in CONTACT_KEYS
+    )
     if not sc.model.reduction:
-        return ExploreState(sc.model.name, body, {}, math.nan, start, own)  # type: ignore[arg-type]
+        return ExploreState(
+            sc.model.name,
+            body,
+            {},
+            math.nan,
+            start,  # type: ignore[arg-type]
+            own,
+            contact,
+            contact,
+        )
     level = sc.level_set()
     values = {k: float(v) for k, v in level.values().items()}
     return ExploreState(
@@ -168,6 +210,8 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
         float(sc.level_h()),
         start,  # type: ignore[arg-type]
         own,
+        contact,
+        contact,
     )
 
 
@@ -188,7 +232,13 @@ def parse_query(query: Mapping[str, Any], base: ExploreState) -> ExploreState:
         if name not in MODELS:
             raise ScenarioError(f"model = {name!r} is not a contact model ({', '.join(MODELS)})")
         state = base.with_model(name)
-    allowed = ("model", *BODY_KEYS, *state.level, *((H_KEY,) if state.reduces else ()))
+    allowed = (
+        "model",
+        *BODY_KEYS,
+        *dict(state.contact),
+        *state.level,
+        *((H_KEY,) if state.reduces else ()),
+    )
     numbers: dict[str, float] = {}
     for key, text in flat.items():
         if key == "model":
@@ -219,6 +269,13 @@ def parse_query(query: Mapping[str, Any], base: ExploreState) -> ExploreState:
         except RollingTopError as err:
             raise ScenarioError(f"body: {err}") from None
         state = replace(state, body=body)
+    contact = tuple((k, numbers.get(k, v)) for k, v in state.contact)
+    if contact != state.contact:
+        try:
+            get_model(state.model).with_parameters(**dict(contact))
+        except RollingTopError as err:
+            raise ScenarioError(f"contact: {err}") from None
+        state = replace(state, contact=contact)
     level = {k: numbers.get(k, v) for k, v in state.level.items()}
     h = numbers.get(H_KEY, state.h)
     state = replace(state, level=level, h=h)
