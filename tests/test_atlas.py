@@ -279,7 +279,7 @@ def test_a_model_other_than_the_meridian_one_is_an_atlas_of_its_own():
         ({"model": "rough"}, "meridian", True, "non-empty list"),
         ({"model": ["rough"], "C2": [0.0]}, "meridian", True, "takes body keys and model"),
         ({"model": ["rough"]}, "meridian", False, "needs an \\[initial\\] table"),
-        ({"a3": [0.1]}, "parallel", True, "parallel model has no reduction"),
+        ({"C2": [0.1]}, "parallel", True, "parallel model has no reduction"),
         ({"model": ["rubber"]}, ["rubber"], True, "must be a model name"),
     ],
 )

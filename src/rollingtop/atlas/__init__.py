@@ -18,6 +18,10 @@ The spec is a scenario file (``[body]``, ``[contact]``, ``[level]`` give the fix
 an ``[axes]`` table whose keys are body or level keys, each a list of values or
 ``{start, stop, num}``; the Dataset's dimensions follow the order of ``[axes]``.
 
+A spec whose contact model has no reduction (``oblique`` over its constraint ``angle``,
+``parallel``) is a *chaos atlas* (issue 39): each cell's chaos indicators, phase-volume rate and
+periodic orbits on the level of the spec's initial state (:mod:`._chaos`).
+
 The package's modules, each imported only by those after it: :mod:`._cells` (the classification
 of a chunk of cells, one Dask task), :mod:`._spec` (the spec and its validation), :mod:`._store`
 (the partial folder and the output), :mod:`._run` (the run on Dask); :mod:`._display` registers

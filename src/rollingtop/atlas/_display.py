@@ -21,6 +21,8 @@ __all__ = ["COUNTED", "AtlasAccessor"]
 
 #: The variables whose values :meth:`AtlasAccessor.counts` counts over the classified cells.
 COUNTED = ("n_steady", "n_centres", "n_saddles", "n_folds")
+#: The same for a chaos atlas (:mod:`rollingtop.atlas._chaos`).
+CHAOS_COUNTED = ("n_finished", "n_vertical", "n_periodic", "n_attracting")
 
 
 class AtlasAccessor:
@@ -53,11 +55,12 @@ class AtlasAccessor:
         return {STATUS.get(int(v), str(int(v))): int(c) for v, c in zip(values, n, strict=True)}
 
     def counts(self) -> dict[str, dict[int, int]]:
-        """For each of :data:`COUNTED`: how many classified cells (``status == 0``) have each
-        value (``rollingtop atlas``' summary)."""
+        """For each of :data:`COUNTED` (:data:`CHAOS_COUNTED` for a chaos atlas): how many
+        classified cells (``status == 0``) have each value (``rollingtop atlas``' summary)."""
         classified = self._ds["status"].values == 0
         out = {}
-        for name in COUNTED:
+        counted = CHAOS_COUNTED if self._ds.attrs.get("kind") == "chaos" else COUNTED
+        for name in counted:
             values, n = np.unique(self._ds[name].values[classified], return_counts=True)
             out[name] = {int(v): int(c) for v, c in zip(values, n, strict=True)}
         return out

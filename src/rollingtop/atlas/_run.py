@@ -241,7 +241,7 @@ def atlas(
     digest = spec.digest(chunk)
     folder = None if out_path is None else _partial_folder(out_path)
     ranges = {k: (start, min(start + chunk, spec.size)) for k, start in enumerate(starts)}
-    done = {} if folder is None else _load_partial(folder, digest, ranges)
+    done = {} if folder is None else _load_partial(folder, digest, ranges, spec.kind)
     created = False
     if folder is not None and not folder.exists():
         folder.mkdir()
@@ -285,7 +285,7 @@ def _compute(
         with connect() as c:
             futures = {
                 c.submit(
-                    classify_cells,
+                    cells_function(spec.kind),
                     spec.fixed,
                     names,
                     cells[starts[k] : starts[k] + chunk],
@@ -350,6 +350,17 @@ def _collect(
             progress(finished, total)
 
 
+def cells_function(kind: str) -> Callable[..., dict[str, np.ndarray]]:
+    """The task of a chunk of cells of an atlas of ``kind``: :func:`classify_cells` or
+    :func:`~rollingtop.atlas._chaos.chaos_cells`."""
+    if kind == "chaos":
+        from rollingtop.atlas._chaos import chaos_cells
+
+        return chaos_cells
+    return classify_cells
+
+
 def classify_in_process(spec: AtlasSpec) -> xr.Dataset:
     """The same Dataset computed in this process, without Dask (small atlases, tests)."""
-    return _dataset(spec, {0: classify_cells(spec.fixed, tuple(spec.axes), spec.cells())})
+    cells = cells_function(spec.kind)(spec.fixed, tuple(spec.axes), spec.cells())
+    return _dataset(spec, {0: cells})

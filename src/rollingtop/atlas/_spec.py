@@ -24,7 +24,7 @@ from rollingtop.io import read_input_text
 
 __all__ = ["AtlasError", "AtlasSpec", "atlas_spec_from_dict", "load_atlas_spec"]
 
-AXIS_KEYS = (*BODY_KEYS, *LEVEL_KEYS, "model")
+AXIS_KEYS = (*BODY_KEYS, *LEVEL_KEYS, "model", "angle")
 #: Largest number of cells of one atlas.
 MAX_CELLS = 10_000_000
 #: Cells per Dask task (a chunk, and a file of the partial folder).
@@ -66,10 +66,17 @@ class AtlasSpec:
 
     fixed: dict[str, float]
     axes: dict[str, FloatArray]
+    #: ``reduction`` (the cells' levels classified, :mod:`._cells`) or ``chaos`` (the cells'
+    #: chaos indicators and periodic orbits, :mod:`._chaos`).
+    kind: str = "reduction"
 
     @property
     def models(self) -> tuple[str, ...]:
         """The models classified: a ``model`` axis's names, or the one model of the spec."""
+        if self.kind == "chaos":
+            from rollingtop.atlas._chaos import CHAOS_MODELS
+
+            return (CHAOS_MODELS[int(self.fixed["model"])],)
         indices = self.axes["model"] if "model" in self.axes else [self.fixed.get("model", 0.0)]
         return tuple(ATLAS_MODELS[int(i)] for i in indices)
 
@@ -85,7 +92,13 @@ class AtlasSpec:
         """What a partial result must match to be reused."""
         axes = {k: v.tolist() for k, v in self.axes.items()}
         text = json.dumps(
-            {"version": ATLAS_VERSION, "fixed": self.fixed, "chunk": chunk, "axes": axes},
+            {
+                "version": ATLAS_VERSION,
+                "kind": self.kind,
+                "fixed": self.fixed,
+                "chunk": chunk,
+                "axes": axes,
+            },
             sort_keys=True,
         )
         return hashlib.sha256(text.encode()).hexdigest()
@@ -156,8 +169,16 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
     model = contact.get("model", "meridian") if isinstance(contact, dict) else "meridian"
     if not isinstance(model, str):
         raise AtlasError(f"contact.model = {short_repr(model)} must be a model name")
+    from rollingtop.atlas._chaos import CHAOS_MODELS, has_angle
     from rollingtop.reduction.models import closed_form_diagram
 
+    if "angle" in axes and not (model in MODELS and has_angle(model)):
+        raise AtlasError(
+            f"axes.angle is the oblique model's constraint angle: [contact] model = "
+            f"{model!r} has none"
+        )
+    if model in CHAOS_MODELS and "model" not in axes:
+        return _chaos_spec(data, axes, model)
     if "model" in axes or not (model in MODELS and closed_form_diagram(model)):
         return _state_spec(data, axes, model)
     # the fixed values: the scenario's, with each axis at its first value
@@ -290,6 +311,86 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
     fixed.update(zip(STATE_KEYS, (float(x) for x in (*y0[12:15], *y0[3:6])), strict=True))
     fixed["model"] = float(ATLAS_MODELS.index(model)) if model in ATLAS_MODELS else 0.0
     return AtlasSpec(fixed, axes)
+
+
+#: Bounds of the ``[chaos]`` table's ``t_end`` and ``seeds``.
+MAX_CHAOS_T_END = 1.0e4
+MAX_CHAOS_SEEDS = 32
+
+
+def _chaos_options(table: object) -> tuple[float, int]:
+    """The ``[chaos]`` table's ``t_end`` and ``seeds`` (defaults of :mod:`._chaos`)."""
+    from rollingtop._checks import number
+    from rollingtop.atlas._chaos import DEFAULT_SEEDS, DEFAULT_T_END
+
+    if table is None:
+        return DEFAULT_T_END, DEFAULT_SEEDS
+    if not isinstance(table, dict):
+        raise AtlasError(f"[chaos] must be a table (t_end, seeds), got {short_repr(table)}")
+    unknown = set(table) - {"t_end", "seeds"}
+    if unknown:
+        raise AtlasError(f"[chaos] has unknown keys {', '.join(sorted(unknown))} (t_end, seeds)")
+    try:
+        t_end = number("chaos", "t_end", table.get("t_end", DEFAULT_T_END))
+        seeds = int(number("chaos", "seeds", table.get("seeds", DEFAULT_SEEDS), integer=True))
+    except ScenarioError as exc:
+        raise AtlasError(str(exc)) from None
+    if not 0.0 < t_end <= MAX_CHAOS_T_END:
+        raise AtlasError(f"chaos.t_end = {t_end:g} must be in (0, {MAX_CHAOS_T_END:g}]")
+    if not 1 <= seeds <= MAX_CHAOS_SEEDS:
+        raise AtlasError(f"chaos.seeds = {seeds} must be in [1, {MAX_CHAOS_SEEDS}]")
+    return t_end, seeds
+
+
+def _chaos_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: str) -> AtlasSpec:
+    """The spec of a chaos atlas (:mod:`._chaos`): a model without a reduction (``oblique``,
+    ``parallel``), the ``[initial]`` state fixed, body keys and ``angle`` (oblique) as axes."""
+    from rollingtop.atlas._chaos import CHAOS_MODELS, free_key, has_angle
+    from rollingtop.scenario import Scenario
+
+    on_level = [key for key in axes if key in LEVEL_KEYS]
+    if on_level:
+        raise AtlasError(
+            f"axes {', '.join(on_level)}: the {model} model has no reduction; a chaos atlas "
+            "takes body keys and angle (oblique) as axes, the level is the [initial] state's"
+        )
+    if not isinstance(data.get("initial"), dict):
+        raise AtlasError(
+            f"a chaos atlas of the {model} model needs an [initial] table (gamma, omega, "
+            f"{free_key(model)}): each cell runs on that state's level"
+        )
+    t_end, seeds = _chaos_options(data.pop("chaos", None))
+    data.pop("level", None)
+    contact = dict(data.get("contact", {}))
+    if "angle" in axes:
+        contact["angle"] = float(axes["angle"][0])
+    data["contact"] = contact
+    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    sc = None
+    for cell in _body_cells(body_t, axes):
+        try:
+            sc = Scenario.from_dict({**data, "body": cell})
+        except BodyError:
+            continue
+        body_t = cell
+        break
+    if sc is None:
+        Scenario.from_dict({**data, "body": next(_body_cells(body_t, axes))})
+        raise AtlasError("no cell of the atlas has an admissible body")
+    if not sc.body.symmetric or sc.body.has_shell:
+        raise AtlasError(
+            "a chaos atlas needs a dynamically symmetric body (I1 = I2) without a shell"
+        )
+    y0 = sc.require_state()
+    fixed = {k: float(getattr(sc.body, k)) for k in BODY_KEYS}
+    fixed.update({k: float(body_t[k]) for k in BODY_KEYS if k in axes})
+    fixed.update(zip(STATE_KEYS, (float(x) for x in (*y0[12:15], *y0[3:6])), strict=True))
+    fixed["free"] = float(data["initial"].get(free_key(model), 0.0))
+    fixed["model"] = float(CHAOS_MODELS.index(model))
+    fixed["t_end"], fixed["seeds"] = t_end, float(seeds)
+    if has_angle(model):
+        fixed["angle"] = float(sc.model.parameter_values["angle"])
+    return AtlasSpec(fixed, axes, kind="chaos")
 
 
 def load_atlas_spec(path: str | os.PathLike[str]) -> AtlasSpec:

@@ -55,9 +55,16 @@ class AtlasResumeWarning(UserWarning):
     """Damaged or foreign chunk files in an atlas's ``.partial`` folder, recomputed."""
 
 
-def _chunk_fits(part: Mapping[str, np.ndarray], n: int) -> bool:
+def _chunk_fits(part: Mapping[str, np.ndarray], n: int, kind: str = "reduction") -> bool:
     """Whether a loaded chunk has the variables, shapes and kinds of :func:`classify_cells`'
-    output for ``n`` cells (a foreign or truncated file does not)."""
+    output (``kind`` ``chaos``: :func:`~rollingtop.atlas._chaos.chaos_cells`') for ``n`` cells
+    (a foreign or truncated file does not)."""
+    if kind == "chaos":
+        from rollingtop.atlas._chaos import CHAOS_FIELDS
+
+        return set(part) == set(CHAOS_FIELDS) and all(
+            part[k].shape == (n,) and part[k].dtype.kind == c for k, c in CHAOS_FIELDS.items()
+        )
     if set(part) != {*FIELDS, *CENTRE_FIELDS}:
         return False
     flat = all(part[k].shape == (n,) and part[k].dtype.kind == "i" for k in FIELDS)
@@ -81,7 +88,7 @@ def _chunk_is(part: dict[str, np.ndarray], k: int, cells: tuple[int, int], diges
 
 
 def _load_partial(
-    folder: Path, digest: str, ranges: Mapping[int, tuple[int, int]]
+    folder: Path, digest: str, ranges: Mapping[int, tuple[int, int]], kind: str = "reduction"
 ) -> dict[int, dict[str, np.ndarray]]:
     """Chunks saved by an earlier run of the same spec (``{}`` if none); ``ranges``: the cells
     ``[start, end)`` of each chunk. A file that does not load, that is not the chunk its name
@@ -113,7 +120,7 @@ def _load_partial(
             part is None
             or k not in ranges
             or not _chunk_is(part, k, ranges[k], digest)
-            or not _chunk_fits(part, ranges[k][1] - ranges[k][0])
+            or not _chunk_fits(part, ranges[k][1] - ranges[k][0], kind)
         ):
             bad.append(f.name)
             with contextlib.suppress(OSError):
@@ -162,6 +169,10 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
         "rotation_centre": "rotation number psi'/omega at each centre (in order of gamma3)",
         "centre_gamma3": "gamma3 of each centre",
     }
+    if spec.kind == "chaos":
+        from rollingtop.atlas._chaos import CHAOS_DOCS
+
+        docs = CHAOS_DOCS
     for key, values in merged.items():
         if values.ndim == 1:
             data_vars[key] = (dims, values.reshape(spec.shape), {"description": docs[key]})
@@ -175,8 +186,12 @@ def _dataset(spec: AtlasSpec, parts: Mapping[int, Mapping[str, np.ndarray]]) -> 
         "fixed_json": json.dumps(spec.fixed),
         "axes": " ".join(dims),
         "models": " ".join(spec.models),
+        "kind": spec.kind,
         "description": "rollingtop atlas: classification of the reduced motions over body "
-        "parameters and integrals or models (issues 14, 24)",
+        "parameters and integrals or models (issues 14, 24)"
+        if spec.kind == "reduction"
+        else "rollingtop atlas: chaos indicators, phase-volume rate and periodic orbits over "
+        "body parameters and the constraint angle (issue 39)",
     }
     coords: dict[str, Any] = dict(spec.axes)
     if "model" in coords:  # indices into ATLAS_MODELS: the names

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import time
+from typing import Any
 
 import click
 import numpy as np
@@ -94,11 +95,16 @@ def atlas(
     wall = time.perf_counter() - start
     classified = ds["status"].values == 0
     counts: dict[str, dict[str, int]] = {}
-    for name in ("n_steady", "n_centres", "n_saddles", "n_folds"):
+    counted = (
+        ("n_finished", "n_vertical", "n_periodic", "n_attracting")
+        if atlas_spec.kind == "chaos"
+        else ("n_steady", "n_centres", "n_saddles", "n_folds")
+    )
+    for name in counted:
         uniq, cnt = np.unique(ds[name].values[classified], return_counts=True)
         counts[name] = {str(int(u)): int(c) for u, c in zip(uniq, cnt, strict=True)}
     dims = {str(k): int(v) for k, v in ds.sizes.items() if k != "centre"}
-    summary = {
+    summary: dict[str, Any] = {
         "output": output,
         "dims": dims,
         "cells": atlas_spec.size,
@@ -106,6 +112,12 @@ def atlas(
         "counts": counts,
         "wall_s": wall,
     }
+    if atlas_spec.kind == "chaos":  # the indicators' ranges over the computed cells
+        summary["ranges"] = {
+            name: [float(np.nanmin(v)), float(np.nanmax(v))] if np.any(np.isfinite(v)) else None
+            for name in ("megno", "lyapunov", "volume_rate")
+            for v in [ds[name].values[classified]]
+        }
     if as_json:
         click.echo(json.dumps(summary))
         return
@@ -116,4 +128,6 @@ def atlas(
     )
     for name, c in counts.items():
         console.print(f"  {name}: " + ", ".join(f"{k}: {v} cells" for k, v in c.items()))
+    for name, r in summary.get("ranges", {}).items():
+        console.print(f"  {name}: " + ("none" if r is None else f"{r[0]:.4g} .. {r[1]:.4g}"))
     click.echo(f"wrote {output}")
