@@ -50,6 +50,15 @@ def _summary(angles, keep):
 
 
 def write_guide(rows):
+    text = GUIDE.read_text()
+    head, rest = text.split(START, 1)
+    tail = rest.split(END, 1)[1]
+    GUIDE.write_text(head + block(rows) + tail)
+    print(f"wrote the table in {GUIDE}")
+
+
+def block(rows):
+    """The guide's table, markers included, for the saved ``rows``."""
     lines = [
         START,
         "| body | density of `gamma3` (symbolic in `t`) | `t` with nothing beyond the classical "
@@ -80,11 +89,7 @@ def write_guide(rows):
             f"{'<br>'.join(integrals)} |"
         )
     lines.append(END)
-    text = GUIDE.read_text()
-    head, rest = text.split(START, 1)
-    tail = rest.split(END, 1)[1]
-    GUIDE.write_text(head + "\n".join(lines) + tail)
-    print(f"wrote the table in {GUIDE}")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

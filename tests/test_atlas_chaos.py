@@ -67,7 +67,7 @@ def test_a_cell_is_what_the_tools_give_for_its_angle(two_angles):
     if megno:
         assert float(cell["megno"]) == pytest.approx(float(np.median(megno)), rel=1e-12)
         assert float(cell["lyapunov"]) == pytest.approx(max(lyap), rel=1e-12)
-    rate = phase_volume(body, model, y0, t_end=T_END, samples=2001).mean[-1]
+    rate = phase_volume(body, model, y0, t_end=T_END, samples=2001, max_steps=200_000).mean[-1]
     assert float(cell["volume_rate"]) == pytest.approx(rate, rel=1e-12)
 
 
@@ -139,3 +139,15 @@ def test_the_command_writes_a_chaos_atlas(tmp_path):
     assert set(summary["counts"]) == {"n_finished", "n_vertical", "n_periodic", "n_attracting"}
     assert set(summary["ranges"]) == {"megno", "lyapunov", "volume_rate"}
     assert out.exists()
+
+
+def test_a_cell_drawn_into_the_vertical_is_counted_not_a_failure():
+    """phi = 5 pi/6: the initial state's motion is drawn into the vertical and crawls there
+    (tests/chaos/test_divergence.py): its volume rate is NaN, the seeds that reach the vertical
+    are counted, and the cell is computed (status 0) in seconds, not minutes."""
+    spec = atlas_spec_from_dict(chaos_dict({"angle": [5 * np.pi / 6]}))
+    out = chaos_cells(spec.fixed, ("angle",), spec.cells())
+    assert int(out["status"][0]) == 0
+    assert np.isnan(out["volume_rate"][0])
+    assert int(out["n_vertical"][0]) >= 1
+    assert int(out["n_vertical"][0]) + int(out["n_finished"][0]) == 2

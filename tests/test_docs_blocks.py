@@ -42,3 +42,17 @@ def test_each_block_is_its_script_output_for_the_saved_results(name, pages):
     expected = script.block(results)
     for page in pages:
         assert _between(ROOT / page, script.START, script.END) == expected, page
+
+
+def test_the_oblique_familys_blocks_are_their_scripts_output():
+    """docs/oblique_search.py's table in the models guide, docs/oblique_map.py's table and
+    answer on the oblique family's page, for their saved JSON."""
+    search = _script("oblique_search")
+    rows = json.loads((ROOT / "docs" / "oblique_search.json").read_text())
+    models = ROOT / "docs" / "guide" / "models.md"
+    assert _between(models, search.START, search.END) == search.block(rows)
+    atlas = _script("oblique_map")
+    data = json.loads((ROOT / "docs" / "oblique_map.json").read_text())
+    page = ROOT / "docs" / "guide" / "oblique.md"
+    assert _between(page, atlas.START, atlas.END) == atlas.block(data)
+    assert _between(page, atlas.ANSWER_START, atlas.ANSWER_END) == atlas.answer_block(data)

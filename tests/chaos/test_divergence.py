@@ -93,3 +93,17 @@ def test_bad_input_is_refused():
         phase_volume(PAPER, "meridian", _paper(), t_end=-1.0)
     with pytest.raises(ScenarioError, match="violates a constraint"):
         manifold_divergence(PAPER, "parallel", _paper())
+
+
+def test_a_motion_drawn_into_the_vertical_is_bounded_by_max_steps():
+    """The oblique model at phi = 5 pi/6 draws this motion into the vertical, where it crawls
+    through the regularised passage in tiny steps (without a bound, minutes): ``max_steps``
+    ends it in one line instead."""
+    from rollingtop._errors import IntegrationError
+    from rollingtop.contact.oblique import oblique
+
+    model = oblique(5 * np.pi / 6)
+    y0 = initial_state(PAPER, model, gamma=[0.0, 0.6, 0.8], omega=[0.7, -0.3, 2.0],
+                       free={"v_slip": 0.25})  # fmt: skip
+    with pytest.raises(IntegrationError, match="max_steps = 20000"):
+        phase_volume(PAPER, model, y0, t_end=100.0, samples=2001, max_steps=20_000)

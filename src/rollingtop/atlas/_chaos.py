@@ -14,7 +14,8 @@ Per cell, under the cell's body and angle:
   finished, ``lyapunov`` their largest exponent (NaN when none finished);
 - ``volume_rate``: the time average of the divergence along the initial state's motion
   (:func:`rollingtop.chaos.phase_volume`), the rate of phase-volume drift (zero on average for
-  a model with an invariant measure);
+  a model with an invariant measure); NaN where that motion runs out of steps near the
+  vertical;
 - ``n_periodic``, ``n_attracting``: the relative periodic orbits that the section's
   trajectories settle onto (:func:`rollingtop.chaos.periodic_orbits`, up to
   ``PERIODIC_RETURNS`` crossings, no grid of seeds), and how many of them attract.
@@ -159,7 +160,7 @@ def _cell(
     out["status"][n] = 0
     try:
         seeds = level_states(body, model, y0, n_seeds, seed=0)  # type: ignore[arg-type]
-    except RollingTopError:
+    except (RollingTopError, IntegrationError):
         seeds = np.asarray([y0])
     megno, lyap, vertical = [], [], 0
     for y in seeds:
@@ -183,9 +184,16 @@ def _cell(
         out["megno"][n] = float(np.median(megno))
         out["lyapunov"][n] = float(np.max(lyap))
     try:
-        pv = phase_volume(body, model, y0, t_end=t_end, samples=2001)  # type: ignore[arg-type]
+        pv = phase_volume(
+            body,
+            model,  # type: ignore[arg-type]
+            y0,
+            t_end=t_end,
+            samples=2001,
+            max_steps=MAX_STEPS,
+        )
         out["volume_rate"][n] = float(pv.mean[-1])
-    except RollingTopError:
+    except (RollingTopError, IntegrationError):  # out of steps near the vertical: NaN
         pass
     try:
         found = periodic_orbits(
@@ -197,7 +205,7 @@ def _cell(
             settle=PERIODIC_SETTLE,
             grid=0,
         )
-    except RollingTopError:
+    except (RollingTopError, IntegrationError):
         return
     out["n_periodic"][n] = len(found)
     out["n_attracting"][n] = sum(o.type == "attracting" for o in found)

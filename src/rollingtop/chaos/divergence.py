@@ -181,6 +181,7 @@ def phase_volume(
     samples: int = 2001,
     rtol: float = 1e-10,
     atol: float | None = None,
+    max_steps: int | None = None,
 ) -> PhaseVolume:
     """The divergence of the vector field along the motion from ``state`` and its running time
     average (module docstring).
@@ -198,10 +199,19 @@ def phase_volume(
         trapezoidal rule over them, so they must resolve the motion.
     rtol, atol : float
         Tolerances of the integration.
+    max_steps : int, optional
+        Bound on accepted steps (default: the integrator's): a motion drawn into the vertical
+        of a model that carries its direction there (``parallel``, ``oblique``) crawls through
+        the regularised passage in tiny steps; this bounds the wait.
 
     Returns
     -------
     PhaseVolume
+
+    Raises
+    ------
+    IntegrationError
+        When the integration cannot reach ``t_end`` (``max_steps`` reached: one line).
     """
     model = get_model(model)
     _refuse_own_inertia(model)
@@ -209,7 +219,7 @@ def phase_volume(
     atol_ = check_options(t_end, samples, rtol, atol)
     code = model.kernel_code(body, y0)
     t = np.linspace(0.0, float(t_end), int(samples))
-    traj = integrate(code, model.params(body), y0, t, rtol=rtol, atol=atol_)
+    traj = integrate(code, model.params(body), y0, t, rtol=rtol, atol=atol_, max_steps=max_steps)
     ws = call(new_workspace)
     div = np.array([_divergence(code, model.params(body), y, ws) for y in traj.y])
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (div[1:] + div[:-1]) * np.diff(t))])
