@@ -167,3 +167,18 @@ def test_the_command_searches_a_scenarios_body():
     by_t = {a["t"]: a for a in result["angles"]}
     assert by_t["0"]["density_gamma3"] and by_t["0"]["bounds"]["linear"] == 3
     assert by_t["1/2"]["bounds"]["linear"] == by_t["1/2"]["known"]["linear"] == 1
+
+
+def test_the_balanced_balls_claims_hold_only_for_the_balanced_ball():
+    """verify's claims for every phi (symbolic/oblique.py): the slip along d x gamma and the
+    area integral conserved when a3 = 0, I3 = I1; with the paper's body's own a3 and I3 the
+    same claims fail (a rational counterexample), so the proof is not vacuous."""
+    from dataclasses import replace
+
+    from rollingtop.symbolic.claims import check, claims_for
+
+    ball = [c for c in claims_for("oblique") if c.name.startswith("balanced ball")]
+    assert len(ball) == 2
+    for claim in ball:
+        assert check(claim).result == "proved", claim.name
+        assert check(replace(claim, params=())).result == "failed", claim.name
