@@ -30,8 +30,8 @@ BODIES = {
     "the paper's body": {"R": 1.0, "m": 1.0, "g": 1.0, "a3": 0.1, "I1": 0.3, "I3": 0.5},
     "a heavy flat top": {"R": 0.8, "m": 2.0, "g": 1.5, "a3": -0.25, "I1": 0.4, "I3": 0.2},
 }
-VARIABLES = ("megno", "lyapunov", "n_finished", "n_vertical", "volume_rate", "n_periodic",
-             "n_attracting")  # fmt: skip
+VARIABLES = ("megno", "lyapunov", "n_finished", "n_vertical", "n_failed", "volume_rate",
+             "n_periodic", "n_attracting")  # fmt: skip
 
 
 def main():
@@ -112,7 +112,8 @@ def block(data):
     """The page's table, markers included."""
     lines = [
         START,
-        "| body | phi | MEGNO | Lyapunov | seeds finished / to the vertical | phase-volume "
+        "| body | phi | MEGNO | Lyapunov | seeds finished / to the vertical / failed "
+        "| phase-volume "
         "rate | periodic orbits (attracting) |",
         "|---|---|---|---|---|---|---|",
     ]
@@ -120,7 +121,8 @@ def block(data):
         for c in row["cells"]:
             lines.append(
                 f"| {row['name']} | {c['angle']:.4f} | {_fmt(c['megno'], '.3f')} | "
-                f"{_fmt(c['lyapunov'], '.4f')} | {c['n_finished']} / {c['n_vertical']} | "
+                f"{_fmt(c['lyapunov'], '.4f')} | {c['n_finished']} / {c['n_vertical']} / "
+                f"{c['n_failed']} | "
                 f"{_fmt(c['volume_rate'], '.3e')} | {c['n_periodic']} ({c['n_attracting']}) |"
             )
     lines.append(END)
@@ -146,12 +148,13 @@ def answer(data):
         f"orbits, {sum(c['n_attracting'] for c in ends)} of them attracting.",
         f"- **At the other {len(others) // len(data['bodies'])} angles** "
         f"{vertical} of {seeds * len(others)} seeds reach the vertical before "
-        f"`t = {data['t_end']:g}`; the phase-volume rate, where the motion could be followed, "
-        f"lies between {min(rates):.3g} and {max(rates):.3g} "
-        f"({sum(r < 0 for r in rates)} of {len(rates)} negative: phase volume contracts).",
-        f"- **MEGNO** of every seed that finished, at every angle: {min(megno):.3f} to "
-        f"{max(megno):.3f} (2 for quasi-periodic motion): no chaos is detected on these levels; "
-        f"attracting periodic orbits found: "
+        f"`t = {data['t_end']:g}`; along the {len(rates)} initial motions that stay away "
+        f"from it, the phase-volume rate lies between {min(rates):.3g} and {max(rates):.3g} "
+        f"({sum(r < 0 for r in rates)} of {len(rates)} negative: phase volume contracts "
+        "there).",
+        f"- **MEGNO** (median per cell) over the seeds that finished, at every angle: "
+        f"{min(megno):.3f} to {max(megno):.3f} (2 for quasi-periodic motion): no chaos among "
+        f"the motions that stay away from the vertical; attracting periodic orbits found: "
         f"{sum(c['n_attracting'] for _, c in cells)}.",
     ]
 

@@ -49,16 +49,22 @@ def test_a_cell_is_what_the_tools_give_for_its_angle(two_angles):
     body = SphericalTop(**BODY)
     model = oblique(0.8)
     f = spec.fixed  # the state as the spec keeps it (the scenario's, normalised)
-    y0 = initial_state(body, model, gamma=[f["gamma1"], f["gamma2"], f["gamma3"]],
-                       omega=[f["omega1"], f["omega2"], f["omega3"]],
-                       free={"v_slip": STATE["v_slip"]})  # fmt: skip
-    megno, lyap, vertical = [], [], 0
-    for y in level_states(body, model, y0, 2, seed=0):
+    y0 = initial_state(
+        body,
+        model,
+        gamma=[f["gamma1"], f["gamma2"], f["gamma3"]],
+        omega=[f["omega1"], f["omega2"], f["omega3"]],
+        free={"v_slip": STATE["v_slip"]},
+    )
+    megno, lyap, vertical, first = [], [], 0, False
+    for k, y in enumerate(level_states(body, model, y0, 2, seed=0)):
         try:
             s = chaos_indicators(body, model, y, t_end=T_END, samples=100, max_steps=200_000)
-        except Exception:
+        except Exception as exc:
+            assert "vertical" in str(exc) or "max_steps" in str(exc)
             vertical += 1
             continue
+        first = first or k == 0
         megno.append(s.summary()["megno"])
         lyap.append(s.summary()["lyapunov"])
     cell = ds.sel(angle=0.8)
@@ -67,8 +73,12 @@ def test_a_cell_is_what_the_tools_give_for_its_angle(two_angles):
     if megno:
         assert float(cell["megno"]) == pytest.approx(float(np.median(megno)), rel=1e-12)
         assert float(cell["lyapunov"]) == pytest.approx(max(lyap), rel=1e-12)
-    rate = phase_volume(body, model, y0, t_end=T_END, samples=2001, max_steps=200_000).mean[-1]
-    assert float(cell["volume_rate"]) == pytest.approx(rate, rel=1e-12)
+    assert int(cell["n_failed"]) == 0
+    if first:  # the rate only along a motion that stays away from the vertical
+        rate = phase_volume(body, model, y0, t_end=T_END, samples=2001, max_steps=200_000)
+        assert float(cell["volume_rate"]) == pytest.approx(rate.mean[-1], rel=1e-12)
+    else:
+        assert np.isnan(float(cell["volume_rate"]))
 
 
 def test_the_volume_rate_is_kozlovs_criterion_at_the_ends(two_angles):
@@ -91,6 +101,8 @@ def test_the_volume_rate_is_kozlovs_criterion_at_the_ends(two_angles):
         ({"chaos": {"t_end": 1.0, "foo": 2}}, "unknown keys foo"),
         ({"chaos": 3}, "must be a table"),
         ({"initial": None}, "needs an \\[initial\\] table"),
+        ({"level": {"M3": 1.0}}, "leave out \\[level\\]"),
+        ({"axes": {"angle": [0.1], "model": ["meridian"]}}, "leave out the model axis"),
     ],
 )
 def test_a_bad_chaos_spec_is_refused_in_one_line(change, message):
@@ -131,12 +143,21 @@ def test_the_command_writes_a_chaos_atlas(tmp_path):
     out = tmp_path / "c.nc"
     run = subprocess.run(
         [sys.executable, "-m", "rollingtop", "atlas", str(spec), "-o", str(out), "--json"],
-        capture_output=True, text=True, check=False, timeout=600,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr
     summary = json.loads(run.stdout)
     assert summary["cells"] == summary["classified"] == 2
-    assert set(summary["counts"]) == {"n_finished", "n_vertical", "n_periodic", "n_attracting"}
+    assert set(summary["counts"]) == {
+        "n_finished",
+        "n_vertical",
+        "n_failed",
+        "n_periodic",
+        "n_attracting",
+    }
     assert set(summary["ranges"]) == {"megno", "lyapunov", "volume_rate"}
     assert out.exists()
 
@@ -151,3 +172,4 @@ def test_a_cell_drawn_into_the_vertical_is_counted_not_a_failure():
     assert np.isnan(out["volume_rate"][0])
     assert int(out["n_vertical"][0]) >= 1
     assert int(out["n_vertical"][0]) + int(out["n_finished"][0]) == 2
+    assert int(out["n_failed"][0]) == 0

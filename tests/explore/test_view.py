@@ -463,3 +463,24 @@ def test_the_oblique_models_angle_is_a_parameter_of_the_view(fig5):
     with pytest.raises(ScenarioError, match="unknown parameter 'angle' for the meridian"):
         parse_query({"angle": "0.3"}, fig5)
     assert fig5.with_model("oblique").with_model("meridian").contact == ()
+
+
+def test_the_scenarios_own_rule_and_angle_are_kept():
+    """A scenario with oblique, an angle and a passage rule of its own: the view's model has
+    them all; another model and back restores the scenario's angle and rule."""
+    from rollingtop.scenario import Scenario
+
+    sc = Scenario.from_dict(
+        {
+            "body": {"R": 1.0, "m": 1.0, "g": 1.0, "a3": 0.1, "I1": 0.3, "I3": 0.5},
+            "contact": {"model": "oblique", "angle": 0.7, "pole_disk": 1e-5},
+            "initial": {"gamma": [0.0, 0.6, 0.8], "omega": [0.7, -0.3, 2.0], "v_slip": 0.25},
+        }
+    )
+    state = state_from_scenario(sc)
+    values = state.contact_model.parameter_values
+    assert values["angle"] == 0.7 and values["pole_disk"] == 1e-5
+    back = state.with_model("meridian").with_model("oblique")
+    assert back.contact == (("angle", 0.7),)
+    assert back.contact_model.parameter_values == values
+    np.testing.assert_array_equal(back.reference_state(), state.reference_state())

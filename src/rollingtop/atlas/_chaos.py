@@ -9,13 +9,14 @@ Per cell, under the cell's body and angle:
   the state itself first) and, for each, MEGNO and the largest Lyapunov exponent over
   ``t_end`` (:func:`rollingtop.chaos.chaos_indicators`). A motion that reaches the vertical
   has no tangent dynamics beyond it (the constraint's direction is not determined there) and
-  is counted in ``n_vertical`` instead; so is one whose steps run out near it (the regularised
-  passage is stiff: ``MAX_STEPS`` bounds each run). ``megno`` is the median over the seeds that
-  finished, ``lyapunov`` their largest exponent (NaN when none finished);
+  is counted in ``n_vertical`` instead; so is one whose steps run out (the regularised passage
+  is stiff: ``MAX_STEPS`` bounds each run); any other failure in ``n_failed``. ``megno`` is the
+  median over the seeds that finished, ``lyapunov`` their largest exponent (NaN when none
+  finished);
 - ``volume_rate``: the time average of the divergence along the initial state's motion
   (:func:`rollingtop.chaos.phase_volume`), the rate of phase-volume drift (zero on average for
-  a model with an invariant measure); NaN where that motion runs out of steps near the
-  vertical;
+  a model with an invariant measure); NaN where that motion reaches the vertical before
+  ``t_end`` (the rate there would be the regularised passage's);
 - ``n_periodic``, ``n_attracting``: the relative periodic orbits that the section's
   trajectories settle onto (:func:`rollingtop.chaos.periodic_orbits`, up to
   ``PERIODIC_RETURNS`` crossings, no grid of seeds), and how many of them attract.
@@ -49,6 +50,7 @@ CHAOS_FIELDS = {
     "lyapunov": "f",
     "n_finished": "i",
     "n_vertical": "i",
+    "n_failed": "i",
     "volume_rate": "f",
     "n_periodic": "i",
     "n_attracting": "i",
@@ -59,7 +61,9 @@ CHAOS_DOCS = {
     "lyapunov": "largest finite-time Lyapunov exponent over the seeds that finished",
     "n_finished": "seeds whose tangent dynamics ran to t_end",
     "n_vertical": "seeds whose motion reached the vertical (or ran out of steps near it)",
-    "volume_rate": "time average of the divergence along the initial state's motion",
+    "n_failed": "seeds whose integration failed otherwise (step size, a non-finite state)",
+    "volume_rate": "time average of the divergence along the initial state's motion, where "
+    "that motion stays away from the vertical up to t_end (else NaN)",
     "n_periodic": "periodic orbits the section's trajectories settle onto",
     "n_attracting": "attracting periodic orbits among them",
 }
@@ -88,6 +92,13 @@ def has_angle(name: str) -> bool:
     from rollingtop.contact import get_model
 
     return any(r.name == "angle" for r in get_model(name).parameters)
+
+
+def _near_vertical(message: str) -> bool:
+    """Whether an integration stopped at the vertical (``chaos_indicators``' stop) or ran out
+    of steps (a motion crawling through the regularised passage, the one place these models
+    do), from its one-line message."""
+    return "reaches the vertical" in message or "max_steps" in message
 
 
 def cell_model(p: Mapping[str, float]) -> object:
@@ -162,8 +173,9 @@ def _cell(
         seeds = level_states(body, model, y0, n_seeds, seed=0)  # type: ignore[arg-type]
     except (RollingTopError, IntegrationError):
         seeds = np.asarray([y0])
-    megno, lyap, vertical = [], [], 0
-    for y in seeds:
+    megno, lyap, vertical, failed = [], [], 0, 0
+    followed = False  # whether the initial state's own motion (seeds[0]) ran to t_end
+    for k, y in enumerate(seeds):
         try:
             s = chaos_indicators(
                 body,
@@ -173,17 +185,25 @@ def _cell(
                 samples=100,
                 max_steps=MAX_STEPS,
             ).summary()
-        except IntegrationError:
-            vertical += 1
+        except IntegrationError as exc:
+            if _near_vertical(str(exc)):
+                vertical += 1
+            else:
+                failed += 1
             continue
+        followed = followed or k == 0
         megno.append(float(s["megno"]))
         lyap.append(float(s["lyapunov"]))
     out["n_finished"][n] = len(megno)
     out["n_vertical"][n] = vertical
+    out["n_failed"][n] = failed
     if megno:
         out["megno"][n] = float(np.median(megno))
         out["lyapunov"][n] = float(np.max(lyap))
+    # the rate through the vertical would be the regularised passage's, not the motion's
     try:
+        if not followed:
+            raise IntegrationError("the initial state's motion reaches the vertical")
         pv = phase_volume(
             body,
             model,  # type: ignore[arg-type]

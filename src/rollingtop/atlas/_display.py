@@ -22,7 +22,7 @@ __all__ = ["COUNTED", "AtlasAccessor"]
 #: The variables whose values :meth:`AtlasAccessor.counts` counts over the classified cells.
 COUNTED = ("n_steady", "n_centres", "n_saddles", "n_folds")
 #: The same for a chaos atlas (:mod:`rollingtop.atlas._chaos`).
-CHAOS_COUNTED = ("n_finished", "n_vertical", "n_periodic", "n_attracting")
+CHAOS_COUNTED = ("n_finished", "n_vertical", "n_failed", "n_periodic", "n_attracting")
 
 
 class AtlasAccessor:

@@ -92,13 +92,10 @@ class AtlasSpec:
         """What a partial result must match to be reused."""
         axes = {k: v.tolist() for k, v in self.axes.items()}
         text = json.dumps(
-            {
-                "version": ATLAS_VERSION,
-                "kind": self.kind,
-                "fixed": self.fixed,
-                "chunk": chunk,
-                "axes": axes,
-            },
+            {"version": ATLAS_VERSION, "fixed": self.fixed, "chunk": chunk, "axes": axes}
+            # a chaos atlas's kind too (a reduction atlas's digest as before: its partial
+            # folders stay reusable)
+            | ({"kind": self.kind} if self.kind != "reduction" else {}),
             sort_keys=True,
         )
         return hashlib.sha256(text.encode()).hexdigest()
@@ -176,6 +173,11 @@ def atlas_spec_from_dict(data: Mapping[str, Any]) -> AtlasSpec:
         raise AtlasError(
             f"axes.angle is the oblique model's constraint angle: [contact] model = "
             f"{model!r} has none"
+        )
+    if "angle" in axes and "model" in axes:
+        raise AtlasError(
+            "axes.angle and axes.model: an angle axis is a chaos atlas of the oblique model "
+            "alone (leave out the model axis)"
         )
     if model in CHAOS_MODELS and "model" not in axes:
         return _chaos_spec(data, axes, model)
@@ -360,7 +362,11 @@ def _chaos_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: str) -
             f"{free_key(model)}): each cell runs on that state's level"
         )
     t_end, seeds = _chaos_options(data.pop("chaos", None))
-    data.pop("level", None)
+    if "level" in data:
+        raise AtlasError(
+            f"[level]: the {model} model has no reduction; a chaos atlas runs on the level of "
+            "the [initial] state (leave out [level])"
+        )
     contact = dict(data.get("contact", {}))
     if "angle" in axes:
         contact["angle"] = float(axes["angle"][0])
@@ -377,7 +383,7 @@ def _chaos_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: str) -
     if sc is None:
         Scenario.from_dict({**data, "body": next(_body_cells(body_t, axes))})
         raise AtlasError("no cell of the atlas has an admissible body")
-    if not sc.body.symmetric or sc.body.has_shell:
+    if not sc.body.symmetric or sc.body.has_shell:  # pragma: no branch
         raise AtlasError(
             "a chaos atlas needs a dynamically symmetric body (I1 = I2) without a shell"
         )

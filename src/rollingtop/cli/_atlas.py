@@ -46,7 +46,9 @@ __all__ = ["atlas"]
     metavar="SECONDS",
     help="Seconds the --scheduler has to answer as a Dask scheduler.",
 )
-@click.option("--chunk", type=int, default=None, help="Cells per task (default 200).")
+@click.option(
+    "--chunk", type=int, default=None, help="Cells per task (default 200; 1 for a chaos atlas)."
+)
 @json_option
 def atlas(
     spec: str,
@@ -87,7 +89,7 @@ def atlas(
                 output,
                 workers=workers,
                 scheduler=scheduler,
-                chunk=chunk or DEFAULT_CHUNK,
+                chunk=chunk or (1 if atlas_spec.kind == "chaos" else DEFAULT_CHUNK),
                 progress=progress,
                 scheduler_timeout=scheduler_timeout,
             )
@@ -96,7 +98,7 @@ def atlas(
     classified = ds["status"].values == 0
     counts: dict[str, dict[str, int]] = {}
     counted = (
-        ("n_finished", "n_vertical", "n_periodic", "n_attracting")
+        ("n_finished", "n_vertical", "n_failed", "n_periodic", "n_attracting")
         if atlas_spec.kind == "chaos"
         else ("n_steady", "n_centres", "n_saddles", "n_folds")
     )

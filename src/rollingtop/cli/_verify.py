@@ -111,8 +111,10 @@ def _search(bodies: tuple[str, ...], as_json: bool) -> None:
     chosen = []
     for path in bodies:
         body = load_scenario(path).body
-        if body.I1 != body.I2:
-            raise BadInput(f"{path}: the search needs a dynamically symmetric body (I1 = I2)")
+        if body.I1 != body.I2 or body.has_shell:
+            raise BadInput(
+                f"{path}: the search needs a dynamically symmetric body (I1 = I2) without a shell"
+            )
         chosen.append({k: getattr(body, k) for k in PAPER_BODY})
     results = []
     for values in chosen or [PAPER_BODY]:

@@ -75,13 +75,19 @@ class ExploreState:
     contact: tuple[tuple[str, float], ...] = ()
     #: The scenario's own values of :attr:`contact` (its state is used as it is only with them).
     own_contact: tuple[tuple[str, float], ...] = ()
+    #: The scenario's model's other parameters (the passage rule's ``pole_disk``, ...), kept
+    #: while the page shows that model.
+    own_rule: tuple[tuple[str, float], ...] = ()
 
     @property
     def contact_model(self) -> Any:
         """The :class:`~rollingtop.contact.ContactModel` of this view: the model with the
-        values of :attr:`contact`."""
+        values of :attr:`contact` (and, for the scenario's own model, its other parameters)."""
         model = get_model(self.model)
-        return model.with_parameters(**dict(self.contact)) if self.contact else model
+        values = dict(self.contact)
+        if self.own is not None and self.own[0] == self.model:
+            values = dict(self.own_rule) | values
+        return model.with_parameters(**values) if values else model
 
     def reference_state(self) -> FloatArray:
         """The full state of the reference state under this view's model and body: the
@@ -139,7 +145,8 @@ class ExploreState:
         from rollingtop.reduction.models import REDUCTIONS
 
         model = get_model(name)
-        contact = _contact_defaults(model.name)
+        own = self.own is not None and self.own[0] == model.name
+        contact = self.own_contact if own else _contact_defaults(model.name)
         if model.name not in REDUCTIONS:
             return replace(self, model=model.name, level={}, h=math.nan, contact=contact)
         from rollingtop.reduction.models import reduction_of
@@ -190,6 +197,9 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
     contact = tuple(
         (k, float(v)) for k, v in sc.model.parameter_values.items() if k in CONTACT_KEYS
     )
+    rule = tuple(
+        (k, float(v)) for k, v in sc.model.parameter_values.items() if k not in CONTACT_KEYS
+    )
     if not sc.model.reduction:
         return ExploreState(
             sc.model.name,
@@ -200,6 +210,7 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
             own,
             contact,
             contact,
+            rule,
         )
     level = sc.level_set()
     values = {k: float(v) for k, v in level.values().items()}
@@ -212,6 +223,7 @@ def state_from_scenario(sc: Scenario) -> ExploreState:
         own,
         contact,
         contact,
+        rule,
     )
 
 

@@ -10,8 +10,10 @@ d'Alembert-Lagrange equations of :mod:`rollingtop.symbolic.equations` (the same
 constraints, the same elimination of the multipliers) on the slice ``gamma = (s, 0, gamma3)``,
 ``w = (-w_n, w_tau, w3)``, ``v = -w x r + u e`` that meets every orbit of the rotations once, in
 exact arithmetic: a polynomial of degree two in the velocities ``(w_tau, w_n, w3, u)`` with
-coefficients rational in ``q`` and in ``t = tan(phi / 2)``. The claim that it follows from the
-full equations at every ``gamma`` is :func:`claims`'s, decided by ``rollingtop verify``.
+coefficients rational in ``q`` and in ``t = tan(phi / 2)``. It is tested against the
+independent NumPy equations (``tests/symbolic/test_oblique_search.py``); the integrals the
+search reports are proved exact integrals of it (:func:`rate_of`), and the balanced ball's for
+every ``phi`` by ``rollingtop verify`` (:mod:`rollingtop.symbolic.oblique`).
 
 **The searches** (:func:`search`), each for every body parameter given as a rational number and
 with ``t`` a symbol where it can be:
@@ -35,9 +37,9 @@ with ``t`` a symbol where it can be:
   larger kernel is reported as such: the class is not ruled out there (``phi = 0``, where the
   paper's integrals live).
 
-The kernels are computed with :class:`sympy.polys.matrices.DomainMatrix` over ``Q(q)``
-(``Q(q, t)`` for ``t`` symbolic): exact, so a dimension is a proof for the body and angle it was
-computed at.
+The prolonged constraints are exact rational functions of ``q``; their rank is taken in exact
+rationals at the point ``q = Q0`` (:func:`solution_bound`), a lower bound on their rank over
+``Q(q)``: so each bound is a proof for the rational body and angle it was computed at.
 """
 
 from __future__ import annotations
@@ -315,6 +317,8 @@ Q0 = Fraction(7, 5)
 
 def _value_at(K: Any, e: Any, q0: Fraction) -> Any:
     """The ground-field element ``e`` at ``q = q0`` (a rational of :data:`sympy.QQ`)."""
+    if len(K.symbols) != 1:
+        raise ValueError("the rank bound needs a rational angle t (the ground field Q(q))")
     x = sp.QQ(q0.numerator, q0.denominator)
     num = e.numer.evaluate(e.numer.ring.gens[0], x)
     den = e.denom.evaluate(e.denom.ring.gens[0], x)
@@ -448,11 +452,11 @@ def _rank_at(red: Reduced, polys: Sequence[Any], q0: Fraction = Q0) -> int:
 
 
 #: The default angles of :func:`search`, as ``t = tan(phi / 2)``: both ends (0 and 1) and
-#: rational points between and beyond them (``phi`` in ``(-pi, pi)``; ``phi`` and ``phi + pi``
-#: are one constraint, so this covers the family).
+#: rational points between them and beyond, twelve distinct constraints (``phi`` and
+#: ``phi + pi``, i.e. ``t`` and ``-1/t``, are one: ``t`` in ``(-1, 1]`` covers the family).
 DEFAULT_T = tuple(
     Fraction(x)
-    for x in ("0", "1/8", "1/4", "1/3", "1/2", "2/3", "3/4", "1", "3/2", "3", "-1/3", "-2")
+    for x in ("0", "1/8", "1/4", "1/3", "1/2", "2/3", "3/4", "1", "-1/4", "-1/2", "-2/3", "-7/8")
 )
 #: The highest degree in the velocities of the density ansatz searched by default.
 DENSITY_DEGREE = 2
@@ -479,10 +483,10 @@ class AngleResult:
         """``phi`` in radians, in ``(-pi, pi)``."""
         return 2 * math.atan(self.t)
 
-    @property
-    def density(self) -> bool:
-        """Whether a density of ``gamma3`` alone exists (its bound is 1, not 0)."""
-        return self.bounds["density 0"] > 0
+    #: Whether a density of ``gamma3`` alone exists: every coefficient of ``div f`` but that of
+    #: ``w_tau`` vanishes identically (then ``div f = w_tau F(q)`` and ``rho`` is
+    #: ``exp(2 int F / (1 + q^2) dq)``), decided exactly.
+    density: bool = False
 
     def closed(self, name: str) -> bool:
         """Whether the class ``name`` holds only what the classical integrals account for."""
@@ -518,7 +522,8 @@ def search_angle(
     for degree in range(max_degree + 1):
         bounds[f"density {degree}"] = density_bound(red, degree)
         known[f"density {degree}"] = 0
-    return AngleResult(t, tuple(found), bounds, known)
+    density = not _wtau_free(_divergence(red))
+    return AngleResult(t, tuple(found), bounds, known, density)
 
 
 def density_obstruction(body: tuple[tuple[str, Fraction], ...]) -> sp.Poly:
