@@ -89,8 +89,11 @@ def write(data):
     axes[2].set_xlabel("constraint angle phi (rad): 0 the paper's, pi/2 the companion's")
     axes[2].set_xticks([0, math.pi / 4, math.pi / 2, 3 * math.pi / 4],
                        ["0", "pi/4", "pi/2", "3pi/4"])  # fmt: skip
-    for ax in axes:
+    axes[1].margins(y=0.15)
+    axes[2].set_ylim(-0.3, 4.6)  # room above the counts for the legend
+    for ax in axes[:2]:
         ax.legend(fontsize=7, loc="best")
+    axes[2].legend(fontsize=7, loc="upper center", ncol=2)
     fig.suptitle("the oblique family: no slip along cos(phi) nu + sin(phi) tau")
     save_figure(fig, FIGURE)
     print(f"wrote {FIGURE}")
