@@ -252,12 +252,30 @@ def _body_cells(body_t: dict[str, Any], axes: Mapping[str, FloatArray]) -> Itera
         yield {**body_t, **{key: float(v) for key, v in zip(keys, values, strict=True)}}
 
 
+def _first_admissible(
+    data: dict[str, Any], axes: Mapping[str, FloatArray]
+) -> tuple[Any, dict[str, Any]]:
+    """The scenario of the first cell whose body is admissible, and that cell's ``[body]``:
+    the state is checked against it; a cell whose body is inadmissible is that cell's status
+    (1), not a refusal of the whole atlas. Every cell inadmissible: what is wrong with the
+    first, or one line."""
+    from rollingtop.scenario import Scenario
+
+    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
+    for cell in _body_cells(body_t, axes):
+        try:
+            return Scenario.from_dict({**data, "body": cell}), cell
+        except BodyError:
+            continue
+    Scenario.from_dict({**data, "body": next(_body_cells(body_t, axes))})
+    raise AtlasError("no cell of the atlas has an admissible body")
+
+
 def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object) -> AtlasSpec:
     """The spec of an atlas whose cells' levels are the ``[initial]`` state's under each model
     (a ``model`` axis, or a model other than the meridian one): body keys and ``model`` as
     axes, the state fixed."""
     from rollingtop.reduction.models import reduction_of
-    from rollingtop.scenario import Scenario
 
     on_level = [key for key in axes if key in LEVEL_KEYS]
     if on_level:
@@ -272,21 +290,8 @@ def _state_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: object
             "needs an [initial] table (gamma, omega): each model's level is that "
             "state's"
         )
-    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
     data.pop("level", None)
-    # The state is checked against the first cell's body that is admissible; a cell whose
-    # body is inadmissible is that cell's status (1), not a refusal of the whole atlas.
-    sc = None
-    for cell in _body_cells(body_t, axes):
-        try:
-            sc = Scenario.from_dict({**data, "body": cell})
-        except BodyError:
-            continue
-        body_t = cell
-        break
-    if sc is None:  # every cell's body is inadmissible: what is wrong with the first
-        Scenario.from_dict({**data, "body": next(_body_cells(body_t, axes))})
-        raise AtlasError("no cell of the atlas has an admissible body")
+    sc, body_t = _first_admissible(data, axes)
     if "model" not in axes:
         try:
             reduction_of(sc.model)
@@ -348,7 +353,6 @@ def _chaos_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: str) -
     """The spec of a chaos atlas (:mod:`._chaos`): a model without a reduction (``oblique``,
     ``parallel``), the ``[initial]`` state fixed, body keys and ``angle`` (oblique) as axes."""
     from rollingtop.atlas._chaos import CHAOS_MODELS, free_key, has_angle
-    from rollingtop.scenario import Scenario
 
     on_level = [key for key in axes if key in LEVEL_KEYS]
     if on_level:
@@ -371,18 +375,7 @@ def _chaos_spec(data: dict[str, Any], axes: dict[str, FloatArray], model: str) -
     if "angle" in axes:
         contact["angle"] = float(axes["angle"][0])
     data["contact"] = contact
-    body_t = dict(data.get("body", {})) if isinstance(data.get("body", {}), dict) else {}
-    sc = None
-    for cell in _body_cells(body_t, axes):
-        try:
-            sc = Scenario.from_dict({**data, "body": cell})
-        except BodyError:
-            continue
-        body_t = cell
-        break
-    if sc is None:
-        Scenario.from_dict({**data, "body": next(_body_cells(body_t, axes))})
-        raise AtlasError("no cell of the atlas has an admissible body")
+    sc, body_t = _first_admissible(data, axes)
     if not sc.body.symmetric or sc.body.has_shell:  # pragma: no branch
         raise AtlasError(
             "a chaos atlas needs a dynamically symmetric body (I1 = I2) without a shell"
