@@ -393,10 +393,24 @@ def docs_block(res) -> str:
     else:
         when = res["date"]
     return (
-        f"Measured on {m['cpu']}, {m['cores']} cores, Python {m['python']}, numpy {m['numpy']}, "
-        f"scipy {m['scipy']}, numba {m['numba']}; {when} (medians of repeated runs; the NumPy "
-        "baseline runs once):\n\n" + res["table_markdown"]
+        f"Measured on {_cpus(res)}, {m['cores']} cores, Python {m['python']}, numpy "
+        f"{m['numpy']}, scipy {m['scipy']}, numba {m['numba']}; {when} (medians of repeated "
+        "runs; the NumPy baseline runs once):\n\n" + res["table_markdown"]
     )
+
+
+def _cpus(res, parts=None) -> str:
+    """The CPU the results (or ``parts`` of them) were measured on; where parts ran on different
+    machines (this VM's kind changes between sessions), which part on which: a ratio is
+    measured side by side on one machine, but times of two machines do not compare."""
+    machines = res.get("machines", {})
+    chosen = {p: machines[p] for p in (parts or machines) if p in machines}
+    if len(set(chosen.values())) <= 1:
+        return next(iter(chosen.values()), res["machine"]["cpu"])
+    by_cpu: dict[str, list[str]] = {}
+    for part, cpu in sorted(chosen.items()):
+        by_cpu.setdefault(cpu, []).append(part)
+    return " and ".join(f"{cpu} ({', '.join(ps)})" for cpu, ps in by_cpu.items())
 
 
 def replace_block(text: str, block: str, where: object = DOCS_PAGE) -> str:
@@ -428,7 +442,8 @@ def readme_block(res) -> str:
     )
     rows = [
         f"W1 (the paper's body and state, t = {w1r['t_end']:g}, rtol {w1r['rtol']:g}) on "
-        f"{m['cpu']}, {m['cores']} cores, numba {m['numba']}: time of each over rollingtop's "
+        f"{_cpus(res, ('W1', 'C', 'peers'))}, {m['cores']} cores, numba {m['numba']}: time of "
+        "each over rollingtop's "
         "(which also projects onto the constraints and monitors the reaction at every step; "
         "medians of paired, interleaved runs):",
         "",
@@ -448,8 +463,9 @@ def readme_block(res) -> str:
     numpy_rhs = w1r["solve_ivp_numpy_rhs"]["speedup_of_rollingtop"]  # paired with rollingtop
     rows.append(f"| SciPy solve_ivp DOP853, NumPy rhs (one run) | {numpy_rhs:.0f} |")
     w2r = res["W2"]
-    rows += ["", "Start-up on the same machine: what a newcomer waits for, each a whole process "
-             "(the first command of the quick start is the first row):", "", start_table(cs),
+    rows += ["", f"Start-up on {_cpus(res, ('cold_start',))}: what a newcomer waits for, each a "
+             "whole process (the first command of the quick start is the first row):", "",
+             start_table(cs),
              "", f"Ensemble of {w2r['n']} trajectories on 2 threads: "
              f"{100 * w2r['parallel_efficiency_2']:.0f} % parallel efficiency."]  # fmt: skip
     if res.get("atlas"):
@@ -523,8 +539,16 @@ def main() -> None:
     if only != parts:  # keep the other parts of the saved results
         res = json.loads(Path(args.out).read_text())
     now = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())
+    # the CPU each part was measured on: a part kept from --out keeps the machine it ran on
+    # (results saved before "machines" was recorded: the machine they name)
+    saved_cpu = res.get("machine", {}).get("cpu")
+    machines = res.setdefault("machines", {})
+    for part in res.get("dates", {}):
+        if saved_cpu:
+            machines.setdefault(part, saved_cpu)
     res |= {"machine": machine(), "quick": quick, "date": now}
     res.setdefault("dates", {}).update({part: now for part in only})
+    machines.update({part: res["machine"]["cpu"] for part in only})
     # W2 first: the parallel measurement wants otherwise idle cores
     if "W2" in only:
         print("W2 ...", flush=True)
