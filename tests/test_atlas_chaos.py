@@ -19,6 +19,9 @@ from rollingtop.chaos.level import level_states
 from rollingtop.chaos.lyapunov import chaos_indicators
 from rollingtop.contact.oblique import oblique
 
+#: One pytest-xdist worker runs this module (its fixture classifies the two angles once).
+pytestmark = pytest.mark.xdist_group("atlas-chaos")
+
 BODY = {"R": 1.0, "m": 1.0, "g": 1.0, "a3": 0.1, "I1": 0.3, "I3": 0.5}
 STATE = {"gamma": [0.0, 0.6, 0.8], "omega": [0.7, -0.3, 2.0], "v_slip": 0.25}
 T_END = 40.0

@@ -108,12 +108,14 @@ def test_simulate_runs_when_numba_cannot_save_its_cache(tmp_path):
     (``EFBIG``); the command still succeeds, with the compile notice and one warning line, and
     costs at most one more compilation than a cold run (the caches are switched off at the first
     failure: before, each cached function of the chain cost one more compilation of its caller,
-    two minutes in all). The paper's model alone is compiled."""
+    two minutes in all). The smooth model alone is compiled (the quickest to compile: the
+    failure path is the same for every model)."""
     script = (
         "import resource, signal, sys, runpy\n"
         "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
         "resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000))\n"
-        "sys.argv = ['rollingtop', 'simulate', 'examples/paper.toml', '--t-end', '0.1', '--json']\n"
+        "sys.argv = ['rollingtop', 'simulate', 'examples/smooth.toml', '--t-end', '0.1',"
+        " '--json']\n"
         "runpy.run_module('rollingtop.cli', run_name='__main__')\n"
     )
     env = os.environ | {"NUMBA_CACHE_DIR": str(tmp_path / "cache")}
@@ -123,7 +125,7 @@ def test_simulate_runs_when_numba_cannot_save_its_cache(tmp_path):
     assert json.loads(proc.stdout)["t_end"] == 0.1
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 2, proc.stderr
-    assert lines[0].startswith("rollingtop: compiling the meridian model's integrator kernels")
+    assert lines[0].startswith("rollingtop: compiling the smooth model's integrator kernels")
     assert "compiled kernels not saved" in lines[1]
 
 
