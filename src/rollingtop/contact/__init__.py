@@ -14,7 +14,10 @@ reduction) and its compiled functions, all with the same signatures:
   variants that carry a constraint direction in ``psi_nu``).
 
 The variant argument is the kernel's index among the model's kernels (0 its own); a model with
-variants receives it at run time, one without receives the constant 0.
+variants receives it at run time, one without receives the constant 0. All of them are
+``@inline`` (:func:`rollingtop._jit.inline`): the compiled dispatch inlines them with that
+constant, so numba prunes the branches of the other variants before it types and lowers them
+(a model's own kernel compiles none of its pole variants' code).
 
 **Adding a model** is one module here plus one line in :data:`MODULES`: its compiled package
 (:mod:`rollingtop._compiled`) is made from the template when first imported, and its cache

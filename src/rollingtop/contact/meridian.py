@@ -57,7 +57,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import inline, kernel
+from rollingtop._jit import inline
 from rollingtop._types import Float6, FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
@@ -165,7 +165,7 @@ def nu_of(p: FloatArray, y: FloatArray, variant: int) -> Float6:
     return nu_carried(p, y, variant == NORTH)
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import inline, kernel
+from rollingtop._jit import inline
 from rollingtop._layout import CONTACT_PARAMS
 from rollingtop._types import ComplexArray, Float3, Float6, FloatArray, Workspace
 from rollingtop.contact._base import (
@@ -98,7 +98,7 @@ def d_of(p: FloatArray, y: FloatArray) -> Float6:
     return d1, d2, d3, dd1, dd2, dd3
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:

@@ -282,7 +282,7 @@ def tau_of(p: FloatArray, y: FloatArray) -> Float6:
     return t1, t2, t3, td1, td2, td3
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import inline, kernel
+from rollingtop._jit import inline
 from rollingtop._types import Float3, Float6, FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._rows import contact_arm_rate, contact_row, free_forces
@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:

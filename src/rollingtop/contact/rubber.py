@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import inline, kernel
+from rollingtop._jit import inline
 from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, contact_arm
 from rollingtop.contact._rows import contact_arm_rate, contact_row, free_forces
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 NO_SPIN = "(omega, gamma) = 0"
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:

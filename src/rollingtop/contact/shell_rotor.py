@@ -68,7 +68,7 @@ if TYPE_CHECKING:
 DELTA = 17
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:

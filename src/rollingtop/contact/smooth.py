@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rollingtop._jit import inline, kernel
+from rollingtop._jit import inline
 from rollingtop._types import FloatArray, Workspace
 from rollingtop.contact._base import ContactModel, FreeVelocity, Symbolic, Vertical, contact_arm
 from rollingtop.contact._closed import project_contact, rhs_contact
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     from rollingtop.body import SphericalTop
 
 
-@kernel
+@inline
 def rows(
     p: FloatArray, y: FloatArray, J: FloatArray, bias: FloatArray, dirs: FloatArray, variant: int
 ) -> int:
