@@ -229,6 +229,35 @@ def test_a_run_not_held_says_so_and_keeps_its_file(tmp_path, capsys, monkeypatch
     assert stderr.count("\n") == 1 and out.stat().st_size > 0
 
 
+def test_a_drift_beyond_doubles_is_not_vouched_for(tmp_path):
+    """A body with ``I1 = 1e300``: the natural size of F6 (``|grad F6| |u|``, about 1e448) is
+    beyond doubles. Its relative drift was drift / inf = 0, the run "held" with exit 0 although
+    F6 drifted by 2e297 of -2e298, and two raw numpy overflow warnings were printed (the pole
+    test's ``|I w|`` overflowed: the variant was chosen on inf). Now: no relative drift (null),
+    not held, exit 1 with one line; the integrals whose size is finite keep theirs."""
+    text = (EXAMPLES / "paper.toml").read_text().replace("I1 = 0.3", "I1 = 1e300")
+    assert "I1 = 1e300" in text
+    status, out, err = rollingtop(
+        "simulate", scenario(tmp_path, "big.toml", text), "--project-integrals", "--json"
+    )
+    assert status == 1, err
+    summary = json.loads(out)
+    assert summary["projection"] == {
+        "held": False,
+        "worst": "F6",
+        "max_rel_drift": None,
+        "tolerance": summary["projection"]["tolerance"],
+    }
+    assert summary["integrals"]["F6"]["max_rel_drift"] is None
+    assert summary["integrals"]["F6"]["max_abs_drift"] > 0
+    assert 0 < summary["integrals"]["jellett"]["max_rel_drift"] < 1e-6  # finite size: measured
+    assert err.splitlines() == [
+        "rollingtop: error: the projection did not hold F6: drift "
+        f"{summary['integrals']['F6']['max_abs_drift']:.2e}, which cannot be measured against "
+        "its natural size (beyond double precision)"
+    ], err
+
+
 # ---- rows 4-7: the atlas ------------------------------------------------------------------
 ATLAS_STATE = (
     '[contact]\nmodel = "meridian"\n[initial]\ngamma = [0.0, 0.6, 0.8]\n'

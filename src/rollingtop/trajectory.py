@@ -239,8 +239,13 @@ class Trajectory(NetCDFOutput):
                 "initial": float(values[0]),
                 "final": float(values[-1]),
                 "max_abs_drift": drift,
-                # on the integral's natural size: the size it can take at the run's speed
-                "max_rel_drift": drift / scales[name] if scales[name] > 0 else None,
+                # on the integral's natural size: the size it can take at the run's speed (None
+                # where that size is 0, or beyond doubles: no relative drift can be measured)
+                "max_rel_drift": (
+                    drift / scales[name]
+                    if 0 < scales[name] < np.inf and np.isfinite(drift)
+                    else None
+                ),
             }
         min_normal = min(
             float(np.min(self.normal_force)), self.step_reactions.get("min_normal_force", np.inf)
@@ -252,15 +257,23 @@ class Trajectory(NetCDFOutput):
         )
         held = {}
         if "projection_passes" in self.stats:  # a run that claims its integrals held
-            worst = max(integrals, key=lambda k: integrals[k]["max_rel_drift"] or 0.0)
-            drift = integrals[worst]["max_rel_drift"] or 0.0
-            verdict = {
-                "held": bool(drift <= HELD_TOLERANCE),
-                "worst": worst,
-                "max_rel_drift": drift,
-                "tolerance": HELD_TOLERANCE,
-            }
-            held = {"projection": verdict}
+            # an integral that drifted where no relative drift can be measured is not vouched for
+            unmeasured = [
+                k
+                for k, v in integrals.items()
+                if v["max_rel_drift"] is None and not v["max_abs_drift"] == 0.0
+            ]
+            if unmeasured:
+                verdict = {"held": False, "worst": unmeasured[0], "max_rel_drift": None}
+            else:
+                worst = max(integrals, key=lambda k: integrals[k]["max_rel_drift"] or 0.0)
+                drift = integrals[worst]["max_rel_drift"] or 0.0
+                verdict = {
+                    "held": bool(drift <= HELD_TOLERANCE),
+                    "worst": worst,
+                    "max_rel_drift": drift,
+                }
+            held = {"projection": {**verdict, "tolerance": HELD_TOLERANCE}}
         return {
             "model": self.model.name,
             **(

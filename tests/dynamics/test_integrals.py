@@ -150,3 +150,30 @@ def test_natural_scales_by_hand(paper_body):
     # jellett = (I w, r), r = -R gamma - a3 e3; area = (I w, gamma)
     assert sizes["jellett"] == pytest.approx(size([(0, -0.6, -0.9), (-0.6, 0, 0.7)]), rel=1e-15)
     assert sizes["area"] == pytest.approx(size([(0, 0.6, 0.8), (0.6, 0, -0.8)]), rel=1e-15)
+
+
+def test_natural_scales_do_not_overflow_below_doubles():
+    """The natural size of an integral is a norm of products: with ``I1 = 1e300`` the squares
+    of its terms overflow although the norm is ~1e300. Scaled norms: finite, and equal to the
+    same computation in exact rational arithmetic (``fractions``) within ``SCALE_RTOL``."""
+    from fractions import Fraction
+
+    from rollingtop import SphericalTop, initial_state
+    from rollingtop.dynamics.integrals import natural_scales
+
+    SCALE_RTOL = 1e-12
+    body = SphericalTop(R=1.0, m=1.0, g=1.0, a3=0.1, I1=1e300, I3=0.5)
+    y = initial_state(body, "meridian", gamma=(0.0, 0.6, 0.8), omega=(0.7, -0.3, 2.0),
+                      free={"v_tau": 0.25})  # fmt: skip
+    size = natural_scales(body, y[None, :], ("jellett",), model="meridian")["jellett"]
+    # Jellett's integral (I w, r), r = -R gamma - a (the sign does not enter): linear in w,
+    # its gradient is I_j r_j, so |grad|_(M^-1)^2 = sum I_j r_j^2 and
+    # |u|_M^2 = m |v|^2 + sum I_j w_j^2, exactly
+    r = [Fraction(float(body.R)) * Fraction(float(g)) for g in y[12:15]]
+    r[2] += Fraction(float(body.a3))
+    inertia = [Fraction(float(i)) for i in body.inertia]
+    dual = sum(ii * ri * ri for ri, ii in zip(r, inertia, strict=True))
+    speed = sum(Fraction(float(v)) ** 2 for v in y[0:3]) * Fraction(float(body.m))
+    speed += sum(ii * Fraction(float(w)) ** 2 for ii, w in zip(inertia, y[3:6], strict=True))
+    exact = math.sqrt(dual) * math.sqrt(speed)
+    assert math.isfinite(size) and size == pytest.approx(exact, rel=SCALE_RTOL)

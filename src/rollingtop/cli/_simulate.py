@@ -186,8 +186,18 @@ def simulate(
             click.echo(f"wrote {output}")
     held = summary.get("projection")
     if held is not None and not held["held"]:
+        if held["max_rel_drift"] is None:
+            row = summary["integrals"][held["worst"]]
+            why = (
+                f"drift {row['max_abs_drift']:.2e}, which cannot be measured against its "
+                "natural size (beyond double precision)"
+            )
+        else:
+            why = (
+                f"drift {held['max_rel_drift']:.2e} of its natural size, above "
+                f"{held['tolerance']:g}"
+            )
         raise NotHeld(
-            f"the projection did not hold {held['worst']}: drift {held['max_rel_drift']:.2e} of "
-            f"its natural size, above {held['tolerance']:g}"
+            f"the projection did not hold {held['worst']}: {why}"
             + ("" if output is None else f" (written to {output} all the same)")
         )

@@ -259,7 +259,7 @@ def select_variant(body: SphericalTop, y: FloatArray) -> str | None:
     Iw = body.inertia * np.asarray(y[3:6], dtype=float)
     M3 = body.I3 * y[5]
     C1 = float(np.dot(Iw, y[12:15]))
-    pole = pole_case(M3, C1, float(np.linalg.norm(Iw)))
+    pole = pole_case(M3, C1, math.hypot(*Iw))  # no square overflows
     if pole == "north":
         return "north"
     if pole is not None:  # "south", or "both" (no spin: the carried direction does not turn)

@@ -302,18 +302,29 @@ def natural_scales(
     still[:, velocity] = 0.0
     metric = [body.m] * 3 + [float(x) for x in body.inertia]
     metric += [body.shell_inertia] * slot_is_velocity
-    speed = np.sqrt(np.sum(np.asarray(metric) * Y[:, velocity] ** 2, axis=-1))  # |u|_M
+    root = np.sqrt(np.asarray(metric))
+    speed = _norms(root[:, None] * Y[:, velocity].T)  # |u|_M
     out = {}
     for name in names:
         if name == "energy":
             e0 = evaluate(body, still, (name,), model=model)[name]
             size = evaluate(body, Y, (name,), model=model)[name] - e0 + np.abs(e0)
         else:
-            dual = np.zeros(Y.shape[0])  # |grad I|^2 in the metric M^-1
-            for j, mass in zip(velocity, metric, strict=True):
+            grad = np.empty((len(velocity), Y.shape[0]))  # grad I in the metric M^-1
+            for row, (j, r) in enumerate(zip(velocity, root, strict=True)):
                 unit = still.copy()
                 unit[:, j] = 1.0
-                dual += evaluate(body, unit, (name,), pole, model=model)[name] ** 2 / mass
-            size = np.sqrt(dual) * speed
+                grad[row] = evaluate(body, unit, (name,), pole, model=model)[name] / r
+            with np.errstate(over="ignore"):  # a product beyond doubles: inf, said by the caller
+                size = _norms(grad) * speed
         out[name] = float(np.max(size)) if size.size else 0.0
     return out
+
+
+def _norms(parts: FloatArray) -> FloatArray:
+    """The Euclidean norm of each column of ``parts`` (shape ``(k, n)``), scaled by the column's
+    largest magnitude: no square overflows (an inertia of 1e300 has a gradient of that size)."""
+    scale = np.max(np.abs(parts), axis=0)
+    unit = np.where(scale > 0, scale, 1.0)
+    norms: FloatArray = scale * np.sqrt(np.sum((parts / unit) ** 2, axis=0))
+    return norms
