@@ -258,6 +258,23 @@ def test_a_drift_beyond_doubles_is_not_vouched_for(tmp_path):
     ], err
 
 
+def test_h_on_the_command_line_replaces_the_files(tmp_path):
+    """``orbits --h 5`` on a file whose ``[level]`` has ``h = 0`` (below the minimum of U):
+    was refused naming h = 0, the file's, as if ``--h`` were not given. Now the orbits at h = 5,
+    the same as those of the file with ``h = 5`` written in it."""
+    level = "[level]\njellett = 1.0\nrouth = 1.5\nh = {h}\n"
+    text = BODY + '[contact]\nmodel = "rough"\n' + level
+    below = scenario(tmp_path, "h0.toml", text.format(h=0.0))
+    written = scenario(tmp_path, "h5.toml", text.format(h=5.0))
+    status, out, err = rollingtop("orbits", below, "--h", "5", "--json")
+    assert status == 0, err
+    assert json.loads(out)["level"]["h"] == 5.0 and json.loads(out)["orbits"]
+    status, same, err = rollingtop("orbits", written, "--json")
+    assert status == 0 and json.loads(same) == json.loads(out), err
+    status, _, err = rollingtop("orbits", below)  # without --h: the file's h, refused
+    assert status == 2 and "at h = 0:" in err
+
+
 # ---- rows 4-7: the atlas ------------------------------------------------------------------
 ATLAS_STATE = (
     '[contact]\nmodel = "meridian"\n[initial]\ngamma = [0.0, 0.6, 0.8]\n'

@@ -382,8 +382,12 @@ def _reject_unknown(table: str, values: Mapping[str, object], allowed: tuple[str
             )
 
 
-def load_scenario(path: str | os.PathLike[str]) -> Scenario:
+def load_scenario(path: str | os.PathLike[str], *, level_h: float | None = None) -> Scenario:
     """Read and validate a TOML scenario file.
+
+    ``level_h`` replaces the ``[level]`` table's ``h`` before the scenario is validated (the
+    command line's ``--h``: a file whose own ``h`` has no motion is still read at the ``h``
+    asked for); a file without a ``[level]`` table is read as it is.
 
     Raises
     ------
@@ -402,6 +406,8 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
         raise ScenarioError(f"{path}: invalid TOML: arrays or tables nested too deeply") from None
     except ValueError:  # an integer beyond Python's limit on converting digits (4300)
         raise ScenarioError(f"{path}: invalid TOML: an integer with too many digits") from None
+    if level_h is not None and isinstance(data.get("level"), dict):
+        data["level"] = {**data["level"], "h": level_h}
     try:
         return Scenario.from_dict(data, source=str(path))
     except RollingTopError as exc:

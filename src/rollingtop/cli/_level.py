@@ -137,7 +137,7 @@ def orbits(scenario: str, h: float | None, as_json: bool) -> None:
 
     if h is not None and not math.isfinite(h):
         raise BadInput(f"--h {h:g} must be finite")
-    sc = load_scenario(scenario)
+    sc = load_scenario(scenario, level_h=h)  # --h replaces [level]'s h before it is checked
     level = sc.level_set()
     h = sc.level_h() if h is None else h
     survey = survey_orbits(level, h)
