@@ -410,6 +410,35 @@ def test_a_body_beyond_doubles_is_one_line_naming_it(tmp_path, model):
     assert "overflows double precision" in err and ("R = 1e+150" in err or "|v| = " in err)
 
 
+@pytest.mark.parametrize("model", ["rough", "meridian", "rubber"])
+@pytest.mark.parametrize("command", ["simulate", "stability"])
+def test_a_body_beyond_doubles_is_named_by_simulate_and_stability(tmp_path, model, command):
+    """Issue 36 row 12, found again by a review: ``simulate`` said "the initial state or its
+    derivative is not finite ... (initial values too large?)" (exit 1), ``stability`` blamed the
+    spin ("choose a smaller omega3") or the level alone. Now both name ``R = 1e+150`` in one
+    line, exit 2, and leave no file (the rubber model has no vertical spin: said first)."""
+    v = "v_tau = 0.25\n" if model == "meridian" else ""
+    body = BODY.replace("R = 1.0", "R = 1e150").replace("a3 = 0.1", "a3 = 1e149")
+    omega = "[0.7, -0.3, 2.0]" if model != "rubber" else "[0.7, -1.6, 1.2]"  # rubber: (w, g) = 0
+    path = scenario(
+        tmp_path,
+        "b.toml",
+        f'{body}[contact]\nmodel = "{model}"\n'
+        f"[initial]\ngamma = [0.0, 0.6, 0.8]\nomega = {omega}\n{v}",
+    )
+    out = tmp_path / "b.nc"
+    args = (
+        ("simulate", path, "--t-end", "1", "-o", out) if command == "simulate" else (command, path)
+    )
+    code, _, err = rollingtop(*args)
+    assert code == 2 and err.count("\n") == 1, err
+    if model == "rubber" and command == "stability":
+        assert "has no vertical spin" in err
+    else:
+        assert "R = 1e+150" in err and "double precision" in err, err
+    assert not out.exists()
+
+
 def test_a_spin_too_small_for_a_diagram_is_said(tmp_path):
     """Issue 36 row 12: `bifurcation` at ``omega3 = 1e-300`` said "C2 range (2.25e+298,
     2.25e+298) must be finite and increasing"; now one line naming M3."""

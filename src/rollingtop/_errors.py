@@ -34,6 +34,11 @@ class IntegrationError(RuntimeError):
     """The integrator could not reach the requested end time."""
 
 
+class NotFiniteAtStart(IntegrationError):
+    """The initial state or its derivative is not finite: the integrator took no step (the
+    caller, who knows the body, may name the input that overflows)."""
+
+
 class Interrupted(KeyboardInterrupt):
     """A run was stopped by a signal (SIGINT or SIGTERM); ``signum`` says which.
 

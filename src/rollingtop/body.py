@@ -8,6 +8,7 @@ sphere of radius ``R`` and mass ``m`` whose centre of mass lies on the symmetry 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import overload
 
@@ -16,7 +17,7 @@ from numpy.typing import NDArray
 
 from rollingtop._errors import BodyError
 
-__all__ = ["SphericalTop"]
+__all__ = ["OVERFLOW_DECADES", "SphericalTop", "largest_input"]
 
 #: Names and meanings of the parameters, in the order of the compiled parameter vector.
 PARAMETERS = {
@@ -187,3 +188,23 @@ class SphericalTop:
         if self.has_shell:
             keys += ("shell_mass", "shell_inertia")
         return {k: float(getattr(self, k)) for k in keys}
+
+
+#: An input at least this many decades from 1 is named where a product overflows (two such
+#: factors, or a square, reach the largest double, 1.8e308).
+OVERFLOW_DECADES = 50
+
+
+def largest_input(
+    body: SphericalTop, y: Sequence[float] | NDArray[np.float64]
+) -> tuple[str, float]:
+    """The body parameter or speed of the state ``y`` (shape (18,)) farthest from 1 in magnitude,
+    as ``("name = value", |log10 value|)``: the input to blame for an overflow."""
+    named = {
+        k: float(getattr(body, k))
+        for k in ("R", "m", "g", "a3", "I1", "I2", "I3", "shell_mass", "shell_inertia")
+    }
+    named |= {"|v|": math.hypot(*map(float, y[0:3])), "|omega|": math.hypot(*map(float, y[3:6]))}
+    sizes = {k: abs(math.log10(abs(v))) for k, v in named.items() if v != 0 and math.isfinite(v)}
+    worst = max(sizes, key=sizes.__getitem__)
+    return f"{worst} = {named[worst]:g}", sizes[worst]

@@ -19,10 +19,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._compiled import for_code
 from rollingtop._compiled._kernel import new_workspace
-from rollingtop._errors import ContactLostWarning, InitialStateError, ScenarioError
+from rollingtop._errors import (
+    ContactLostWarning,
+    InitialStateError,
+    NotFiniteAtStart,
+    ScenarioError,
+)
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE
-from rollingtop.body import SphericalTop
+from rollingtop.body import OVERFLOW_DECADES, SphericalTop, largest_input
 from rollingtop.contact import ContactModel, get_model, models_for
 from rollingtop.dynamics.start import InitialConditions
 from rollingtop.dynamics.state import UNIT_TOLERANCE, constraint_residuals, project_state
@@ -276,19 +281,29 @@ def _run(
                 "yet (its integrals carry the shell's terms)"
             )
         held = model.integrals_for(body)
-    result = integrate(
-        code,
-        model.params(body),
-        y0,
-        opts.t_eval,
-        rtol=opts.rtol,
-        atol=opts.resolved_atol,
-        max_steps=opts.max_steps,
-        progress=progress,
-        events=events,
-        event_direction=event_direction,
-        project_integrals=held,
-    )
+    try:
+        result = integrate(
+            code,
+            model.params(body),
+            y0,
+            opts.t_eval,
+            rtol=opts.rtol,
+            atol=opts.resolved_atol,
+            max_steps=opts.max_steps,
+            progress=progress,
+            events=events,
+            event_direction=event_direction,
+            project_integrals=held,
+        )
+    except NotFiniteAtStart:
+        blamed, size = largest_input(body, y0)
+        if size < OVERFLOW_DECADES:  # no input far enough from 1 to make a product overflow
+            raise
+        raise InitialStateError(  # a bad input, named (the reduction's commands say the same)
+            f"the derivative of the initial state is not finite at t = {opts.t_eval[0]:.9g}: "
+            f"{blamed} overflows double precision in the products of the equations; rescale "
+            "the units of the scenario"
+        ) from None
     stats = {
         "steps": result.steps,
         "rejected_steps": result.rejected_steps,

@@ -40,7 +40,7 @@ from rollingtop._jit import call
 from rollingtop._layout import N_STATE
 from rollingtop._numdiff import central_jacobian
 from rollingtop._types import ComplexArray, FloatArray
-from rollingtop.body import SphericalTop
+from rollingtop.body import OVERFLOW_DECADES, SphericalTop, largest_input
 from rollingtop.contact import ContactModel, get_model
 
 __all__ = ["StabilityError", "VerticalSpin", "vertical_spin_eigenvalues", "vertical_spins"]
@@ -81,6 +81,18 @@ _OVERFLOW = (
 )
 
 
+def _overflow(body: SphericalTop, omega3: float, x0: FloatArray) -> str:
+    """The refusal of a linearisation that overflows: the body parameter to blame where one is
+    far from 1 (``R = 1e150``), else the spin."""
+    blamed, decades = largest_input(body, _state(x0))
+    if decades >= OVERFLOW_DECADES and not blamed.startswith("|omega|"):
+        return (
+            f"the linearisation at omega3 = {omega3:.3g} overflows double precision: {blamed} "
+            "is beyond the products of the equations; rescale the units of the scenario"
+        )
+    return _OVERFLOW.format(omega3)
+
+
 def _generic_eigenvalues(
     model: ContactModel, body: SphericalTop, omega3: float, pole: int
 ) -> ComplexArray:
@@ -105,14 +117,14 @@ def _generic_eigenvalues(
     with np.errstate(all="ignore"):  # an overflow is refused below, in one line
         G = central_jacobian(constraints, x0)
     if not np.all(np.isfinite(G)):
-        raise StabilityError(_OVERFLOW.format(omega3))
+        raise StabilityError(_overflow(body, omega3, x0))
     _, sv, vt = np.linalg.svd(G)
     rank = int(np.sum(sv > 1e-9 * sv[0]))
     T = vt[rank:].T  # orthonormal basis of the tangent space of the constraint manifold
     with np.errstate(all="ignore"):
         A = T.T @ central_jacobian(rhs, x0) @ T
     if not np.all(np.isfinite(A)):
-        raise StabilityError(_OVERFLOW.format(omega3))
+        raise StabilityError(_overflow(body, omega3, x0))
     out: ComplexArray = np.linalg.eigvals(A).astype(complex)
     return out
 

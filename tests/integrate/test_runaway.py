@@ -17,6 +17,7 @@ import pytest
 from rollingtop import IntegrationError, SphericalTop, initial_state, simulate
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import for_code
+from rollingtop._errors import InitialStateError
 from rollingtop.contact import get_model
 from rollingtop.integrate import integrate
 from rollingtop.integrate.driver import _workspace, compile_kernels
@@ -72,8 +73,10 @@ def test_huge_spin_ends_a_single_run(tmp_path, omega3):
     path = tmp_path / "huge.toml"
     path.write_text(scenario_text(initial=initial), encoding="utf-8")
     exc, seconds = timed(simulate, path, t_end=50.0)
-    assert isinstance(exc, IntegrationError)
-    assert "initial state or its derivative is not finite at t = 0" in str(exc)
+    # a bad input, named (issue 36 row 12): was an IntegrationError "initial values too large?"
+    assert isinstance(exc, InitialStateError)
+    assert "derivative of the initial state is not finite at t = 0" in str(exc)
+    assert f"|omega| = {omega3:g} overflows double precision" in str(exc)
     assert seconds < RETURNS_WITHIN_S
 
 
@@ -185,7 +188,8 @@ def test_every_status_has_a_name():
 
 
 def test_cli_reports_a_huge_spin_in_one_line(tmp_path):
-    """``rollingtop simulate`` on ``omega3 = 1e170`` (the reported hang): exit 1, one line."""
+    """``rollingtop simulate`` on ``omega3 = 1e170`` (the reported hang): exit 2 (a bad input,
+    named), one line."""
     initial = "gamma = [0.0, 0.6, 0.8]\nomega = [0.7, -0.3, 1e170]\nv_tau = 0.25"
     (tmp_path / "huge.toml").write_text(scenario_text(initial=initial), encoding="utf-8")
     proc = subprocess.run(
@@ -197,9 +201,10 @@ def test_cli_reports_a_huge_spin_in_one_line(tmp_path):
         timeout=WATCHDOG_S,
     )
     lines = proc.stderr.splitlines()
-    assert proc.returncode == 1, proc.stderr
+    assert proc.returncode == 2, proc.stderr
     assert len(lines) == 1 and lines[0].startswith("rollingtop: error: ")
-    assert "not finite" in lines[0] and "Traceback" not in proc.stderr
+    assert "not finite" in lines[0] and "|omega| = 1e+170" in lines[0]
+    assert "Traceback" not in proc.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["huge.toml"]
 
 

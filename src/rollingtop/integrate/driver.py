@@ -15,7 +15,7 @@ from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import compiling, for_code, packages_of
 from rollingtop._compiled._events import EVENTS, NONE
 from rollingtop._compiled._kernel import new_workspace
-from rollingtop._errors import IntegrationError
+from rollingtop._errors import IntegrationError, NotFiniteAtStart
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
@@ -289,7 +289,7 @@ def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
         )
     if status == dop.NOT_FINITE:
         if counts[dop.STEPS] == 0 and counts[dop.REJECTED] == 0:
-            raise IntegrationError(
+            raise NotFiniteAtStart(
                 f"the initial state or its derivative is not finite at t = {t:.9g} "
                 "(initial values too large?)"
             )

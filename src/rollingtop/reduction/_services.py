@@ -25,7 +25,8 @@ from numpy.typing import NDArray
 from rollingtop._errors import RollingTopError
 from rollingtop._figures import draw
 from rollingtop._html import html_view
-from rollingtop.body import SphericalTop
+from rollingtop._layout import N_STATE
+from rollingtop.body import OVERFLOW_DECADES, SphericalTop, largest_input
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -95,9 +96,12 @@ def check_level_size(level: Any) -> None:
     except (OverflowError, ZeroDivisionError):  # Python floats raise where numpy's give inf
         size = math.inf
     if not size <= _MAX_U:
+        blamed, decades = largest_input(level.body, np.zeros(N_STATE))  # the body's alone
+        cause = f"; {blamed}" if decades >= OVERFLOW_DECADES else ""
         raise LevelSetError(
             f"level {level.describe()} is too large for double precision: its effective "
-            f"potential reaches {size:.3g} at gamma3 = 0 (at most {_MAX_U:g}; rescale units)"
+            f"potential reaches {size:.3g} at gamma3 = 0 (at most {_MAX_U:g}{cause}; rescale "
+            "units)"
         )
 
 

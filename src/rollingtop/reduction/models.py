@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._errors import ScenarioError
 from rollingtop._layout import W
-from rollingtop.body import SphericalTop
+from rollingtop.body import SphericalTop, largest_input
 from rollingtop.contact import MODELS, ContactModel, get_model
 from rollingtop.reduction.level import Level, LevelSet, LevelSetError
 from rollingtop.reduction.rough import RoughLevel, rough_integrals
@@ -122,7 +122,7 @@ class Reduction:
         if bad or not np.isfinite(scale):
             raise LevelSetError(
                 f"the level of the state is not finite ({', '.join(bad) or '|I w|'} = "
-                f"{float(values[bad[0]]) if bad else scale:g}): {_largest_input(body, y)} "
+                f"{float(values[bad[0]]) if bad else scale:g}): {largest_input(body, y)[0]} "
                 "overflows double precision in the integrals' products; rescale the "
                 "scenario's units"
             )
@@ -131,19 +131,6 @@ class Reduction:
     def reduced_energy(self, body: SphericalTop, y: ArrayLike) -> float:
         """The reduced energy ``h`` of the state ``y`` (:attr:`energy`)."""
         return float(self.integrals(body, np.asarray(y, dtype=float))["h"])
-
-
-def _largest_input(body: SphericalTop, y: NDArray[np.float64]) -> str:
-    """The body parameter or velocity of ``y`` farthest from 1 in magnitude, as ``name = value``
-    (the input to blame for an overflow)."""
-    named = {
-        k: float(getattr(body, k))
-        for k in ("R", "m", "g", "a3", "I1", "I2", "I3", "shell_mass", "shell_inertia")
-    }
-    named |= {"|v|": float(np.linalg.norm(y[0:3])), "|omega|": float(np.linalg.norm(y[W]))}
-    sizes = {k: abs(math.log10(abs(v))) for k, v in named.items() if v != 0 and np.isfinite(v)}
-    worst = max(sizes, key=sizes.__getitem__)
-    return f"{worst} = {named[worst]:g}"
 
 
 REDUCTIONS: dict[str, Reduction] = {
