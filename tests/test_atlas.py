@@ -505,7 +505,10 @@ def test_a_running_scheduler_passes_the_probe(tmp_path):
     from distributed import LocalCluster
 
     spec = atlas_spec_from_dict(spec_dict({"C2": [-2.0, 0.0]}))
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster:  # fmt: skip
+    # the scheduler's HTTP server on a free port, as the atlas's own cluster (on 8787, taken by
+    # another test's cluster, distributed warns)
+    free_port = {"dashboard_address": "127.0.0.1:0"}
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
+                      scheduler_kwargs=free_port) as cluster:  # fmt: skip
         ds = atlas(spec, scheduler=cluster.scheduler_address, scheduler_timeout=5.0)
     assert ds["n_steady"].values.tolist() == [3, 1]
