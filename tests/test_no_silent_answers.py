@@ -473,6 +473,38 @@ def test_a_tiny_rubber_spin_has_its_centre(tmp_path):
     assert code == 0, err
 
 
+def test_every_tiny_rubber_spin_has_the_small_spin_centre_or_a_refusal(tmp_path):
+    """Found by a review: below 1e-40 the centre's curvature came out wrong -- a period of 13.2
+    at rubber_spin = 1e-60, 20.93 (the value of no spin) from 1e-100 to 1e-160 -- and at 1e-200
+    no steady motion at all, exit 0. For any spin the centre sits where the barrier ``c F^2 /
+    d^2`` balances the pole's curvature ``k d^2 / 2``, and there ``U'' = 4 k``: half the period
+    of the level of no spin (``rubber_spin = 0``, computed by the pole case's own path), to
+    ``PERIOD_RTOL``. Below the floor where ``F^2`` leaves the normal doubles: one line, exit 2."""
+    PERIOD_RTOL = 1e-9
+
+    def equilibria(spin):
+        path = scenario(
+            tmp_path,
+            f"{spin}.toml",
+            f'{BODY}[contact]\nmodel = "rubber"\n[level]\nrubber_spin = {spin}\n',
+        )
+        return rollingtop("equilibria", path, "--json")
+
+    code, out, err = equilibria("0.0")
+    assert code == 0, err
+    (still,) = [m for m in json.loads(out)["equilibria"] if m["type"] == "center"]
+    for spin in ("1e-40", "1e-60", "1e-100", "1e-150"):
+        code, out, err = equilibria(spin)
+        assert code == 0, err
+        (centre,) = json.loads(out)["equilibria"]
+        assert centre["type"] == "center", spin
+        assert centre["period"] == pytest.approx(still["period"] / 2, rel=PERIOD_RTOL), spin
+    for spin in ("1e-160", "1e-200"):
+        code, out, err = equilibria(spin)
+        assert code == 2 and out == "" and err.count("\n") == 1, (spin, err)
+        assert f"rubber_spin = {spin} is below" in err and "underflows" in err
+
+
 # ---- item 6: budgets honoured --------------------------------------------------------------
 def test_ensemble_honours_the_scenarios_max_steps(tmp_path):
     """``[integration] max_steps`` was ignored by `ensemble` (its own 1e7 applied): now each

@@ -234,9 +234,17 @@ class Level(ABC):
     @overload
     def d2U(self, theta: FloatArray) -> FloatArray: ...
     def d2U(self, theta: float | FloatArray) -> float | FloatArray:
-        """``d^2U/dtheta^2`` by the complex step ``Im dU(theta + i h)/h`` (exact to round-off)."""
-        z: ComplexArray = np.asarray(theta, dtype=float) + 1j * _COMPLEX_STEP
-        return np.imag(self.dU(z)) / _COMPLEX_STEP  # a numpy float for a float theta
+        """``d^2U/dtheta^2`` by the complex step ``Im dU(theta + i h)/h`` (exact to round-off).
+
+        Next to a pole the step is ``1e-10`` times the distance to it (a truncation error of
+        1e-20 relative; the complex step has no cancellation): a steady motion there (a
+        mirrored level's, 1e-30 or 1e-75 from the pole) has its curvature on the scale of that
+        distance, which a fixed step of 1e-30 straddled, and a step far below it underflowed in
+        the barrier's products (``rubber_spin = 1e-150``: the curvature without the barrier)."""
+        t = np.asarray(theta, dtype=float)
+        near = np.minimum(np.abs(t), np.abs(math.pi - t))
+        h = np.where((near > 0) & (near < 1e-20), 1e-10 * near, _COMPLEX_STEP)
+        return np.imag(self.dU(t + 1j * h)) / h  # a numpy float for a float theta
 
     def v_tau(self, theta: Real) -> Real:
         """``v_tau = P / I1`` (:meth:`P`)."""

@@ -44,6 +44,7 @@ whole circle as the pole case ``"both"`` of :class:`~rollingtop.reduction.LevelS
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
@@ -52,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rollingtop.body import SphericalTop
 from rollingtop.reduction._services import (
+    LevelSetError,
     _Analytic,
     _AnalyticResult,
     check_level_size,
@@ -68,6 +70,12 @@ from rollingtop.reduction.level import (
 __all__ = ["RubberLevel", "rubber_integrals"]
 
 FloatArray = NDArray[np.float64]
+
+#: The smallest ``|rubber_spin|`` whose level is computed: its square, which the barrier of
+#: ``U`` next to the poles holds, stays a normal double with four decades to spare (below it
+#: the barrier underflows and the centre next to the pole took the curvature of no spin: a
+#: period twice too long at 1e-160, none at all at 1e-200).
+SPIN_FLOOR = math.sqrt(1e4 * sys.float_info.min)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -101,6 +109,12 @@ class RubberLevel(SpinInPotential, RollingMass, Level):
         )
         if F == 0.0 or abs(F) <= POLE_TOLERANCE * scale:
             F = 0.0
+        elif abs(F) < SPIN_FLOOR:
+            raise LevelSetError(
+                f"rubber_spin = {F:g} is below {SPIN_FLOOR:.1e}: its steady motion lies within "
+                f"{math.sqrt(abs(F)):.0e} of a pole, where the barrier of U underflows double "
+                "precision; give rubber_spin = 0 (the level of no spin) or a larger spin"
+            )
         object.__setattr__(self, "rubber_spin", F)
         object.__setattr__(self, "pole", "both" if F == 0.0 else None)
         check_level_size(self)
