@@ -190,8 +190,9 @@ class SphericalTop:
         return {k: float(getattr(self, k)) for k in keys}
 
 
-#: An input at least this many decades from 1 is named where a product overflows (two such
-#: factors, or a square, reach the largest double, 1.8e308).
+#: An input at least this many decades from 1 is named where a product of the equations
+#: overflows (they multiply several inputs and their squares: R^2 m w^2, I w^2 R, ...); an input
+#: nearer to 1 is not blamed, and the refusal stays generic.
 OVERFLOW_DECADES = 50
 
 
