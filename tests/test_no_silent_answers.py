@@ -273,6 +273,16 @@ def test_h_on_the_command_line_replaces_the_files(tmp_path):
     assert status == 0 and json.loads(same) == json.loads(out), err
     status, _, err = rollingtop("orbits", below)  # without --h: the file's h, refused
     assert status == 2 and "at h = 0:" in err
+    # a gamma3 chosen for the file's h places the start only: --h drops it (found by a review:
+    # fig5's [level] with gamma3 = -0.3 at h = 4 was refused at --h 3.3, below U(-0.3))
+    fig5 = (EXAMPLES / "fig5.toml").read_text().replace("h = 4.0", "h = 4.0\ngamma3 = -0.3")
+    assert "gamma3 = -0.3" in fig5
+    placed = scenario(tmp_path, "placed.toml", fig5)
+    plain = scenario(tmp_path, "plain.toml", (EXAMPLES / "fig5.toml").read_text())
+    status, out, err = rollingtop("orbits", placed, "--h", "3.3", "--json")
+    assert status == 0 and json.loads(out)["orbits"], err
+    status, same, err = rollingtop("orbits", plain, "--h", "3.3", "--json")
+    assert status == 0 and json.loads(same) == json.loads(out), err
 
 
 # ---- rows 4-7: the atlas ------------------------------------------------------------------

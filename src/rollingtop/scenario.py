@@ -387,7 +387,9 @@ def load_scenario(path: str | os.PathLike[str], *, level_h: float | None = None)
 
     ``level_h`` replaces the ``[level]`` table's ``h`` before the scenario is validated (the
     command line's ``--h``: a file whose own ``h`` has no motion is still read at the ``h``
-    asked for); a file without a ``[level]`` table is read as it is.
+    asked for), and drops its ``gamma3``, a point of the orbit at the file's ``h`` (the start is
+    then the orbit's first turning point at ``level_h``); a file without a ``[level]`` table is
+    read as it is.
 
     Raises
     ------
@@ -407,7 +409,8 @@ def load_scenario(path: str | os.PathLike[str], *, level_h: float | None = None)
     except ValueError:  # an integer beyond Python's limit on converting digits (4300)
         raise ScenarioError(f"{path}: invalid TOML: an integer with too many digits") from None
     if level_h is not None and isinstance(data.get("level"), dict):
-        data["level"] = {**data["level"], "h": level_h}
+        kept = {k: v for k, v in data["level"].items() if k != "gamma3"}
+        data["level"] = {**kept, "h": level_h}
     try:
         return Scenario.from_dict(data, source=str(path))
     except RollingTopError as exc:
