@@ -543,8 +543,8 @@ def main() -> None:
     # (results saved before "machines" was recorded: the machine they name)
     saved_cpu = res.get("machine", {}).get("cpu")
     machines = res.setdefault("machines", {})
-    for part in res.get("dates", {}):
-        if saved_cpu:
+    if saved_cpu:
+        for part in res.get("dates", {}):
             machines.setdefault(part, saved_cpu)
     res |= {"machine": machine(), "quick": quick, "date": now}
     res.setdefault("dates", {}).update({part: now for part in only})

@@ -261,7 +261,7 @@ class Trajectory(NetCDFOutput):
             unmeasured = [
                 k
                 for k, v in integrals.items()
-                if v["max_rel_drift"] is None and not v["max_abs_drift"] == 0.0
+                if v["max_rel_drift"] is None and v["max_abs_drift"] != 0.0  # NaN: drifted
             ]
             if unmeasured:
                 verdict = {"held": False, "worst": unmeasured[0], "max_rel_drift": None}
