@@ -178,19 +178,24 @@ def test_projection_holds_at_every_tolerance(example, tol):
     assert plain_energy(summary["final"], body) == pytest.approx(e0, rel=ENERGY_ROUNDOFF)
 
 
-def test_projection_at_the_pole_is_never_worse(tmp_path):
+@pytest.mark.parametrize("tol", [None, "1e-2", "1e-4", "1e-6", "1e-8"])
+def test_projection_at_the_pole_is_never_worse(tmp_path, tol):
     """Issue 36 row 3: through the vertical (a sample within 1e-9 of the pole) the projection
     made every integral worse (5e-10 against 9e-12 without) and moved omega3 off its exact
     value; now each linear integral is at round-off and omega3 (Lagrange's) stays exact to a
-    few units of round-off."""
+    few units of round-off. At the looser tolerances the area integral and Jellett's drifted
+    by 3e-8 (1e-2), 8e-6 (1e-4), 1e-9 (1e-6) and 3e-12 (1e-8) of their size, "not held": their
+    rows are dependent on Lagrange's within a tilt of 1e-4 of the vertical, where the velocity
+    cannot hold them; the projection now turns the body there."""
     text = (
         f'{BODY}[contact]\nmodel = "meridian"\n[initial]\ngamma = [0.0, 0.0, -1.0]\n'
         "omega = [0.0, 0.0, 2.0]\nv_tau = 0.3\n[integration]\nt_end = 20.0\n"
     )
     path = scenario(tmp_path, "pole.toml", text)
+    tolerances = [] if tol is None else ["--rtol", tol, "--atol", tol]
     runs = {}
     for flag in ([], ["--project-integrals"]):
-        code, out, err = rollingtop("simulate", path, "--json", *flag)
+        code, out, err = rollingtop("simulate", path, "--json", *tolerances, *flag)
         assert code == 0, err
         runs[bool(flag)] = json.loads(out)
     held, free = runs[True], runs[False]

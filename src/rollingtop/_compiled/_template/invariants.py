@@ -44,6 +44,17 @@ at this velocity), the residual is set to zero: the row still keeps the correcti
 direction. A well-conditioned row's round-off is corrected (else it would be left to wander
 up to that bound).
 
+**The attitude, for a dependent linear integral.** Within a tilt of about ``1e-4`` of the
+vertical the area integral's and Jellett's rows are Lagrange's to round-off and dropped: the
+velocity cannot hold them, and a motion through the vertical (the sleeping top of the meridian
+model started with ``v_tau``) left them off their values by the step's error (``8e-6`` at
+``rtol = 1e-4``), as far as the orbit then misses the pole. After the linear part, such an
+integral still off by more than :data:`SETTLED` units of round-off is corrected by turning the
+body about the axis perpendicular to ``gamma`` along which it falls fastest (a secant step on
+central differences, each trial with the linear part solved again, its ill-conditioned integral
+rows dropped in every trial alike); a slope within the differences' round-off
+(:data:`RESOLVED`) is no direction, and a turn that does not lower the residual is not taken.
+
 ``F6`` carries ``-M3 a3 theta``, with the signed ``theta`` of the carried direction: its value
 jumps by ``2 pi M3 a3`` where ``atan2`` wraps (a passage of the north pole in a pole case), so
 its deviation is taken modulo that.
@@ -78,6 +89,9 @@ SMALL_CHANGE = 1e-8
 NEWTON_ITERATIONS = 8
 #: After the last pass, a nonlinear residual within this many :data:`ROUNDOFF` s is on the level.
 SETTLED = 4.0
+#: An attitude slope of a linear integral below this many of its central difference's
+#: round-off is no direction (:func:`_attitude_step`).
+RESOLVED = 1e3
 #: Step of the central difference in the tilt angle (radians).
 TILT_STEP = 1e-5
 #: Below this ``|gamma x e3|`` (the pole) there is no tilt axis.
@@ -141,12 +155,13 @@ def _linear(
     pw: FloatArray,
     ws: Workspace,
     minv: FloatArray,
+    kept: float = DEPENDENT * DEPENDENT,
 ) -> int:
     """The constraints and the linear integrals: one exact minimum-norm correction of the
-    velocity of ``y`` (in place); the orthonormal rows stay in ``pw[0:n_rows]``. Returns
-    ``n_rows``."""
+    velocity of ``y`` (in place); the orthonormal rows stay in ``pw[0:n_rows]``. An integral's
+    row is kept where more than ``kept`` of its squared size is orthogonal to the earlier rows
+    (a constraint's where more than ``DEPENDENT ** 2``). Returns ``n_rows``."""
     J, bias, dirs = ws[0], ws[1], ws[2]
-    a3, I3 = p[3], p[6]
     n_int = icodes.shape[0]
     usize = _velocity_size(y, minv)
     nc = constraint_rows(code, p, y, J, bias, dirs)
@@ -164,18 +179,14 @@ def _linear(
             if not LINEAR[ic]:
                 continue
             velocity_gradient(ic, p, y, pw[n_rows])
-            res = integral_value(ic, p, y) - targets[i - nc]
-            if ic == F6:
-                period = 2.0 * math.pi * abs(a3 * I3 * y[5])
-                if period > 0.0:
-                    res -= period * math.floor(res / period + 0.5)
+            res = _residual(ic, p, y, targets[i - nc])
         natural = 0.0  # the row's integral at most, at this velocity (Cauchy-Schwarz)
         for k in range(6):
             natural += pw[n_rows, k] * pw[n_rows, k] * minv[k]
         natural = math.sqrt(natural) * usize
         pw[n_rows, 6] = -res
         left = _orthogonalise(pw, n_rows, n_rows, minv)
-        if left > DEPENDENT * DEPENDENT:
+        if left > (DEPENDENT * DEPENDENT if i < nc else kept):
             noise = abs(pw[n_rows, 6]) <= ROUNDOFF * natural
             if noise and left < ILL_CONDITIONED * ILL_CONDITIONED:
                 pw[n_rows, 6] = 0.0  # round-off that 1 / sqrt(left) would amplify: not corrected
@@ -195,28 +206,47 @@ def _linear(
 
 
 @kernel
-def _tilt(y: FloatArray, src: FloatArray, phi: float) -> bool:
-    """``y`` = ``src`` with the body tilted by ``phi`` about ``gamma x e3`` (the fixed axes
-    ``alpha, beta, gamma`` seen in the body frame turned by ``-phi``, exactly: Rodrigues);
-    ``False`` at the pole, where there is no such axis."""
+def _rotate(y: FloatArray, src: FloatArray, ax: float, ay: float, az: float, phi: float) -> None:
+    """``y`` = ``src`` with the body turned by ``phi`` about the unit axis ``a = (ax, ay, az)``
+    of the body frame (the fixed axes ``alpha, beta, gamma`` seen in the body frame turned by
+    ``-phi``, exactly: Rodrigues)."""
     for k in range(18):
         y[k] = src[k]
-    ax, ay = src[13], -src[12]  # gamma x e3 = (gamma2, -gamma1, 0)
-    s = math.hypot(ax, ay)
-    if s < MIN_TILT_SINE:
-        return False
-    ax /= s
-    ay /= s
     c, sn = math.cos(phi), math.sin(phi)
     for base in (6, 9, 12):
         x0, x1, x2 = src[base], src[base + 1], src[base + 2]
-        dot = ax * x0 + ay * x1
-        # rotation by -phi about a = (ax, ay, 0): x c - (a x x) sn + a (a.x)(1 - c)
-        cx0, cx1, cx2 = ay * x2, -ax * x2, ax * x1 - ay * x0
+        dot = ax * x0 + ay * x1 + az * x2
+        # rotation by -phi about a: x c - (a x x) sn + a (a.x)(1 - c)
+        cx0, cx1, cx2 = ay * x2 - az * x1, az * x0 - ax * x2, ax * x1 - ay * x0
         y[base] = x0 * c - cx0 * sn + ax * dot * (1.0 - c)
         y[base + 1] = x1 * c - cx1 * sn + ay * dot * (1.0 - c)
-        y[base + 2] = x2 * c - cx2 * sn
+        y[base + 2] = x2 * c - cx2 * sn + az * dot * (1.0 - c)
+
+
+@kernel
+def _tilt(y: FloatArray, src: FloatArray, phi: float) -> bool:
+    """``y`` = ``src`` with the body tilted by ``phi`` about ``gamma x e3`` (the axis that
+    changes ``gamma3``); ``False`` at the pole, where there is no such axis."""
+    ax, ay = src[13], -src[12]  # gamma x e3 = (gamma2, -gamma1, 0)
+    s = math.hypot(ax, ay)
+    if s < MIN_TILT_SINE:
+        for k in range(18):
+            y[k] = src[k]
+        return False
+    _rotate(y, src, ax / s, ay / s, 0.0, phi)
     return True
+
+
+@kernel
+def _residual(ic: int, p: FloatArray, y: FloatArray, target: float) -> float:
+    """The integral ``ic``'s deviation from ``target`` at ``y``; ``F6``'s modulo the jump of its
+    ``theta`` (module docstring)."""
+    res = integral_value(ic, p, y) - target
+    if ic == F6:
+        period = 2.0 * math.pi * abs(p[3] * p[6] * y[5])
+        if period > 0.0:
+            res -= period * math.floor(res / period + 0.5)
+    return float(res)
 
 
 @kernel
@@ -237,6 +267,113 @@ def _tilted_energy(
     _tilt(y, src, phi)
     _linear(code, p, y, icodes, targets, pw, ws, minv)
     return integral_value(ic, p, y)
+
+
+@kernel
+def _linear_natural(
+    i: int, p: FloatArray, y: FloatArray, grad: FloatArray, minv: FloatArray, icodes: IntArray
+) -> float:
+    """The natural size of the linear integral ``icodes[i]`` at ``y``: its largest value at this
+    velocity size (Cauchy-Schwarz in the metric, as :func:`_linear` measures a row)."""
+    velocity_gradient(icodes[i], p, y, grad)
+    size = 0.0
+    for k in range(6):
+        size += grad[k] * grad[k] * minv[k]
+    return math.sqrt(size) * _velocity_size(y, minv)
+
+
+@kernel
+def _turned_residual(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    src: FloatArray,
+    axis: FloatArray,
+    phi: float,
+    i: int,
+    icodes: IntArray,
+    targets: FloatArray,
+    pw: FloatArray,
+    ws: Workspace,
+    minv: FloatArray,
+) -> float:
+    """The residual of the integral ``icodes[i]`` after turning ``src`` by ``phi`` about
+    ``axis`` and the linear part (into ``y``), every ill-conditioned integral's row dropped:
+    the rows kept do not change between the trials of one step (a row kept in one and dropped
+    in the other would make their difference no slope)."""
+    _rotate(y, src, axis[0], axis[1], axis[2], phi)
+    _linear(code, p, y, icodes, targets, pw, ws, minv, ILL_CONDITIONED * ILL_CONDITIONED)
+    return _residual(icodes[i], p, y, targets[i])
+
+
+@kernel
+def _attitude_step(
+    code: int,
+    p: FloatArray,
+    y: FloatArray,
+    res: float,
+    natural: float,
+    i: int,
+    icodes: IntArray,
+    targets: FloatArray,
+    pw: FloatArray,
+    ws: Workspace,
+    minv: FloatArray,
+) -> bool:
+    """Correct the residual ``res`` of the linear integral ``icodes[i]``, whose row the linear
+    part dropped (near the vertical, the area integral's and Jellett's rows tend to
+    Lagrange's), by turning the body: about the axis perpendicular to ``gamma`` along which
+    the residual (after the linear part) falls fastest, by a secant step on central
+    differences. ``y`` is changed only if the residual falls; returns whether it did. ``pw``'s
+    rows are the trials' afterwards: the caller solves the linear part again."""
+    src, trial, axis = pw[WORK_ROWS], pw[WORK_ROWS + 1], pw[WORK_ROWS - 3]
+    for k in range(18):
+        src[k] = y[k]
+    g0, g1, g2 = y[12], y[13], y[14]
+    # two unit axes perpendicular to gamma: gamma x e_k (e_k the body axis least along gamma)
+    # and gamma x that
+    k0 = 0
+    if abs(g1) < abs(g0):
+        k0 = 1
+    if abs(g2) < abs(g0) and abs(g2) < abs(g1):
+        k0 = 2
+    b0, b1, b2 = (0.0, g2, -g1) if k0 == 0 else ((-g2, 0.0, g0) if k0 == 1 else (g1, -g0, 0.0))
+    size = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+    b0, b1, b2 = b0 / size, b1 / size, b2 / size
+    c0, c1, c2 = g1 * b2 - g2 * b1, g2 * b0 - g0 * b2, g0 * b1 - g1 * b0
+    slopes = pw[WORK_ROWS - 3, 3:5]
+    for j in range(2):
+        if j == 0:
+            axis[0], axis[1], axis[2] = b0, b1, b2
+        else:
+            axis[0], axis[1], axis[2] = c0, c1, c2
+        up = _turned_residual(
+            code, p, trial, src, axis, TILT_STEP, i, icodes, targets, pw, ws, minv
+        )
+        down = _turned_residual(
+            code, p, trial, src, axis, -TILT_STEP, i, icodes, targets, pw, ws, minv
+        )
+        slopes[j] = (up - down) / (2.0 * TILT_STEP)
+    norm2 = slopes[0] * slopes[0] + slopes[1] * slopes[1]
+    # a slope within the difference's round-off is no direction (an integral the linear part
+    # holds whatever the attitude, its residual that part's round-off)
+    resolved = RESOLVED * ROUNDOFF * natural / TILT_STEP
+    if not (norm2 > resolved * resolved and math.isfinite(norm2)):
+        return False
+    # the least turn that zeroes the linearised residual: phi = -res slopes / |slopes|^2
+    f0, f1 = -res * slopes[0] / norm2, -res * slopes[1] / norm2
+    phi = math.hypot(f0, f1)
+    if phi > MAX_CHANGE:
+        return False
+    axis[0] = (f0 * b0 + f1 * c0) / phi
+    axis[1] = (f0 * b1 + f1 * c1) / phi
+    axis[2] = (f0 * b2 + f1 * c2) / phi
+    after = _turned_residual(code, p, trial, src, axis, phi, i, icodes, targets, pw, ws, minv)
+    if not abs(after) < abs(res):
+        return False
+    for k in range(18):
+        y[k] = trial[k]
+    return True
 
 
 @kernel
@@ -269,6 +406,18 @@ def project_integrals(
         passes += 1
         moved = False
         left = False
+        for i in range(n_int):  # a linear integral whose row was dropped: the attitude
+            if not LINEAR[icodes[i]]:
+                continue
+            res = _residual(icodes[i], p, y, targets[i])
+            if abs(res) <= SETTLED * ROUNDOFF * abs(targets[i]):  # natural >= |value|
+                continue
+            natural = _linear_natural(i, p, y, grad, minv, icodes)
+            if abs(res) <= SETTLED * ROUNDOFF * natural:
+                continue
+            if _attitude_step(code, p, y, res, natural, i, icodes, targets, pw, ws, minv):
+                moved = True
+            n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
         for i in range(n_int):
             ic = icodes[i]
             if LINEAR[ic]:
@@ -355,10 +504,11 @@ def project_integrals(
         usize = _velocity_size(y, minv)
         for i in range(n_int):
             ic = icodes[i]
-            if not LINEAR[ic]:
-                res = integral_value(ic, p, y) - targets[i]
-                if abs(res) > SETTLED * ROUNDOFF * _natural(ic, p, usize, minv):
-                    left = True
+            if LINEAR[ic]:
+                continue
+            res = integral_value(ic, p, y) - targets[i]
+            if abs(res) > SETTLED * ROUNDOFF * _natural(ic, p, usize, minv):
+                left = True
     pw[WORK_ROWS - 1, 7] = 1.0 if left else 0.0
     for k in range(18):
         if not math.isfinite(y[k]):
