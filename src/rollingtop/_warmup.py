@@ -50,6 +50,14 @@ def warm_package(package: str) -> dict[str, float]:
     return seconds
 
 
+def _no_compile_helper() -> None:
+    """In a worker of :func:`warmup`: no helper process for a cold compile (the workers already
+    fill the CPUs; :mod:`rollingtop.integrate._compile_helper`)."""
+    from rollingtop.integrate._compile_helper import ENV
+
+    os.environ[ENV] = "0"
+
+
 def _sum(parts: list[dict[str, float]]) -> dict[str, float]:
     return {group: sum(p[group] for p in parts) for group in GROUPS}
 
@@ -116,7 +124,9 @@ def warmup(
 
     # spawn: a fresh interpreter per worker (no fork of a process holding numba's threads)
     context = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
+    with concurrent.futures.ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_no_compile_helper
+    ) as pool:
         futures = {pool.submit(warm_package, g.package): g for g in packages}
         for future in concurrent.futures.as_completed(futures):
             finished(futures[future], future.result())

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rollingtop._compiled import for_code
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import (
     ContactLostWarning,
     InitialStateError,
@@ -101,7 +101,7 @@ def _given_state(
             code,
             model.params(body),
             projected,
-            call(new_workspace),
+            workspace(),
         )
         gap = float(np.max(np.abs(projected[0:3] - y[0:3])))
         if gap > UNIT_TOLERANCE * max(1.0, float(np.max(np.abs(y[0:6])))):

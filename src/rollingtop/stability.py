@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from rollingtop._compiled import for_code
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import RollingTopError
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE
@@ -101,7 +101,7 @@ def _generic_eigenvalues(
     x0[8] = float(pole)
     code = model.kernel_code(body, _state(x0))
     p = model.params(body)
-    ws = call(new_workspace)
+    ws = workspace()
     dynamics = for_code(code).dynamics
 
     def rhs(x: FloatArray) -> FloatArray:

@@ -17,13 +17,13 @@ from rollingtop._jit import compiled, inline, kernel
 from rollingtop._layout import MAX_ROWS
 from rollingtop._types import FloatArray, Workspace
 
-__all__ = ["new_workspace", "reaction", "solve_spd"]
+__all__ = ["new_workspace", "reaction", "solve_spd", "workspace"]
 
 
-@compiled()
-def new_workspace() -> Workspace:
-    """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels (callable from
-    Python and from compiled code)."""
+def workspace() -> Workspace:
+    """Work arrays ``(J, bias, dirs, A, lam)`` for one thread of the kernels, made by NumPy:
+    for Python callers, which so compile nothing (the arrays' types are those of
+    :func:`new_workspace`'s)."""
     return (
         np.zeros((MAX_ROWS, 6)),
         np.zeros(MAX_ROWS),
@@ -31,6 +31,10 @@ def new_workspace() -> Workspace:
         np.zeros((MAX_ROWS, MAX_ROWS)),
         np.zeros(MAX_ROWS),
     )
+
+
+#: :func:`workspace` compiled, for compiled callers (the ensemble's threads, the diagnostics).
+new_workspace = compiled()(workspace)
 
 
 @inline

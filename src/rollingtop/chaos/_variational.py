@@ -35,7 +35,7 @@ import numpy as np
 
 from rollingtop._compiled import for_code
 from rollingtop._compiled._dop853 import FINISHED
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._compiled._tangent import LOG_SUM, N_AUG, NORM, REACHED_VERTICAL
 from rollingtop._errors import IntegrationError
 from rollingtop._jit import call
@@ -142,7 +142,7 @@ def variational_jacobian(
         y_end = z[:N_STATE].copy()
         columns.append(size * math.exp(float(ctrl[LOG_SUM])) * z[N_STATE : 2 * N_STATE])
     f = np.zeros(N_STATE)
-    call(for_code(code).dynamics.rhs, code, p, y_end, f, call(new_workspace))
+    call(for_code(code).dynamics.rhs, code, p, y_end, f, workspace())
     df = _section_gradient(y_end, f)
 
     def coords(y: FloatArray) -> FloatArray:

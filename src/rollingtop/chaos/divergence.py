@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import for_code
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE
@@ -125,7 +125,7 @@ def manifold_divergence(body: SphericalTop, model: str | ContactModel, y: ArrayL
     _refuse_own_inertia(model)
     y = check_state(body, model, y)
     code = model.kernel_code(body, y)
-    return _divergence(code, model.params(body), y, call(new_workspace))
+    return _divergence(code, model.params(body), y, workspace())
 
 
 def _divergence(code: int, p: FloatArray, y: FloatArray, ws: Any) -> float:
@@ -220,7 +220,7 @@ def phase_volume(
     code = model.kernel_code(body, y0)
     t = np.linspace(0.0, float(t_end), int(samples))
     traj = integrate(code, model.params(body), y0, t, rtol=rtol, atol=atol_, max_steps=max_steps)
-    ws = call(new_workspace)
+    ws = workspace()
     div = np.array([_divergence(code, model.params(body), y, ws) for y in traj.y])
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (div[1:] + div[:-1]) * np.diff(t))])
     with np.errstate(invalid="ignore", divide="ignore"):

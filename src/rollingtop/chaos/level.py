@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 
 from rollingtop._checks import short_repr
 from rollingtop._compiled import for_code
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE
@@ -114,7 +114,7 @@ def _orientation(
 
 def _velocity_basis(body: SphericalTop, model: ContactModel, y: FloatArray) -> FloatArray:
     """Orthonormal basis of the constraint subspace ``J u = 0`` at ``y``, shape (d, 6)."""
-    J, bias, dirs, _, _ = call(new_workspace)
+    J, bias, dirs, _, _ = workspace()
     code = model.kernel_code(body, y)
     nc = call(for_code(code).dynamics.constraint_rows, code, model.params(body), y, J, bias, dirs)
     if nc == 0:

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rollingtop._compiled import for_code
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import RollingTopError
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE
@@ -109,7 +109,7 @@ class _Field:
 
     def __init__(self, P: SectionMap) -> None:
         self.P = P
-        self.ws = call(new_workspace)
+        self.ws = workspace()
 
     def __call__(self, z: FloatArray) -> FloatArray:
         body, model = self.P.body, self.P.model

@@ -55,6 +55,27 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
     return traj
 
 
+def _compile_ahead(path: str, model: ContactModel | None) -> None:
+    """On a cold first run, start compiling the integrator's start and diagnostics in a helper
+    while the scenario's initial state is projected (:func:`rollingtop.integrate.driver.
+    compile_ahead`): for the scenario's model (or ``model``), its plain stepper, where the file
+    has an initial state and does not hold its integrals by projection."""
+    import tomllib
+
+    from rollingtop.contact import DEFAULT_MODEL, get_model
+    from rollingtop.integrate.driver import compile_ahead
+
+    try:
+        with open(path, "rb") as file:
+            data = tomllib.load(file)
+        if "initial" not in data or data.get("integration", {}).get("project_integrals"):
+            return
+        code = (model or get_model(data.get("contact", {}).get("model", DEFAULT_MODEL))).code
+    except Exception:  # noqa: BLE001 - whatever is wrong, load_scenario says it in one line
+        return
+    compile_ahead(code)
+
+
 def _integrals_table(summary: dict[str, Any]) -> Table:
     from rich.table import Table
 
@@ -157,6 +178,8 @@ def simulate(
 
     if output is not None:
         check_output_path(output, OUTPUT_SUFFIXES)
+    if not project_integrals:
+        _compile_ahead(scenario, model)
     sc = load_scenario(scenario).with_overrides(
         t_end=t_end,
         rtol=rtol,

@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import compiling, for_code
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
 from rollingtop._layout import N_STATE
@@ -115,7 +115,7 @@ def constraint_residuals(body: SphericalTop, model: str | ContactModel, y: Array
     """Residuals ``J_k u`` of the model's constraint rows at state ``y``, shape (rows,)."""
     model = get_model(model)
     state = np.asarray(y, dtype=float)
-    J, bias, dirs, _, _ = call(new_workspace)
+    J, bias, dirs, _, _ = workspace()
     nc = call(
         for_code(model.code).dynamics.constraint_rows,
         model.code,
@@ -257,7 +257,7 @@ def initial_state(
     code = _start_code(body, model, y)
     kernels = for_code(code)  # the model's own package, or its variants'
     with compiling(kernels, "integrator"):  # the projection: a model's first compiled kernel
-        call(kernels.dynamics.project, code, model.params(body), y, call(new_workspace))
+        call(kernels.dynamics.project, code, model.params(body), y, workspace())
     return y
 
 
@@ -307,7 +307,7 @@ def project_state(
         y[9:12] = np.cross(gamma, y[6:9])
     if gamma[0] == 0.0 and gamma[1] == 0.0 and model.vertical.direction is not None:
         y[17] = model.vertical.direction(y[3:6], y[6:9], y[9:12], y[17])
-    ws = call(new_workspace)
+    ws = workspace()
     code = _start_code(body, model, y)
     dynamics = for_code(code).dynamics
     with compiling(for_code(code), "integrator"):

@@ -6,7 +6,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import ModuleType
-from typing import TypedDict
+from typing import Any, TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -14,12 +14,13 @@ from numpy.typing import ArrayLike
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import compiling, for_code, packages_of
 from rollingtop._compiled._events import EVENTS, NONE
-from rollingtop._compiled._kernel import new_workspace
+from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import IntegrationError, NotFiniteAtStart
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
 from rollingtop._types import FloatArray, IntArray, Workspace
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
+from rollingtop.integrate import _compile_helper
 from rollingtop.integrate._held import held_arrays
 from rollingtop.integrate._pace import check_pace
 
@@ -114,7 +115,7 @@ def _workspace(n_samples: int) -> _Work:
         ytmp=np.zeros(N_STATE),
         y_old=np.zeros(N_STATE),
         Fd=np.zeros((7, N_STATE)),
-        ws=call(new_workspace),
+        ws=workspace(),
         out=np.full((n_samples, N_STATE), np.nan),
     )
 
@@ -141,59 +142,143 @@ def compile_code(code: int, *, held: bool = False, events: bool = False) -> floa
     return _compile_package(for_code(int(code)), held, events)
 
 
+def _warmup_state() -> FloatArray:
+    """The state of :func:`compile_code`'s warm-up run: the axis tilted, so that no model is
+    singular."""
+    y = np.zeros(N_STATE)
+    y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
+    y[3:6] = (0.1, 0.2, 0.3)
+    return y
+
+
+def _warmup_calls(
+    kernels: ModuleType, held: bool, events: bool
+) -> tuple[Callable[[bool], None], Callable[[], None], tuple[str, bool, bool]]:
+    """What compiles a package's integrator (:func:`compile_code`): a function compiling all but
+    the stepper's loop (the constraint projection -- if its argument is true --, the stepper's
+    start and the samples' diagnostics), one compiling the loop (and loading the rest), and the
+    compile's key."""
+    p = np.array(WARMUP_PARAMS)
+    y = _warmup_state()
+    code = kernels._dispatch.CODES[0]
+    # with a projection onto an integral (held): the held stepper's loop
+    event = (1, 0, 1) if events or held else (0, 0, 0)
+    held_codes = np.array([0], dtype=np.int64) if held else None
+    t_eval = np.array([0.0, 1e-3])
+
+    def rest(project: bool) -> None:
+        if project:
+            call(kernels.dynamics.project, code, p, y.copy(), workspace())
+        stepper, start_args, _, _ = _stepper_calls(
+            code, p, y, t_eval, 1e-6, 1e-9, event, held_codes
+        )
+        call(stepper.start, *start_args)
+        call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
+
+    def loop() -> None:
+        _run_compiled(code, p, y, t_eval, 1e-6, 1e-9, None, None, event, held_codes)
+
+    return rest, loop, (kernels.PACKAGE, held, events)
+
+
+def _loop_signature(kernels: ModuleType, held: bool, events: bool) -> tuple[Any, Any]:
+    """The stepper copy's ``run`` dispatcher for :func:`compile_code`'s warm-up run, and its
+    argument types (``start``'s results by placeholders of their types)."""
+    event = (1, 0, 1) if events or held else (0, 0, 0)
+    held_codes = np.array([0], dtype=np.int64) if held else None
+    code = kernels._dispatch.CODES[0]
+    stepper, _, run_args, _ = _stepper_calls(
+        code,
+        np.array(WARMUP_PARAMS),
+        _warmup_state(),
+        np.array([0.0, 1e-3]),
+        1e-6,
+        1e-9,
+        event,
+        held_codes,
+    )
+    placeholders = (np.zeros(8), np.zeros(dop.N_COUNTS, dtype=np.int64), np.zeros(8))
+    args = run_args(*placeholders, 1)
+    return stepper.run, tuple(stepper.run.typeof_pyval(a) for a in args)
+
+
+def _helped(kernels: ModuleType, held: bool, events: bool, project: bool) -> bool:
+    """Start the helper of a cold compile of ``kernels``' integrator (:mod:`._compile_helper`),
+    compiling all but the stepper's loop (the projection too if ``project``), unless one runs, the
+    loop is compiled or cached, or no helper may run here; whether a helper runs."""
+    rest, _, key = _warmup_calls(kernels, held, events)
+    if key in _compiled:
+        return False
+    if _compile_helper.running(key):
+        return True
+    run, sig = _loop_signature(kernels, held, events)
+    if not _compile_helper.eligible(run) or _compile_helper.cached(run, sig):
+        return False
+    _compile_helper.start(key, lambda: rest(project))
+    return True
+
+
+def compile_ahead(code: int) -> None:
+    """Start compiling the plain integrator of the package that runs kernel ``code`` (its
+    stepper's start and diagnostics) in a helper process, where one may run and the package is
+    not compiled yet (:mod:`._compile_helper`), and return at once: for a caller about to
+    compile the constraint projection (an initial state) and then run. The run's
+    :func:`compile_code` compiles the stepper's loop and loads the helper's work."""
+    kernels = for_code(int(code))
+    with compiling(kernels, "integrator"):
+        _helped(kernels, held=False, events=False, project=False)
+
+
 def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
     """:func:`compile_kernels` for one compiled package (``held``, ``events``:
-    :func:`compile_code`)."""
+    :func:`compile_code`). A cold compile (the stepper's loop neither in memory nor in numba's
+    cache) leaves the start, the projection and the diagnostics to a forked helper where one may
+    run (:mod:`._compile_helper`), while this process compiles the loop."""
     events = events and not held  # the held stepper locates events too
-    key = (kernels.PACKAGE, held, events)
+    rest, loop, key = _warmup_calls(kernels, held, events)
     if key in _compiled:
         return 0.0
     start = time.perf_counter()
-    p = np.array(WARMUP_PARAMS)
-    y = np.zeros(N_STATE)
-    y[6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)  # axis tilted: no model is singular
-    y[3:6] = (0.1, 0.2, 0.3)
-    code = kernels._dispatch.CODES[0]
     what = "held integrator" if held else "event integrator" if events else "integrator"
     with compiling(kernels, what):
-        call(kernels.dynamics.project, code, p, y, call(new_workspace))
-        # with a projection onto an integral (held): the held stepper's loop
-        _run_compiled(
-            code,
-            p,
-            y,
-            np.array([0.0, 1e-3]),
-            1e-6,
-            1e-9,
-            None,
-            None,
-            (1, 0, 1) if events or held else (0, 0, 0),
-            np.array([0], dtype=np.int64) if held else None,
-        )
-        call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
+        if _helped(kernels, held, events, project=True):
+            run, sig = _loop_signature(kernels, held, events)
+            try:
+                call(run.compile, sig)
+            except BaseException:
+                _compile_helper.stop(key)
+                raise
+            _compile_helper.join(key)
+        rest(True)
+        loop()
     _compiled[key] = time.perf_counter() - start
     return _compiled[key]
 
 
-def _run_compiled(
+def _stepper_calls(
     code: int,
     p: FloatArray,
     y0: FloatArray,
     t_eval: FloatArray,
     rtol: float,
     atol: float,
-    max_steps: int | None,
-    progress: Callable[[float], None] | None,
     event: tuple[int, int, int],
     held: IntArray | None = None,
     dips: bool = True,
-) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
-    n = t_eval.shape[0]
-    w = _workspace(n)
+) -> tuple[
+    ModuleType,
+    tuple[Any, ...],
+    Callable[..., tuple[Any, ...]],
+    tuple[FloatArray, FloatArray, FloatArray],
+]:
+    """The copy of the stepper a run needs (:mod:`rollingtop._compiled._instances`), the
+    arguments of its ``start`` (``y``: a copy of ``y0``, advanced in place by the run), a
+    function of ``start``'s result ``(ctrl, counts, track)`` and a step budget giving those of
+    its ``run``, and the arrays the run fills: the samples, the events' times and states."""
+    w = _workspace(t_eval.shape[0])
     icodes, targets, pw = held_arrays(code, p, y0, held)
     package = for_code(code)
     ev_code, ev_direction, capacity = event
-    # the copy of the stepper the run needs (rollingtop._compiled._instances)
     stepper = (
         package.stepper_held
         if icodes.shape[0] > 0
@@ -207,8 +292,7 @@ def _run_compiled(
     ev_y = np.empty((capacity, N_STATE))
     y = y0.copy()
     f = np.zeros(N_STATE)
-    ctrl, counts, track = call(
-        stepper.start,
+    start_args = (
         code,
         p,
         y,
@@ -222,14 +306,11 @@ def _run_compiled(
         w["ynew"],
         w["ws"],
     )
-    t_end = float(t_eval[-1])
-    start = time.perf_counter()
-    while True:
-        budget = PROGRESS_CHUNK
-        if max_steps is not None:
-            budget = min(budget, max_steps - int(counts[dop.STEPS]))
-        status = call(
-            stepper.run,
+
+    def run_args(
+        ctrl: FloatArray, counts: IntArray, track: FloatArray, budget: int
+    ) -> tuple[Any, ...]:
+        return (
             code,
             p,
             y,
@@ -253,6 +334,34 @@ def _run_compiled(
             targets,
             pw,
         )
+
+    return stepper, start_args, run_args, (w["out"], ev_t, ev_y)
+
+
+def _run_compiled(
+    code: int,
+    p: FloatArray,
+    y0: FloatArray,
+    t_eval: FloatArray,
+    rtol: float,
+    atol: float,
+    max_steps: int | None,
+    progress: Callable[[float], None] | None,
+    event: tuple[int, int, int],
+    held: IntArray | None = None,
+    dips: bool = True,
+) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
+    stepper, start_args, run_args, (out, ev_t, ev_y) = _stepper_calls(
+        code, p, y0, t_eval, rtol, atol, event, held, dips
+    )
+    ctrl, counts, track = call(stepper.start, *start_args)
+    t_end = float(t_eval[-1])
+    start = time.perf_counter()
+    while True:
+        budget = PROGRESS_CHUNK
+        if max_steps is not None:
+            budget = min(budget, max_steps - int(counts[dop.STEPS]))
+        status = call(stepper.run, *run_args(ctrl, counts, track, budget))
         if progress is not None:
             progress(float(ctrl[dop.T]))
         if status != dop.BUDGET_EXHAUSTED:
@@ -269,8 +378,8 @@ def _run_compiled(
     wall = time.perf_counter() - start
     _raise_for_status(status, ctrl, counts)
     found = int(counts[dop.N_EVENTS])
-    kept = min(found, capacity)
-    return w["out"], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
+    kept = min(found, ev_t.shape[0])
+    return out, counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
 
 
 def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
