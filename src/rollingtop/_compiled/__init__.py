@@ -28,7 +28,7 @@ import importlib
 import json
 import logging
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
@@ -48,11 +48,13 @@ __all__ = [
     "GROUPS",
     "Group",
     "Notifier",
+    "before_projection",
     "by_package",
     "compiling",
     "for_code",
     "for_model",
     "packages_of",
+    "run_before_projection",
     "set_notifier",
 ]
 
@@ -151,6 +153,27 @@ class _LogNotifier:
 _notifier: Notifier = _LogNotifier()
 #: (model, group) pairs announced in this process.
 _announced: set[tuple[str, str]] = set()
+
+#: Work to do before a package's next constraint projection of an initial state, by package
+#: (:func:`run_before_projection`).
+_before_projection: dict[str, Callable[[], None]] = {}
+
+
+def run_before_projection(package: str, work: Callable[[], None]) -> None:
+    """Do ``work`` before the next projection of an initial state onto the constraints of
+    ``package`` (:func:`before_projection`), once: there, an initial state has passed every
+    check of its values, so a bad one is still refused at once. The integrator's
+    :func:`~rollingtop.integrate.driver.compile_ahead` compiles the stepper's loop there, while
+    a helper compiles the projection it is about to load."""
+    _before_projection[package] = work
+
+
+def before_projection(kernels: ModuleType) -> None:
+    """What :func:`run_before_projection` left for ``kernels``' package, if anything (called by
+    :mod:`rollingtop.dynamics.state` before it projects an initial state)."""
+    work = _before_projection.pop(kernels.PACKAGE, None)
+    if work is not None:
+        work()
 
 
 def set_notifier(notifier: Notifier | None) -> Notifier:

@@ -64,10 +64,11 @@ def _compile_ahead(path: str, model: ContactModel | None) -> None:
 
     from rollingtop.contact import DEFAULT_MODEL, get_model
     from rollingtop.integrate.driver import compile_ahead
+    from rollingtop.io import read_input_text
+    from rollingtop.scenario import MAX_SCENARIO_BYTES
 
-    try:
-        with open(path, "rb") as file:
-            data = tomllib.load(file)
+    try:  # read as load_scenario reads it: a device or a huge file is not read here either
+        data = tomllib.loads(read_input_text(path, "scenario", MAX_SCENARIO_BYTES))
         if "initial" not in data or data.get("integration", {}).get("project_integrals"):
             return
         code = (model or get_model(data.get("contact", {}).get("model", DEFAULT_MODEL))).code

@@ -8,7 +8,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rollingtop._compiled import compiling, for_code
+from rollingtop._compiled import before_projection, compiling, for_code
 from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import InitialStateError
 from rollingtop._jit import call
@@ -257,6 +257,7 @@ def initial_state(
     code = _start_code(body, model, y)
     kernels = for_code(code)  # the model's own package, or its variants'
     with compiling(kernels, "integrator"):  # the projection: a model's first compiled kernel
+        before_projection(kernels)
         call(kernels.dynamics.project, code, model.params(body), y, workspace())
     return y
 
@@ -311,6 +312,7 @@ def project_state(
     code = _start_code(body, model, y)
     dynamics = for_code(code).dynamics
     with compiling(for_code(code), "integrator"):
+        before_projection(for_code(code))
         if model.own is not None:  # the rows' projection of (v, w), then the model's slot
             call(dynamics.project_velocity_rows, code, model.params(body), y, ws)
             y[17] = model.own.value(body, y)

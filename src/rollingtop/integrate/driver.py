@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
-from rollingtop._compiled import compiling, for_code, packages_of
+from rollingtop._compiled import compiling, for_code, packages_of, run_before_projection
 from rollingtop._compiled._events import EVENTS, NONE
 from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import IntegrationError, NotFiniteAtStart
@@ -167,6 +167,9 @@ def _warmup_calls(
     t_eval = np.array([0.0, 1e-3])
 
     def rest(project: bool) -> None:
+        # in the order a helper's work is needed by the loop compiled beside it: the right-hand
+        # side soonest, then the projection (both called by the loop)
+        call(kernels.dynamics.rhs, code, p, y.copy(), np.zeros(N_STATE), workspace())
         if project:
             call(kernels.dynamics.project, code, p, y.copy(), workspace())
         stepper, start_args, _, _ = _stepper_calls(
@@ -219,14 +222,28 @@ def _helped(kernels: ModuleType, held: bool, events: bool, project: bool) -> boo
 
 
 def compile_ahead(code: int) -> None:
-    """Start compiling the plain integrator of the package that runs kernel ``code`` (its
-    stepper's start and diagnostics) in a helper process, where one may run and the package is
-    not compiled yet (:mod:`._compile_helper`), and return at once: for a caller about to
-    compile the constraint projection (an initial state) and then run. The run's
-    :func:`compile_code` compiles the stepper's loop and loads the helper's work."""
+    """Start compiling the plain integrator of the package that runs kernel ``code``, where the
+    package is cold and a helper process may run (:mod:`._compile_helper`): the helper compiles
+    the constraint projection, the stepper's start and the diagnostics at once, and this process
+    compiles the stepper's loop just before it next projects an initial state onto that
+    package's constraints (:func:`rollingtop._compiled.run_before_projection`: after the
+    state's checks, so that a bad one is refused at once), then loads the projection the
+    helper saved. Returns at once. For a command that loads a scenario and then runs it; the
+    run's :func:`compile_code` waits for the helper and loads its work."""
     kernels = for_code(int(code))
-    with compiling(kernels, "integrator"):
-        _helped(kernels, held=False, events=False, project=False)
+    if not _helped(kernels, held=False, events=False, project=True):
+        return
+    run, sig = _loop_signature(kernels, False, False)
+    key = _warmup_calls(kernels, False, False)[2]
+
+    def loop() -> None:
+        try:
+            call(run.compile, sig)
+        except BaseException:
+            _compile_helper.stop(key)
+            raise
+
+    run_before_projection(kernels.PACKAGE, loop)
 
 
 def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
