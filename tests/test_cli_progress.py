@@ -68,7 +68,7 @@ def test_piped_runs_show_no_progress(capsys, tmp_path, piped, few_claims):
     not among those the suite compiles first, so the test failed when it ran before any other
     that compiles them)."""
     for args in (["verify", "--model", "rough"], _rotation(), _section(tmp_path)):
-        run_cli(capsys, *args)
+        assert run_cli(capsys, *args)[0] == 0
         code, out, err = run_cli(capsys, *args)
         assert code == 0, err
         assert err == ""

@@ -24,26 +24,31 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import logging
 import os
 import signal
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Callable, Hashable
 from typing import Any
 
 from rollingtop._jit import caching_disabled
 
-__all__ = ["ENV", "cached", "eligible", "join", "running", "start", "stop"]
+__all__ = ["ENV", "cached", "eligible", "join", "running", "start", "stop", "stop_others"]
 
 #: Environment variable: ``0`` compiles in one process always (the benchmarks' sequential
 #: reference; :func:`rollingtop.warmup`'s workers).
 ENV = "ROLLINGTOP_COMPILE_HELPER"
-#: Seconds this process waits, after its own half, for the child to save the other half: a
-#: child still compiling by then is stopped, and what it has not saved is compiled here.
-WAIT = 120.0
+#: Seconds this process waits, after its own half, for the child to save the other half (about
+#: as long as this process's half): a child still compiling by then is stopped, and what it has
+#: not saved is compiled here.
+WAIT = 60.0
 #: Seconds between two looks at the child while waiting.
 POLL = 0.01
+#: The signals blocked across the fork (:func:`start`).
+_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
 def _cpus() -> int:
@@ -83,14 +88,18 @@ def cached(dispatcher: Any, sig: tuple[Any, ...]) -> bool:
 
 
 def _child(work: Callable[[], None]) -> None:
-    """The child: ``work``, silently (its output would interleave with the parent's), then
-    exit without the parent's cleanup (``os._exit``: no atexit handlers, no flushed buffers)."""
+    """The child: ``work``, silently (its output and log records would interleave with the
+    parent's), then exit without the parent's cleanup (``os._exit``: no atexit handlers, no
+    flushed buffers). Entered with SIGINT and SIGTERM blocked (:func:`start`)."""
     status = 1
     try:
         signal.signal(signal.SIGINT, signal.SIG_DFL)  # Ctrl-C ends it at once
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, 1)
         os.dup2(devnull, 2)
+        logging.disable(logging.CRITICAL)  # the compile notice's record is the parent's
         work()
         status = 0
     finally:
@@ -102,8 +111,15 @@ _children: dict[Hashable, int] = {}
 
 
 def _stop(pid: int) -> None:
+    """Stop the child ``pid`` and reap it; a child already reaped elsewhere (SIGCHLD ignored,
+    another waiter) is not signalled: its pid may be another process's by now."""
+    try:
+        if os.waitpid(pid, os.WNOHANG)[0] == pid:
+            return  # it had finished
+    except ChildProcessError:
+        return
     with contextlib.suppress(ProcessLookupError):
-        os.kill(pid, signal.SIGKILL)
+        os.kill(pid, signal.SIGKILL)  # not reaped: still our child, whatever its state
     with contextlib.suppress(ChildProcessError):
         os.waitpid(pid, 0)
 
@@ -115,15 +131,27 @@ def _stop_all() -> None:
         _stop(_children.pop(key))
 
 
-def start(key: Hashable, work: Callable[[], None]) -> None:
-    """Run ``work`` in a forked child, the helper of the compile ``key``; call only where
+def start(key: Hashable, work: Callable[[], None]) -> bool:
+    """Run ``work`` in a forked child, the helper of the compile ``key``; whether one was
+    started (not when the fork fails: a process limit, memory). Call only where
     :func:`eligible`, and while :func:`running` is false for ``key``."""
+    # no signal handler may run between the fork and the child's own (it would unwind the
+    # parent's frames in the child): SIGINT and SIGTERM wait until each side is ready
+    signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    try:
+        with warnings.catch_warnings():  # Python >= 3.12 warns of a library's native threads
+            warnings.simplefilter("ignore", DeprecationWarning)
+            pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child never returns here (coverage cannot see it)
+            _child(work)
+    except OSError:
+        return False
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)
     if not _children:
-        atexit.register(_stop_all)  # once: unregistered below when the last child is reaped
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child never returns here (coverage cannot see it)
-        _child(work)
+        atexit.register(_stop_all)  # unregistered when the last child is reaped
     _children[key] = pid
+    return True
 
 
 def running(key: Hashable) -> bool:
@@ -143,7 +171,10 @@ def join(key: Hashable) -> None:
     deadline = time.monotonic() + WAIT
     try:
         while time.monotonic() < deadline:
-            if os.waitpid(pid, os.WNOHANG)[0] == pid:
+            try:
+                if os.waitpid(pid, os.WNOHANG)[0] == pid:
+                    return
+            except ChildProcessError:  # reaped elsewhere (SIGCHLD ignored): it has ended
                 return
             time.sleep(POLL)
         _stop(pid)
@@ -159,3 +190,10 @@ def stop(key: Hashable) -> None:
     if key in _children:
         _stop(_children[key])
         _reaped(key)
+
+
+def stop_others(key: Hashable) -> None:
+    """Stop every helper but that of ``key`` (a run of another package: two helpers and this
+    process would share two CPUs three ways)."""
+    for other in [k for k in _children if k != key]:
+        stop(other)

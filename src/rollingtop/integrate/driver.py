@@ -153,11 +153,11 @@ def _warmup_state() -> FloatArray:
 
 def _warmup_calls(
     kernels: ModuleType, held: bool, events: bool
-) -> tuple[Callable[[bool], None], Callable[[], None], tuple[str, bool, bool]]:
+) -> tuple[Callable[[], None], Callable[[], None], tuple[str, bool, bool]]:
     """What compiles a package's integrator (:func:`compile_code`): a function compiling all but
-    the stepper's loop (the constraint projection -- if its argument is true --, the stepper's
-    start and the samples' diagnostics), one compiling the loop (and loading the rest), and the
-    compile's key."""
+    the stepper's loop (the right-hand side, the constraint projection, the stepper's start and
+    the samples' diagnostics), one compiling the loop (and loading the rest), and the compile's
+    key."""
     p = np.array(WARMUP_PARAMS)
     y = _warmup_state()
     code = kernels._dispatch.CODES[0]
@@ -166,12 +166,11 @@ def _warmup_calls(
     held_codes = np.array([0], dtype=np.int64) if held else None
     t_eval = np.array([0.0, 1e-3])
 
-    def rest(project: bool) -> None:
+    def rest() -> None:
         # in the order a helper's work is needed by the loop compiled beside it: the right-hand
         # side soonest, then the projection (both called by the loop)
         call(kernels.dynamics.rhs, code, p, y.copy(), np.zeros(N_STATE), workspace())
-        if project:
-            call(kernels.dynamics.project, code, p, y.copy(), workspace())
+        call(kernels.dynamics.project, code, p, y, workspace())  # y on the constraints
         stepper, start_args, _, _ = _stepper_calls(
             code, p, y, t_eval, 1e-6, 1e-9, event, held_codes
         )
@@ -205,10 +204,10 @@ def _loop_signature(kernels: ModuleType, held: bool, events: bool) -> tuple[Any,
     return stepper.run, tuple(stepper.run.typeof_pyval(a) for a in args)
 
 
-def _helped(kernels: ModuleType, held: bool, events: bool, project: bool) -> bool:
+def _helped(kernels: ModuleType, held: bool, events: bool) -> bool:
     """Start the helper of a cold compile of ``kernels``' integrator (:mod:`._compile_helper`),
-    compiling all but the stepper's loop (the projection too if ``project``), unless one runs, the
-    loop is compiled or cached, or no helper may run here; whether a helper runs."""
+    compiling all but the stepper's loop, unless one runs, the loop is compiled or cached, or
+    no helper may run here; whether a helper runs. A helper of another package is stopped."""
     rest, _, key = _warmup_calls(kernels, held, events)
     if key in _compiled:
         return False
@@ -217,8 +216,8 @@ def _helped(kernels: ModuleType, held: bool, events: bool, project: bool) -> boo
     run, sig = _loop_signature(kernels, held, events)
     if not _compile_helper.eligible(run) or _compile_helper.cached(run, sig):
         return False
-    _compile_helper.start(key, lambda: rest(project))
-    return True
+    _compile_helper.stop_others(key)
+    return _compile_helper.start(key, rest)
 
 
 def compile_ahead(code: int) -> None:
@@ -231,12 +230,14 @@ def compile_ahead(code: int) -> None:
     helper saved. Returns at once. For a command that loads a scenario and then runs it; the
     run's :func:`compile_code` waits for the helper and loads its work."""
     kernels = for_code(int(code))
-    if not _helped(kernels, held=False, events=False, project=True):
+    if not _helped(kernels, held=False, events=False):
         return
     run, sig = _loop_signature(kernels, False, False)
     key = _warmup_calls(kernels, False, False)[2]
 
     def loop() -> None:
+        if not _compile_helper.running(key):  # stopped meanwhile: the run compiles as it needs
+            return
         try:
             call(run.compile, sig)
         except BaseException:
@@ -258,7 +259,7 @@ def _compile_package(kernels: ModuleType, held: bool = False, events: bool = Fal
     start = time.perf_counter()
     what = "held integrator" if held else "event integrator" if events else "integrator"
     with compiling(kernels, what):
-        if _helped(kernels, held, events, project=True):
+        if _helped(kernels, held, events):
             run, sig = _loop_signature(kernels, held, events)
             try:
                 call(run.compile, sig)
@@ -266,7 +267,7 @@ def _compile_package(kernels: ModuleType, held: bool = False, events: bool = Fal
                 _compile_helper.stop(key)
                 raise
             _compile_helper.join(key)
-        rest(True)
+        rest()
         loop()
     _compiled[key] = time.perf_counter() - start
     return _compiled[key]

@@ -92,6 +92,9 @@ SETTLED = 4.0
 #: An attitude slope of a linear integral below this many of its central difference's
 #: round-off is no direction (:func:`_attitude_step`).
 RESOLVED = 1e3
+#: A turn of the attitude (:func:`_attitude_step`) is taken where it leaves at most this
+#: fraction of the residual it corrects.
+DECREASE = 0.5
 #: Step of the central difference in the tilt angle (radians).
 TILT_STEP = 1e-5
 #: Below this ``|gamma x e3|`` (the pole) there is no tilt axis.
@@ -311,7 +314,6 @@ def _attitude_step(
     code: int,
     p: FloatArray,
     y: FloatArray,
-    res: float,
     natural: float,
     i: int,
     icodes: IntArray,
@@ -320,12 +322,13 @@ def _attitude_step(
     ws: Workspace,
     minv: FloatArray,
 ) -> bool:
-    """Correct the residual ``res`` of the linear integral ``icodes[i]``, whose row the linear
-    part dropped (near the vertical, the area integral's and Jellett's rows tend to
-    Lagrange's), by turning the body: about the axis perpendicular to ``gamma`` along which
-    the residual (after the linear part) falls fastest, by a secant step on central
-    differences. ``y`` is changed only if the residual falls; returns whether it did. ``pw``'s
-    rows are the trials' afterwards: the caller solves the linear part again."""
+    """Correct the residual of the linear integral ``icodes[i]`` (natural size ``natural``),
+    whose row the linear part dropped (near the vertical, the area integral's and Jellett's
+    rows tend to Lagrange's), by turning the body: about the axis perpendicular to ``gamma``
+    along which the residual (after the linear part) falls fastest, by a secant step on
+    central differences. ``y`` is changed only if the residual falls to :data:`DECREASE` of
+    its value; returns whether it did. ``pw``'s rows are the trials' afterwards (the caller
+    solves the linear part again) and ``pw[WORK_ROWS]`` the state before the turn."""
     src, trial, axis = pw[WORK_ROWS], pw[WORK_ROWS + 1], pw[WORK_ROWS - 3]
     for k in range(18):
         src[k] = y[k]
@@ -360,8 +363,10 @@ def _attitude_step(
     resolved = RESOLVED * ROUNDOFF * natural / TILT_STEP
     if not (norm2 > resolved * resolved and math.isfinite(norm2)):
         return False
-    # the least turn that zeroes the linearised residual: phi = -res slopes / |slopes|^2
-    f0, f1 = -res * slopes[0] / norm2, -res * slopes[1] / norm2
+    # the residual the trials are measured from: the state unturned, with their rows
+    base = _turned_residual(code, p, trial, src, axis, 0.0, i, icodes, targets, pw, ws, minv)
+    # the least turn that zeroes the linearised residual: phi = -base slopes / |slopes|^2
+    f0, f1 = -base * slopes[0] / norm2, -base * slopes[1] / norm2
     phi = math.hypot(f0, f1)
     if phi > MAX_CHANGE:
         return False
@@ -369,7 +374,7 @@ def _attitude_step(
     axis[1] = (f0 * b1 + f1 * c1) / phi
     axis[2] = (f0 * b2 + f1 * c2) / phi
     after = _turned_residual(code, p, trial, src, axis, phi, i, icodes, targets, pw, ws, minv)
-    if not abs(after) < abs(res):
+    if not abs(after) <= DECREASE * abs(base):  # a step that does not clearly help: none
         return False
     for k in range(18):
         y[k] = trial[k]
@@ -415,8 +420,13 @@ def project_integrals(
             natural = _linear_natural(i, p, y, grad, minv, icodes)
             if abs(res) <= SETTLED * ROUNDOFF * natural:
                 continue
-            if _attitude_step(code, p, y, res, natural, i, icodes, targets, pw, ws, minv):
-                moved = True
+            if _attitude_step(code, p, y, natural, i, icodes, targets, pw, ws, minv):
+                n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
+                if abs(_residual(icodes[i], p, y, targets[i])) < abs(res):
+                    moved = True
+                else:  # worse with this state's own rows: the turn is taken back
+                    for k in range(18):
+                        y[k] = pw[WORK_ROWS, k]
             n_rows = _linear(code, p, y, icodes, targets, pw, ws, minv)
         for i in range(n_int):
             ic = icodes[i]
