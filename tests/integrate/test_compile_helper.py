@@ -81,6 +81,8 @@ def test_a_helped_cold_compile_gives_the_same_run_and_compiles_half_here(tmp_pat
     again when a second process loads the helped cache); with the helper this process compiles
     the stepper's loop and not its start or the diagnostics (the helper's half, loaded from the
     cache), without it, everything."""
+    # exact: one machine, the same sources; what differs is only which process compiled a
+    # kernel (the claim under test is that this cannot change a bit)
     helped, compiled_helped = simulate(tmp_path / "helped", True)
     alone, compiled_alone = simulate(tmp_path / "alone", False)
     warm, compiled_warm = simulate(tmp_path / "helped", True)
