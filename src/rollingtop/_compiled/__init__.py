@@ -162,9 +162,9 @@ _before_projection: dict[str, Callable[[], None]] = {}
 def run_before_projection(package: str, work: Callable[[], None]) -> None:
     """Do ``work`` before the next projection of an initial state onto the constraints of
     ``package`` (:func:`before_projection`), once: there, an initial state has passed every
-    check of its values, so a bad one is still refused at once. The integrator's
-    :func:`~rollingtop.integrate.driver.compile_ahead` compiles the stepper's loop there, while
-    a helper compiles the projection it is about to load."""
+    check of its values, so a bad one is still refused at once (before numba loads). The
+    command line's ``simulate`` leaves :func:`~rollingtop.integrate.driver.compile_ahead` there:
+    the stepper's loop compiles while a helper compiles the projection it is about to load."""
     _before_projection[package] = work
 
 

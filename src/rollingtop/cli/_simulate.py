@@ -56,17 +56,21 @@ def run_scenario(sc: Scenario, **options: Any) -> Trajectory:
 
 
 def _compile_ahead(path: str, model: ContactModel | None) -> None:
-    """On a cold first run, start compiling the integrator's start and diagnostics in a helper
-    while the scenario's initial state is projected (:func:`rollingtop.integrate.driver.
-    compile_ahead`): for the scenario's model (or ``model``), its plain stepper, where the file
-    has an initial state and does not hold its integrals by projection."""
+    """On a cold first run, compile in two processes while the scenario's initial state is
+    projected (:func:`rollingtop.integrate.driver.compile_ahead`, run just before that
+    projection): for the scenario's model (or ``model``), its plain stepper, where the file has
+    an initial state and does not hold its integrals by projection, and a helper may run."""
     import tomllib
 
+    from rollingtop._compiled import group_of, run_before_projection
     from rollingtop.contact import DEFAULT_MODEL, get_model
+    from rollingtop.integrate._compile_helper import may_fork
     from rollingtop.integrate.driver import compile_ahead
     from rollingtop.io import read_input_text
     from rollingtop.scenario import MAX_SCENARIO_BYTES
 
+    if not may_fork():
+        return
     try:  # read as load_scenario reads it: a device or a huge file is not read here either
         data = tomllib.loads(read_input_text(path, "scenario", MAX_SCENARIO_BYTES))
         if "initial" not in data or data.get("integration", {}).get("project_integrals"):
@@ -74,7 +78,7 @@ def _compile_ahead(path: str, model: ContactModel | None) -> None:
         code = (model or get_model(data.get("contact", {}).get("model", DEFAULT_MODEL))).code
     except Exception:  # noqa: BLE001 - whatever is wrong, load_scenario says it in one line
         return
-    compile_ahead(code)
+    run_before_projection(group_of(code).package, lambda: compile_ahead(code))
 
 
 def _integrals_table(summary: dict[str, Any]) -> Table:

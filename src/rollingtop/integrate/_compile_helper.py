@@ -36,7 +36,17 @@ from typing import Any
 
 from rollingtop._jit import caching_disabled
 
-__all__ = ["ENV", "cached", "eligible", "join", "running", "start", "stop", "stop_others"]
+__all__ = [
+    "ENV",
+    "cached",
+    "eligible",
+    "join",
+    "may_fork",
+    "running",
+    "start",
+    "stop",
+    "stop_others",
+]
 
 #: Environment variable: ``0`` compiles in one process always (the benchmarks' sequential
 #: reference; :func:`rollingtop.warmup`'s workers).
@@ -58,12 +68,9 @@ def _cpus() -> int:
         return os.cpu_count() or 1
 
 
-def eligible(dispatcher: Any) -> bool:
-    """Whether a cold compile of ``dispatcher`` may fork a helper here (module docstring):
-    Linux, one thread, two CPUs or more, :data:`ENV` not ``0``, and an on-disk cache for the
-    dispatcher (none: no folder could be written, or saving failed in this process)."""
-    from numba.core.caching import NullCache
-
+def may_fork() -> bool:
+    """Whether a helper may be forked here at all (module docstring): Linux, one thread, two
+    CPUs or more, :data:`ENV` not ``0``. Cheap: numba is not loaded."""
     return (
         os.environ.get(ENV, "1") != "0"
         and sys.platform.startswith("linux")
@@ -71,8 +78,16 @@ def eligible(dispatcher: Any) -> bool:
         and threading.active_count() == 1
         and _cpus() >= 2
         and not caching_disabled()
-        and not isinstance(dispatcher._cache, NullCache)
     )
+
+
+def eligible(dispatcher: Any) -> bool:
+    """Whether a cold compile of ``dispatcher`` may fork a helper here: :func:`may_fork`, and an
+    on-disk cache for the dispatcher (none: no folder could be written, or saving failed in this
+    process)."""
+    from numba.core.caching import NullCache
+
+    return may_fork() and not isinstance(dispatcher._cache, NullCache)
 
 
 def cached(dispatcher: Any, sig: tuple[Any, ...]) -> bool:

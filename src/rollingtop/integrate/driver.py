@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
-from rollingtop._compiled import compiling, for_code, packages_of, run_before_projection
+from rollingtop._compiled import compiling, for_code, packages_of
 from rollingtop._compiled._events import EVENTS, NONE
 from rollingtop._compiled._kernel import workspace
 from rollingtop._errors import IntegrationError, NotFiniteAtStart
@@ -213,6 +213,8 @@ def _helped(kernels: ModuleType, held: bool, events: bool) -> bool:
         return False
     if _compile_helper.running(key):
         return True
+    if not _compile_helper.may_fork():  # before numba is loaded: a refused file stays quick
+        return False
     run, sig = _loop_signature(kernels, held, events)
     if not _compile_helper.eligible(run) or _compile_helper.cached(run, sig):
         return False
@@ -221,30 +223,23 @@ def _helped(kernels: ModuleType, held: bool, events: bool) -> bool:
 
 
 def compile_ahead(code: int) -> None:
-    """Start compiling the plain integrator of the package that runs kernel ``code``, where the
-    package is cold and a helper process may run (:mod:`._compile_helper`): the helper compiles
-    the constraint projection, the stepper's start and the diagnostics at once, and this process
-    compiles the stepper's loop just before it next projects an initial state onto that
-    package's constraints (:func:`rollingtop._compiled.run_before_projection`: after the
-    state's checks, so that a bad one is refused at once), then loads the projection the
-    helper saved. Returns at once. For a command that loads a scenario and then runs it; the
-    run's :func:`compile_code` waits for the helper and loads its work."""
+    """Compile the stepper's loop of the plain integrator of the package that runs kernel
+    ``code`` while a helper process compiles the rest (the right-hand side, the constraint
+    projection, the stepper's start, the diagnostics), where the package is cold and a helper
+    may run (:mod:`._compile_helper`); else nothing. For a command about to project an initial
+    state and then run it: registered with :func:`rollingtop._compiled.run_before_projection`,
+    it runs after the state's checks (a bad file is refused before numba loads), and the
+    projection then loads what the helper saved; the run's :func:`compile_code` waits for the
+    helper and loads the rest."""
     kernels = for_code(int(code))
     if not _helped(kernels, held=False, events=False):
         return
     run, sig = _loop_signature(kernels, False, False)
-    key = _warmup_calls(kernels, False, False)[2]
-
-    def loop() -> None:
-        if not _compile_helper.running(key):  # stopped meanwhile: the run compiles as it needs
-            return
-        try:
-            call(run.compile, sig)
-        except BaseException:
-            _compile_helper.stop(key)
-            raise
-
-    run_before_projection(kernels.PACKAGE, loop)
+    try:
+        call(run.compile, sig)
+    except BaseException:
+        _compile_helper.stop(_warmup_calls(kernels, False, False)[2])
+        raise
 
 
 def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
