@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import ModuleType
-from typing import Any, TypedDict
+from typing import Any, NamedTuple, TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -151,13 +152,24 @@ def _warmup_state() -> FloatArray:
     return y
 
 
-def _warmup_calls(
-    kernels: ModuleType, held: bool, events: bool
-) -> tuple[Callable[[], None], Callable[[], None], tuple[str, bool, bool]]:
-    """What compiles a package's integrator (:func:`compile_code`): a function compiling all but
-    the stepper's loop (the right-hand side, the constraint projection, the stepper's start and
-    the samples' diagnostics), one compiling the loop (and loading the rest), and the compile's
-    key."""
+class _Warmup(NamedTuple):
+    """What compiles a package's integrator (:func:`compile_code`, :func:`_warmup`)."""
+
+    #: Compiles all but the stepper's loop: the right-hand side, the constraint projection, the
+    #: stepper's start and the samples' diagnostics (a helper's half).
+    rest: Callable[[], None]
+    #: Runs the warm-up run (compiles the loop, loads the rest).
+    loop: Callable[[], None]
+    #: The stepper copy's ``run`` dispatcher and its argument types in the warm-up run
+    #: (``start``'s results by placeholders of their types); computed once.
+    signature: Callable[[], tuple[Any, tuple[Any, ...]]]
+    #: The compile's key in ``_compiled`` and of its helper.
+    key: tuple[str, bool, bool]
+
+
+def _warmup(kernels: ModuleType, held: bool, events: bool) -> _Warmup:
+    """The warm-up of ``kernels``' integrator: the plain stepper, the held one (``held``) or the
+    one that locates events (``events``)."""
     p = np.array(WARMUP_PARAMS)
     y = _warmup_state()
     code = kernels._dispatch.CODES[0]
@@ -180,46 +192,44 @@ def _warmup_calls(
     def loop() -> None:
         _run_compiled(code, p, y, t_eval, 1e-6, 1e-9, None, None, event, held_codes)
 
-    return rest, loop, (kernels.PACKAGE, held, events)
+    @functools.cache
+    def signature() -> tuple[Any, tuple[Any, ...]]:
+        stepper, _, run_args, _ = _stepper_calls(
+            code, p, _warmup_state(), t_eval, 1e-6, 1e-9, event, held_codes
+        )
+        placeholders = (np.zeros(8), np.zeros(dop.N_COUNTS, dtype=np.int64), np.zeros(8))
+        args = run_args(*placeholders, 1)
+        return stepper.run, tuple(stepper.run.typeof_pyval(a) for a in args)
+
+    return _Warmup(rest, loop, signature, (kernels.PACKAGE, held, events))
 
 
-def _loop_signature(kernels: ModuleType, held: bool, events: bool) -> tuple[Any, Any]:
-    """The stepper copy's ``run`` dispatcher for :func:`compile_code`'s warm-up run, and its
-    argument types (``start``'s results by placeholders of their types)."""
-    event = (1, 0, 1) if events or held else (0, 0, 0)
-    held_codes = np.array([0], dtype=np.int64) if held else None
-    code = kernels._dispatch.CODES[0]
-    stepper, _, run_args, _ = _stepper_calls(
-        code,
-        np.array(WARMUP_PARAMS),
-        _warmup_state(),
-        np.array([0.0, 1e-3]),
-        1e-6,
-        1e-9,
-        event,
-        held_codes,
-    )
-    placeholders = (np.zeros(8), np.zeros(dop.N_COUNTS, dtype=np.int64), np.zeros(8))
-    args = run_args(*placeholders, 1)
-    return stepper.run, tuple(stepper.run.typeof_pyval(a) for a in args)
-
-
-def _helped(kernels: ModuleType, held: bool, events: bool) -> bool:
-    """Start the helper of a cold compile of ``kernels``' integrator (:mod:`._compile_helper`),
-    compiling all but the stepper's loop, unless one runs, the loop is compiled or cached, or
-    no helper may run here; whether a helper runs. A helper of another package is stopped."""
-    rest, _, key = _warmup_calls(kernels, held, events)
-    if key in _compiled:
+def _helped(warm: _Warmup) -> bool:
+    """Start the helper of a cold compile (:mod:`._compile_helper`) doing ``warm.rest``, unless
+    one runs, the loop is compiled or cached, or no helper may run here; whether a helper runs.
+    A helper of another package is stopped."""
+    if warm.key in _compiled:
         return False
-    if _compile_helper.running(key):
+    if _compile_helper.running(warm.key):
         return True
     if not _compile_helper.may_fork():  # before numba is loaded: a refused file stays quick
         return False
-    run, sig = _loop_signature(kernels, held, events)
+    run, sig = warm.signature()
     if not _compile_helper.eligible(run) or _compile_helper.cached(run, sig):
         return False
-    _compile_helper.stop_others(key)
-    return _compile_helper.start(key, rest)
+    _compile_helper.stop_others(warm.key)
+    return _compile_helper.start(warm.key, warm.rest)
+
+
+def _compile_loop(warm: _Warmup) -> None:
+    """Compile the stepper's loop here while the helper compiles the rest; the helper is
+    stopped if this fails or is interrupted."""
+    run, sig = warm.signature()
+    try:
+        call(run.compile, sig)
+    except BaseException:
+        _compile_helper.stop(warm.key)
+        raise
 
 
 def compile_ahead(code: int) -> None:
@@ -231,15 +241,9 @@ def compile_ahead(code: int) -> None:
     it runs after the state's checks (a bad file is refused before numba loads), and the
     projection then loads what the helper saved; the run's :func:`compile_code` waits for the
     helper and loads the rest."""
-    kernels = for_code(int(code))
-    if not _helped(kernels, held=False, events=False):
-        return
-    run, sig = _loop_signature(kernels, False, False)
-    try:
-        call(run.compile, sig)
-    except BaseException:
-        _compile_helper.stop(_warmup_calls(kernels, False, False)[2])
-        raise
+    warm = _warmup(for_code(int(code)), held=False, events=False)
+    if _helped(warm):
+        _compile_loop(warm)
 
 
 def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
@@ -248,24 +252,19 @@ def _compile_package(kernels: ModuleType, held: bool = False, events: bool = Fal
     cache) leaves the start, the projection and the diagnostics to a forked helper where one may
     run (:mod:`._compile_helper`), while this process compiles the loop."""
     events = events and not held  # the held stepper locates events too
-    rest, loop, key = _warmup_calls(kernels, held, events)
-    if key in _compiled:
+    warm = _warmup(kernels, held, events)
+    if warm.key in _compiled:
         return 0.0
     start = time.perf_counter()
     what = "held integrator" if held else "event integrator" if events else "integrator"
     with compiling(kernels, what):
-        if _helped(kernels, held, events):
-            run, sig = _loop_signature(kernels, held, events)
-            try:
-                call(run.compile, sig)
-            except BaseException:
-                _compile_helper.stop(key)
-                raise
-            _compile_helper.join(key)
-        rest()
-        loop()
-    _compiled[key] = time.perf_counter() - start
-    return _compiled[key]
+        if _helped(warm):
+            _compile_loop(warm)
+            _compile_helper.join(warm.key)
+        warm.rest()
+        warm.loop()
+    _compiled[warm.key] = time.perf_counter() - start
+    return _compiled[warm.key]
 
 
 def _stepper_calls(
