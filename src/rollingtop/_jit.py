@@ -12,7 +12,7 @@ an ulp of the written expression and do not depend on reassociation).
   counting on, every call increments and decrements each array argument's count atomically,
   which cost more than the arithmetic -- the whole stepper ran about twice as slow
   (``benchmarks/``). Such a function must not allocate or return arrays.
-- :func:`inline`: a small helper inlined into its caller at numba's IR level.
+- :func:`inline`: a small helper that LLVM inlines into its compiled callers.
 - :func:`compiled`: a driver that may allocate (reference counting on), with extra options.
 
 The decorators are typed (they return the function's own type), so that type checkers see the
@@ -210,9 +210,28 @@ def loop(func: F) -> F:
     return _make(func, {**BASE_OPTIONS, "_nrt": False, "nogil": True})
 
 
+#: Options of :func:`inline`: a stage kernel's (no reference counting), LLVM's ``alwaysinline``
+#: (numba's ``forceinline``), and no C-callable wrapper (none is used). The wrapper for calls
+#: from Python stays: numba does not refuse a Python call of a function compiled without one,
+#: it crashes.
+INLINE_OPTIONS: dict[str, Any] = {
+    **BASE_OPTIONS,
+    "_nrt": False,
+    "forceinline": True,
+    "no_cfunc_wrapper": True,
+}
+
+
 def inline(func: F) -> F:
-    """Compile ``func`` as a helper inlined into every compiled caller."""
-    return _make(func, {**BASE_OPTIONS, "inline": "always"})
+    """Compile ``func`` as a helper that LLVM inlines into every compiled caller.
+
+    It is compiled once, as a function of its own, and inlined by LLVM (``alwaysinline``) where
+    it is called: the caller's machine code is that of the function written out in place.
+    numba's own inlining (``inline="always"``) gave the same code but ran the helper's front
+    end, typing and lowering again at every call site, nested helpers once per path: 1.2 to
+    2.9 s of each model's 8 to 11 s first compile (``docs/development.md``, "Compile time").
+    Like a :func:`kernel` it must not allocate."""
+    return _make(func, INLINE_OPTIONS)
 
 
 def compiled(**options: Any) -> Callable[[F], F]:
