@@ -1,5 +1,6 @@
 """Measure what the compile notice estimates: the seconds each group of the paper's model's
-kernels takes to compile with an empty cache, each group in a fresh process.
+kernels takes to compile with an empty cache, each group in a fresh process; and the seconds of
+each compiled package in a worker of ``rollingtop warmup`` (the order it hands them out in).
 
 The command line announces a cold compilation with an estimate
 (``rollingtop: compiling the meridian model's integrator kernels (first run only, about 9 s)``);
@@ -28,7 +29,7 @@ ROOT = HERE.parent
 TARGET = ROOT / "src" / "rollingtop" / "_compiled" / "estimates.json"
 
 #: The groups the library announces (:func:`rollingtop._compiled.compiling`), in order.
-GROUPS = ("dynamics", "integrator", "held integrator", "event integrator", "ensemble", "chaos")
+GROUPS = ("dynamics", "integrator", "held integrator", "event integrator", "chaos")
 
 CHILD = r"""
 import json, re, sys
@@ -63,9 +64,6 @@ if what == "dynamics":  # the shading of a portrait: reactions along states (nea
     with _compiled.compiling("meridian", "dynamics"):
         call(_compiled.for_code(code).dynamics.contact_forces, code, np.array(WARMUP_PARAMS),
              y[None, :].copy(), np.zeros((1, 2)))
-elif what == "ensemble":
-    from rollingtop.integrate.ensemble import compile_ensemble_code
-    compile_ensemble_code(code)
 elif what == "chaos":
     from rollingtop import SphericalTop
     from rollingtop.chaos.lyapunov import chaos_indicators
@@ -103,7 +101,41 @@ def estimates() -> dict[str, object]:
         "date": time.strftime("%Y-%m-%d", time.gmtime()),
         "written_by": "benchmarks/compile_estimates.py --write",
         "seconds": seconds,
+        "packages": package_seconds(),
     }
+
+
+PACKAGE_CHILD = r"""
+import json, sys, time
+from rollingtop._warmup import warm_package
+
+start = time.perf_counter()
+warm_package(sys.argv[1])
+print(json.dumps(time.perf_counter() - start))
+"""
+
+
+def package_seconds() -> dict[str, float]:
+    """Seconds each compiled package's kernels take in a worker of ``rollingtop warmup`` (one
+    process, no helper; the pieces every model shares already cached, as they are after the
+    first package), each in a fresh process: the order in which warmup hands them out."""
+    from rollingtop._compiled import GROUPS as PACKAGES
+    from rollingtop.integrate._compile_helper import ENV
+
+    seconds = {}
+    with tempfile.TemporaryDirectory() as cache:
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+        env |= {"NUMBA_CACHE_DIR": cache, ENV: "0"}
+        shared = "from rollingtop.integrate.driver import compile_shared; compile_shared()"
+        subprocess.run([sys.executable, "-c", shared], env=env, cwd=ROOT, check=True)
+        for group in PACKAGES:
+            proc = subprocess.run([sys.executable, "-c", PACKAGE_CHILD, group.package], env=env,
+                                  cwd=ROOT, capture_output=True, text=True)  # fmt: skip
+            if proc.returncode != 0:
+                raise SystemExit(f"measuring {group.package!r} failed:\n{proc.stderr}")
+            seconds[group.package] = round(float(proc.stdout.strip().splitlines()[-1]), 1)
+            print(f"  package {group.package}: {seconds[group.package]} s", flush=True)
+    return seconds
 
 
 def write(result: dict[str, object], path: Path = TARGET) -> None:

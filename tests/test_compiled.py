@@ -102,7 +102,7 @@ def test_the_estimate_and_the_variants_label():
     """The estimates are the measured ones (benchmarks/compile_estimates.py writes them), one
     for every group the library announces."""
     assert set(_compiled.ESTIMATES) == {"dynamics", "integrator", "held integrator",
-                                        "event integrator", "ensemble", "chaos"}  # fmt: skip
+                                        "event integrator", "chaos"}  # fmt: skip
     assert all(0.0 < s < 600.0 for s in _compiled.ESTIMATES.values())
     about = f"about {_compiled.ESTIMATES['integrator']:.0f} s"
     assert about in _compiled.message("meridian", "integrator")

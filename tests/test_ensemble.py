@@ -14,6 +14,7 @@ from rollingtop import (
     simulate,
     simulate_ensemble,
 )
+from rollingtop._compiled import for_model
 from rollingtop.ensemble import grid_table, states_from_table
 from rollingtop.reduction import LevelSet, orbits
 from rollingtop.scenario import InitialConditions, IntegrationOptions, LevelSpec, Scenario
@@ -71,6 +72,8 @@ def test_ensemble_equals_single_runs(scenario, threads):
     s = res.summary()
     assert s["n"] == 9 and s["failed"] == 0
     assert all(v < 1e-9 for v in s["max_rel_drift"].values())
+    # the rows ran through the single run's compiled loop, with its argument types: one compile
+    assert len(for_model("meridian").stepper.run_rows.signatures) == 1
 
 
 def test_samples_bodies_and_pole_cases(paper_body):

@@ -299,7 +299,7 @@ def test_the_instances_keep_the_templates_lines_and_file():
             assert all("_template" in template[i] or "False" in template[i]
                        or "stepper import" in template[i] for i in changed)  # fmt: skip
     package = _compiled.for_model("smooth")
-    run = package.stepper.run
+    run = package.stepper.run_rows
     func = getattr(run, "py_func", run)
     assert func.__code__.co_filename == str(_instances.TEMPLATE / "stepper.py")
     assert package.stepper_held.HELD and package.stepper_held.EVENTS
@@ -367,7 +367,7 @@ def test_the_key_is_the_same_in_every_process_and_ignores_line_numbers():
         "from rollingtop import _compiled, _jit, _kernel_cache as kc\n"
         "_jit.load_numba()\n"
         "k = _compiled.for_model('rough')\n"
-        "print(kc.module_digest(k.stepper.__name__), kc.module_digest(k.ensemble.__name__))\n"
+        "print(kc.module_digest(k.stepper.__name__), kc.module_digest(k.chaos.__name__))\n"
     )
     digests = set()
     for seed in ("1", "2"):
@@ -393,20 +393,20 @@ def test_a_models_key_reaches_the_flag_intrinsic_and_no_other_model():
 
     _jit.load_numba()
     _compiled.for_model("meridian")  # another model imported: never part of rough's key
-    ensemble = _compiled.for_model("rough").ensemble
-    reached = _kernel_cache.closure(ensemble.__name__)
+    stepper = _compiled.for_model("rough").stepper  # its loop polls the stop flag
+    reached = _kernel_cache.closure(stepper.__name__)
     assert "rollingtop._compiled._flags" in reached
     assert not [m for m in reached if "meridian" in m or "smooth" in m], reached
     from rollingtop._compiled import _dop853
 
-    before = _kernel_cache.module_digest(ensemble.__name__)
+    before = _kernel_cache.module_digest(stepper.__name__)
     saved = _dop853.SAFETY
     try:
         _dop853.SAFETY = 0.5
-        assert _kernel_cache.module_digest(ensemble.__name__) != before
+        assert _kernel_cache.module_digest(stepper.__name__) != before
     finally:
         _dop853.SAFETY = saved
-    assert _kernel_cache.module_digest(ensemble.__name__) == before
+    assert _kernel_cache.module_digest(stepper.__name__) == before
 
 
 def test_old_versions_of_a_module_are_pruned(tmp_path):

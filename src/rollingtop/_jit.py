@@ -13,6 +13,7 @@ an ulp of the written expression and do not depend on reassociation).
   which cost more than the arithmetic -- the whole stepper ran about twice as slow
   (``benchmarks/``). Such a function must not allocate or return arrays.
 - :func:`inline`: a small helper that LLVM inlines into its compiled callers.
+- :func:`spliced`: a function typed as part of its one compiled caller.
 - :func:`compiled`: a driver that may allocate (reference counting on), with extra options.
 
 The decorators are typed (they return the function's own type), so that type checkers see the
@@ -232,6 +233,16 @@ def inline(func: F) -> F:
     2.9 s of each model's 8 to 11 s first compile (``docs/development.md``, "Compile time").
     Like a :func:`kernel` it must not allocate."""
     return _make(func, INLINE_OPTIONS)
+
+
+def spliced(func: F) -> F:
+    """Compile ``func`` into its compiled caller at numba's IR level (``inline="always"``):
+    typed, lowered and optimised as part of it, with no machine code of its own. For a function
+    called at one site (the stepper's loop in the rows it advances): a function of its own is
+    optimised and emitted once more inside each caller, which cost a second of every model's
+    first compile; where called at several sites, each types it again (:func:`inline` serves
+    those). Called from Python, it compiles as a :func:`kernel`."""
+    return _make(func, {**BASE_OPTIONS, "_nrt": False, "inline": "always"})
 
 
 def compiled(**options: Any) -> Callable[[F], F]:

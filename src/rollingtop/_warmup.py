@@ -20,13 +20,14 @@ import time
 from collections.abc import Callable, Sequence
 
 from rollingtop._compiled import GROUPS as PACKAGES
-from rollingtop._compiled import Group
+from rollingtop._compiled import PACKAGE_SECONDS, Group
 from rollingtop.contact import MODELS, get_model
 
 #: The groups compiled for each model by :func:`warmup`, in order, with what each serves.
 GROUPS = {
     "integrator": "the right-hand side, projection, diagnostics and DOP853 stepper",
-    "ensemble": "the parallel ensemble kernel",
+    # the single run's loop since issue 35: nothing more to compile (the key stays for scripts)
+    "ensemble": "the parallel ensembles' loop (the integrator's)",
 }
 
 
@@ -50,6 +51,16 @@ def warm_package(package: str) -> dict[str, float]:
     return seconds
 
 
+def warm_shared() -> float:
+    """Compile (or load) the pieces of the stepper's loop that every package shares
+    (:func:`rollingtop.integrate.driver.compile_shared`) in this process; seconds spent."""
+    from rollingtop.integrate.driver import compile_shared
+
+    start = time.perf_counter()
+    compile_shared()
+    return time.perf_counter() - start
+
+
 def _no_compile_helper() -> None:
     """In a worker of :func:`warmup`: no helper process for a cold compile (the workers already
     fill the CPUs; :mod:`rollingtop.integrate._compile_helper`)."""
@@ -63,17 +74,12 @@ def _sum(parts: list[dict[str, float]]) -> dict[str, float]:
 
 
 def _packages(models: Sequence[str]) -> list[Group]:
-    """The compiled packages of ``models``, the longest to compile first: by their model's
-    module's size (the closed forms make most of the code), a model's variants right after its
-    own package (they compile as long). Handed out in this order, the last process to finish is
-    not left with a long one alone."""
-    import os.path
-
-    from rollingtop.contact import MODULES
-
-    size = {m.MODEL.name: os.path.getsize(str(m.__file__)) for m in MODULES}
+    """The compiled packages of ``models``, the longest to compile first, by the seconds
+    measured for each (:data:`PACKAGE_SECONDS`; a package not measured, a new model's, first of
+    all). Handed out in this order, the last process to finish is not left with a long one
+    alone."""
     chosen = [g for g in PACKAGES if g.model in models]
-    return sorted(chosen, key=lambda g: (-size[g.model], g.codes != (g.base,)))
+    return sorted(chosen, key=lambda g: -PACKAGE_SECONDS.get(g.package, float("inf")))
 
 
 def warmup(
@@ -127,7 +133,11 @@ def warmup(
     with concurrent.futures.ProcessPoolExecutor(
         workers, mp_context=context, initializer=_no_compile_helper
     ) as pool:
+        # first, in one worker, the pieces every package's loop shares: the others' first
+        # packages reach their loops after their right-hand sides, and find them saved
+        shared = pool.submit(warm_shared)
         futures = {pool.submit(warm_package, g.package): g for g in packages}
         for future in concurrent.futures.as_completed(futures):
             finished(futures[future], future.result())
+        shared.result()
     return {name: out[name] for name in names}

@@ -302,7 +302,7 @@ def test_the_loops_python_calls_release_the_gil():
     for name in MODELS:
         k = for_model(name)
         steppers = (k.stepper, k.stepper_events, k.stepper_held)
-        loops = [s.run for s in steppers] + [k.tangent.indicators_chunk, k.ensemble.batch]
+        loops = [s.run_rows for s in steppers] + [k.tangent.indicators_chunk]
         loops.append(k.chaos.section_batch)
         assert all(f.targetoptions.get("nogil") is True for f in loops), name
 

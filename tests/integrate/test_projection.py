@@ -272,9 +272,9 @@ def test_a_run_without_projection_never_compiles_it():
         f"sc = load_scenario({str(EXAMPLES / 'paper.toml')!r})\n"
         "k = for_model('meridian')\n"
         "simulate(sc, t_end=1.0)\n"
-        "print(len(k.stepper.run.signatures), len(k.stepper_held.run.signatures))\n"
+        "print(len(k.stepper.run_rows.signatures), len(k.stepper_held.run_rows.signatures))\n"
         "simulate(sc, t_end=1.0, project_integrals=True)\n"
-        "print(len(k.stepper_held.run.signatures))\n"
+        "print(len(k.stepper_held.run_rows.signatures))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["1", "0", "1"], out.stdout + out.stderr

@@ -16,11 +16,10 @@ import pytest
 
 from rollingtop import IntegrationError, SphericalTop, initial_state, simulate
 from rollingtop._compiled import _dop853 as dop
-from rollingtop._compiled import for_code
 from rollingtop._errors import InitialStateError
 from rollingtop.contact import get_model
 from rollingtop.integrate import integrate
-from rollingtop.integrate.driver import _workspace, compile_kernels
+from rollingtop.integrate.driver import _stepper_calls, compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble, integrate_batch
 
 from ..conftest import GAMMA0, OMEGA0, PAPER_BODY, scenario_text
@@ -122,17 +121,14 @@ def test_stepper_stops_on_a_nan_or_underflowing_step(h):
     the last place of ``t`` (at t = 1: 2.2e-15) returns ``STEP_TOO_SMALL`` without a step."""
     body, y0 = paper_state()
     t_eval = np.array([1.0, 50.0])
-    w = _workspace(t_eval.size)
-    y, f = y0.copy(), np.zeros_like(y0)
-    stepper = for_code(0).stepper
-    ctrl, counts, track = stepper.start(0, body.params, y, f, t_eval, 1e-10, 1e-12, 0, w["out"],
-                                    w["ytmp"], w["ynew"], w["ws"])  # fmt: skip
-    ctrl[dop.H_ABS] = h
-    status = stepper.run(0, body.params, y, f, ctrl, counts, track, t_eval, w["out"],
-                     np.zeros(2, dtype=np.int64), np.zeros(1), np.zeros((1, y.size)), 10**6,
-                     w["K"], w["ynew"], w["ytmp"], w["y_old"], w["Fd"], w["ws"],
-                     np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8)))  # fmt: skip
-    assert status == dop.STEP_TOO_SMALL and counts[dop.STEPS] == 0
+    stepper, run_args, (row, _, _, _) = _stepper_calls(
+        0, body.params, y0, t_eval, 1e-10, 1e-12, (0, 0, 1)
+    )
+    stepper.run_rows(*run_args(0))  # starts the row, takes no step
+    assert row.STATUS[0] == dop.BUDGET_EXHAUSTED and row.COUNTS[0, dop.STEPS] == 0
+    row.CTRL[0, dop.H_ABS] = h
+    stepper.run_rows(*run_args(10**6))
+    assert row.STATUS[0] == dop.STEP_TOO_SMALL and row.COUNTS[0, dop.STEPS] == 0
 
 
 @pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning")

@@ -1,19 +1,19 @@
 """The compiled core, one package per contact model (and one for a model's variants),
 compiled on first use.
 
-Each registered contact model has a package here (``rollingtop._compiled.meridian``, ...),
-made from the template :mod:`rollingtop._compiled._template` when first imported
-(:mod:`rollingtop._compiled._instances`; no file is generated): its right-hand side,
-projection, diagnostics, DOP853 stepper, ensemble kernel, tangent dynamics and chaos batches,
-compiled against that model's functions alone. A model with variants (the meridian model's pole
-cases, :class:`rollingtop.contact.Kernel`) has a second package for them,
-``meridian_variants``: its own kernel's code is then straight-line, with no branch on the
-variant, and a run that needs no variant compiles none (:data:`GROUPS`). :func:`for_code`
-imports the package of a kernel code (cheap: nothing is compiled at import); numba compiles each
-function on its first call, or loads it from the on-disk cache, keyed on every source compiled
-into it (:mod:`rollingtop._kernel_cache`), so a command pays only for the kernels it runs and
-never runs machine code older than its sources. The modules beside the packages (``_kernel``,
-``_dop853``, ...) are the compiled pieces every model shares, compiled once.
+Each registered contact model has a package here (``rollingtop._compiled.meridian``, ...), made from
+the template :mod:`rollingtop._compiled._template` when first imported
+(:mod:`rollingtop._compiled._instances`; no file is generated): its right-hand side, projection,
+diagnostics, DOP853 stepper (whose loop runs a single run and an ensemble's rows alike), tangent
+dynamics and chaos batches, compiled against that model's functions alone. A model with variants
+(the meridian model's pole cases, :class:`rollingtop.contact.Kernel`) has a second package for them,
+``meridian_variants``: its own kernel's code is then straight-line, with no branch on the variant,
+and a run that needs no variant compiles none (:data:`GROUPS`). :func:`for_code` imports the package
+of a kernel code (cheap: nothing is compiled at import); numba compiles each function on its first
+call, or loads it from the on-disk cache, keyed on every source compiled into it
+(:mod:`rollingtop._kernel_cache`), so a command pays only for the kernels it runs and never runs
+machine code older than its sources. The modules beside the packages (``_kernel``, ``_dop853``, ...)
+are the compiled pieces every model shares, compiled once.
 
 :func:`compiling` wraps a first call that may compile: when numba actually compiles (a cache
 miss, not a load), the notifier (:func:`set_notifier`; the command line's prints one line on
@@ -46,6 +46,7 @@ install(GROUPS)
 __all__ = [
     "ESTIMATES",
     "GROUPS",
+    "PACKAGE_SECONDS",
     "Group",
     "Notifier",
     "before_projection",
@@ -61,15 +62,16 @@ __all__ = [
 
 _GROUP_OF_CODE: dict[int, Group] = {c: g for g in GROUPS for c in g.codes}
 
+_MEASURED = json.loads((Path(__file__).with_name("estimates.json")).read_text())
 #: Seconds a cold compilation of each group of the paper's model's kernels took, measured (each
 #: group in a fresh process with an empty cache) by ``benchmarks/compile_estimates.py --write``
 #: into ``estimates.json`` beside this file; the models differ by a few seconds. Only the
 #: announcement uses them.
-ESTIMATES: dict[str, float] = {
-    str(k): float(v)
-    for k, v in json.loads((Path(__file__).with_name("estimates.json")).read_text())[
-        "seconds"
-    ].items()
+ESTIMATES: dict[str, float] = {str(k): float(v) for k, v in _MEASURED["seconds"].items()}
+#: Seconds each compiled package (:data:`GROUPS`) took in a worker of :func:`rollingtop.warmup`
+#: (measured by the same script, in fresh processes): the order warmup hands them out in.
+PACKAGE_SECONDS: dict[str, float] = {
+    str(k): float(v) for k, v in _MEASURED.get("packages", {}).items()
 }
 
 
@@ -86,10 +88,10 @@ def for_code(code: int) -> ModuleType:
     """The compiled package that runs kernel code ``code``.
 
     Its modules ``dynamics``, ``events``, ``dense``, ``stepper`` (``stepper_held`` with the
-    projection onto the integrals), ``ensemble``, ``tangent`` and
-    ``chaos`` hold the functions of :mod:`rollingtop._compiled._template`, compiled for its
-    group's codes only (:data:`GROUPS`; a code of another group is not checked by the compiled
-    functions: pick the package by the code).
+    projection onto the integrals), ``tangent`` and ``chaos`` hold the functions of
+    :mod:`rollingtop._compiled._template`, compiled for its group's codes only (:data:`GROUPS`;
+    a code of another group is not checked by the compiled functions: pick the package by the
+    code).
     """
     package = group_of(code).package
     _jit.load_numba()  # compiled code is wanted: its functions numba dispatchers from here on

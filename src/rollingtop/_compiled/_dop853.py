@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from rollingtop._jit import compiled, kernel
+from rollingtop._jit import kernel
 from rollingtop._types import FloatArray
 
 SAFETY = 0.9
@@ -33,17 +33,19 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 ERROR_EXPONENT = -1.0 / 8.0
 
-# Status codes returned by ``run`` (and, per trajectory, by the ensemble kernel): >= 0 the run
-# may go on (or is done), < 0 it cannot reach ``t_end``.
+# Status codes of each row of the stepper's loop (``run_rows``: a single run's one row, an
+# ensemble's trajectories): >= 0 the run may go on (or is done), < 0 it cannot reach ``t_end``.
 FINISHED = 0
 #: The step budget of this call is spent (the caller resumes, or reports ``max_steps``).
 BUDGET_EXHAUSTED = 1
-#: An ensemble trajectory stopped (or never started) on a stop request; never returned by ``run``.
+#: A trajectory stopped (or never started) on a stop request.
 INTERRUPTED = 2
+#: A row still advancing, inside the loop; never reported.
+RUNNING = 3
 #: The step size fell below ten units in the last place of ``t``, or is zero or NaN (no initial
 #: step: the scaled norm of the state or its derivative overflows).
 STEP_TOO_SMALL = -1
-#: The state or its derivative is not finite (at an accepted step, or when ``run`` is entered),
+#: The state or its derivative is not finite (at an accepted step, or when ``run_rows`` is entered),
 #: or ``MAX_REJECTED_IN_A_ROW`` steps in a row were rejected with a non-finite error estimate.
 NOT_FINITE = -2
 #: ``MAX_REJECTED_IN_A_ROW`` steps in a row were rejected by the error control.
@@ -91,11 +93,25 @@ MIN_NORMAL, T_MIN_NORMAL, T_CONTACT_LOST, MAX_RATIO, T_MAX_RATIO, LAST_NORMAL = 
 PREV_T, PREV_NORMAL = 6, 7
 
 
-@compiled()
-def new_track() -> FloatArray:
-    """Reaction tracking: min normal force and when, first time it is < 0, max ratio and when,
-    the normal force at the last accepted step, the time and normal force of the one before."""
-    return np.array([np.inf, np.nan, np.nan, 0.0, np.nan, np.nan, np.nan, np.nan])
+#: Length of ``track``.
+N_TRACK = 8
+#: Length of ``ctrl``.
+N_CTRL = 8
+
+
+@kernel
+def reset_track(track: FloatArray) -> None:
+    """Reaction tracking from scratch, in ``track`` (shape (:data:`N_TRACK`,)): min normal force
+    and when, first time it is < 0, max ratio and when, the normal force at the last accepted
+    step, the time and normal force of the one before."""
+    track[MIN_NORMAL] = np.inf
+    track[T_MIN_NORMAL] = np.nan
+    track[T_CONTACT_LOST] = np.nan
+    track[MAX_RATIO] = 0.0
+    track[T_MAX_RATIO] = np.nan
+    track[LAST_NORMAL] = np.nan
+    track[PREV_T] = np.nan
+    track[PREV_NORMAL] = np.nan
 
 
 @kernel

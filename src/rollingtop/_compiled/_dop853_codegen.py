@@ -19,6 +19,8 @@ from rollingtop._compiled._dop853_tableau import E3, E5, N_STAGES_EXTENDED, A
 
 TARGET = Path(__file__).with_name("_dop853_stages.py")
 LINE_LENGTH = 100
+#: :data:`_dop853_stages.LAST_STEP_STAGE` (written into it).
+LAST_STEP_STAGE = 12
 
 HEADER = '''"""DOP853 stages and error estimates, coefficients spelled out (GENERATED: do not edit).
 
@@ -31,10 +33,16 @@ from __future__ import annotations
 from rollingtop._jit import kernel
 from rollingtop._types import FloatArray
 
+#: The last stage of a step (the new point, first same as last); the later ones serve the dense
+#: output.
+LAST_STEP_STAGE = 12
+
 
 @kernel
 def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
-    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
+    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``: :func:`step_stage`
+    or :func:`dense_stage` (the compiled callers call those: each links only the code of its
+    own stages).
 
     Parameters
     ----------
@@ -49,7 +57,10 @@ def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> N
     ytmp : ndarray, shape (n,)
         Output.
     """
-    n = y.shape[0]
+    if s <= LAST_STEP_STAGE:
+        step_stage(K, s, y, h, ytmp)
+    else:
+        dense_stage(K, s, y, h, ytmp)
 '''
 
 
@@ -101,14 +112,34 @@ def _combination(coefficients: Iterable[float], lhs: str, head: str, tail: str) 
     return [f"{lhs} = {head}", *(indent + part for part in parts), f"{indent[:-4]}){tail}"]
 
 
+STAGE_FUNCTION = '''
+
+@kernel
+def {name}(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
+    """:func:`stage` for ``s`` in ``{first} .. {last}`` ({what})."""
+    n = y.shape[0]
+'''
+
+
+def _stages(name: str, first: int, last: int, what: str) -> list[str]:
+    """A stage function of the stages ``first .. last`` (another ``s`` writes nothing)."""
+    lines = STAGE_FUNCTION.format(name=name, first=first, last=last, what=what).rstrip("\n")
+    out = lines.split("\n")
+    for s in range(first, last + 1):
+        keyword = "if" if s == first else "elif"
+        out.append(f"    {keyword} s == {s}:")
+        out.append("        for i in range(n):")
+        out += _combination(A[s, :s], "            ytmp[i]", "y[i] + h * (", "")
+    return out
+
+
 def render() -> str:
     """Source of the generated module."""
     lines = [HEADER.rstrip("\n")]
-    for s in range(1, N_STAGES_EXTENDED):
-        keyword = "if" if s == 1 else "elif"
-        lines.append(f"    {keyword} s == {s}:")
-        lines.append("        for i in range(n):")
-        lines += _combination(A[s, :s], "            ytmp[i]", "y[i] + h * (", "")
+    lines += _stages("step_stage", 1, LAST_STEP_STAGE, "a step's stages and its new point")
+    lines += _stages(
+        "dense_stage", LAST_STEP_STAGE + 1, N_STAGES_EXTENDED - 1, "the dense output's stages"
+    )
     lines += ERROR_FUNCTION.rstrip("\n").split("\n")
     lines += _combination(E5, "        err5[i]", "(", " / sc")
     lines += _combination(E3, "        err3[i]", "(", " / sc")

@@ -9,10 +9,16 @@ from __future__ import annotations
 from rollingtop._jit import kernel
 from rollingtop._types import FloatArray
 
+#: The last stage of a step (the new point, first same as last); the later ones serve the dense
+#: output.
+LAST_STEP_STAGE = 12
+
 
 @kernel
 def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
-    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``.
+    """``ytmp = y + h * sum_{j<s} A[s, j] K[j]`` for stage ``s`` in ``1 .. 15``: :func:`step_stage`
+    or :func:`dense_stage` (the compiled callers call those: each links only the code of its
+    own stages).
 
     Parameters
     ----------
@@ -27,6 +33,15 @@ def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> N
     ytmp : ndarray, shape (n,)
         Output.
     """
+    if s <= LAST_STEP_STAGE:
+        step_stage(K, s, y, h, ytmp)
+    else:
+        dense_stage(K, s, y, h, ytmp)
+
+
+@kernel
+def step_stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
+    """:func:`stage` for ``s`` in ``1 .. 12`` (a step's stages and its new point)."""
     n = y.shape[0]
     if s == 1:
         for i in range(n):
@@ -126,7 +141,13 @@ def stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> N
                 + 0.20136540080403034 * K[10, i]
                 + 0.04471061572777259 * K[11, i]
             )
-    elif s == 13:
+
+
+@kernel
+def dense_stage(K: FloatArray, s: int, y: FloatArray, h: float, ytmp: FloatArray) -> None:
+    """:func:`stage` for ``s`` in ``13 .. 15`` (the dense output's stages)."""
+    n = y.shape[0]
+    if s == 13:
         for i in range(n):
             ytmp[i] = y[i] + h * (
                 0.056167502283047954 * K[0, i]

@@ -5,7 +5,7 @@ stepper that dispatched on a kernel code at run time held every model: compiling
 newcomer's first run) compiled all of them, and adding a model made every user's first run
 slower. So each group of kernels (:data:`GROUPS`: a model's own kernel, or its variants) gets its
 own instance of the compiled core -- the modules of :mod:`rollingtop._compiled._template`
-(dynamics, events, dense output, stepper, ensemble, tangent dynamics, chaos batches) -- in a
+(dynamics, events, dense output, stepper, tangent dynamics, chaos batches) -- in a
 package of its own, ``rollingtop._compiled.<package>``, whose ``_dispatch`` calls that group's
 model functions alone, written here from the registry (:func:`dispatch_source`).
 
@@ -63,7 +63,6 @@ MODULES_COPIED = (
     "dense",
     "invariants",
     "stepper",
-    "ensemble",
     "tangent",
     "chaos",
 )
@@ -71,7 +70,7 @@ MODULES_COPIED = (
 #: location compiled in (``HELD = True``, ``EVENTS = True``), and with its event location alone.
 COPIES = {"stepper_held": "stepper", "stepper_events": "stepper"}
 #: The import of the stepper in ``chaos``, pointed at ``stepper_events`` in the instances.
-CHAOS_IMPORT = ".stepper import run, start"
+CHAOS_IMPORT = ".stepper import run_rows"
 #: Every module of a group's package, in the order the package imports them.
 SUBMODULES = ("_dispatch", *MODULES_COPIED, *COPIES)
 

@@ -33,7 +33,7 @@ def workspace() -> Workspace:
     )
 
 
-#: :func:`workspace` compiled, for compiled callers (the ensemble's threads, the diagnostics).
+#: :func:`workspace` compiled, for compiled callers (the diagnostics, the chaos batches).
 new_workspace = compiled()(workspace)
 
 

@@ -1,15 +1,15 @@
 """A second process for a cold compile: half of a package's kernels compiled beside the rest.
 
-numba compiles one function at a time, in one thread, under a global lock: a model's first run
-(an empty cache) spends about 13 s on one core while the machine's others idle. Most of that
-time goes to two independent halves of the integrator: the stepper's loop with what it calls
-(the stage sums, the dense output, the search for the normal force's dips) and the rest (the
-stepper's start, the constraint projection, the samples' diagnostics). So on a cold compile
-:func:`forked` runs the rest in a child process -- forked, so it shares this one's imports and
-starts at once -- while this process compiles the stepper's loop; the child's functions reach
-this process through numba's on-disk cache (:mod:`rollingtop._kernel_cache`), keyed on every
-source compiled in, so what is loaded is what would have been compiled. Nothing depends on the
-child: whatever it did not save in time is compiled here as before, and its failure is silent.
+numba compiles one function at a time, in one thread, under a global lock: a model's first run (an
+empty cache) spends about 13 s on one core while the machine's others idle. Most of that time goes
+to two independent halves of the integrator: the stepper's loop with what it calls (its start, the
+stage sums, the dense output, the search for the normal force's dips) and the rest (the right-hand
+side, the constraint projection, the samples' diagnostics). So on a cold compile :func:`forked` runs
+the rest in a child process -- forked, so it shares this one's imports and starts at once -- while
+this process compiles the stepper's loop; the child's functions reach this process through numba's
+on-disk cache (:mod:`rollingtop._kernel_cache`), keyed on every source compiled in, so what is
+loaded is what would have been compiled. Nothing depends on the child: whatever it did not save in
+time is compiled here as before, and its failure is silent.
 
 Why not a pool (``concurrent.futures``, Dask): a spawned interpreter imports numba and the
 package again (about 1 s of the 5 s gained), and nothing is returned but files. Why only here:

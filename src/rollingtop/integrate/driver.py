@@ -14,8 +14,10 @@ from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import compiling, for_code, packages_of
+from rollingtop._compiled._dop853_dense import dense_eval
+from rollingtop._compiled._dop853_stages import dense_stage, scaled_errors, step_stage
 from rollingtop._compiled._events import EVENTS, NONE
-from rollingtop._compiled._kernel import workspace
+from rollingtop._compiled._kernel import reaction, workspace
 from rollingtop._errors import IntegrationError, NotFiniteAtStart
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
@@ -25,7 +27,15 @@ from rollingtop.integrate import _compile_helper
 from rollingtop.integrate._held import held_arrays
 from rollingtop.integrate._pace import check_pace
 
-__all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "compile_kernels"]
+__all__ = [
+    "IntegrationResult",
+    "Rows",
+    "StepReactions",
+    "compile_code",
+    "compile_kernels",
+    "integrate",
+    "work_arrays",
+]
 
 #: Accepted steps per call of the compiled loop (tens of milliseconds). Between calls the driver
 #: is back in Python: the progress callback runs and so do signal handlers (Ctrl-C, SIGTERM;
@@ -98,7 +108,7 @@ class IntegrationResult:
 
 
 class _Work(TypedDict):
-    """Work arrays of one run of the compiled loop (:func:`._dop853.run`) and its samples."""
+    """Work arrays of one run of the compiled loop (:func:`._template.stepper.run_rows`)."""
 
     K: FloatArray
     ynew: FloatArray
@@ -106,10 +116,12 @@ class _Work(TypedDict):
     y_old: FloatArray
     Fd: FloatArray
     ws: Workspace
-    out: FloatArray
 
 
-def _workspace(n_samples: int) -> _Work:
+def work_arrays() -> _Work:
+    """The work arrays of the stepper's loop (:func:`._template.stepper.run_rows`), shared by
+    the rows of one call: the stages, three states, the dense output's coefficients and the
+    kernels' workspace."""
     return _Work(
         K=np.zeros((16, N_STATE)),
         ynew=np.zeros(N_STATE),
@@ -117,8 +129,33 @@ def _workspace(n_samples: int) -> _Work:
         y_old=np.zeros(N_STATE),
         Fd=np.zeros((7, N_STATE)),
         ws=workspace(),
-        out=np.full((n_samples, N_STATE), np.nan),
     )
+
+
+class Rows(NamedTuple):
+    """The per-row arrays of the stepper's loop (:func:`._template.stepper.run_rows`) for ``n``
+    trajectories: states (advanced in place), derivatives, control, counters, reaction
+    tracking and status; a row whose counters are 0 is started by the loop."""
+
+    Y: FloatArray
+    F: FloatArray
+    CTRL: FloatArray
+    COUNTS: IntArray
+    TRACK: FloatArray
+    STATUS: IntArray
+
+    @classmethod
+    def of(cls, states: FloatArray) -> Rows:
+        """Rows starting from ``states`` (shape (n, 18), copied)."""
+        n = states.shape[0]
+        return cls(
+            np.array(states, dtype=float, order="C"),
+            np.zeros((n, N_STATE)),
+            np.zeros((n, dop.N_CTRL)),
+            np.zeros((n, dop.N_COUNTS), dtype=np.int64),
+            np.zeros((n, dop.N_TRACK)),
+            np.zeros(n, dtype=np.int64),
+        )
 
 
 def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:
@@ -155,13 +192,14 @@ def _warmup_state() -> FloatArray:
 class _Warmup(NamedTuple):
     """What compiles a package's integrator (:func:`compile_code`, :func:`_warmup`)."""
 
-    #: Compiles all but the stepper's loop: the right-hand side, the constraint projection, the
-    #: stepper's start and the samples' diagnostics (a helper's half).
+    #: Compiles (or loads) all but the stepper's loop: what the loop calls of the model's
+    #: (the dense output, the projection, the normal force's root and dips, the right-hand side)
+    #: and the samples' diagnostics (a helper's half).
     rest: Callable[[], None]
     #: Runs the warm-up run (compiles the loop, loads the rest).
     loop: Callable[[], None]
-    #: The stepper copy's ``run`` dispatcher and its argument types in the warm-up run
-    #: (``start``'s results by placeholders of their types); computed once.
+    #: The stepper copy's ``run_rows`` dispatcher and its argument types in the warm-up run;
+    #: computed once.
     signature: Callable[[], tuple[Any, tuple[Any, ...]]]
     #: The compile's key in ``_compiled`` and of its helper.
     key: tuple[str, bool, bool]
@@ -179,14 +217,10 @@ def _warmup(kernels: ModuleType, held: bool, events: bool) -> _Warmup:
     t_eval = np.array([0.0, 1e-3])
 
     def rest() -> None:
-        # in the order a helper's work is needed by the loop compiled beside it: the right-hand
-        # side soonest, then the projection (both called by the loop)
+        # the right-hand side first: the loop compiled beside it (by another process) calls it
+        # soonest, after the shared pieces (:func:`compile_shared`); then the projection
         call(kernels.dynamics.rhs, code, p, y.copy(), np.zeros(N_STATE), workspace())
         call(kernels.dynamics.project, code, p, y, workspace())  # y on the constraints
-        stepper, start_args, _, _ = _stepper_calls(
-            code, p, y, t_eval, 1e-6, 1e-9, event, held_codes
-        )
-        call(stepper.start, *start_args)
         call(kernels.dynamics.diagnostics, code, p, y[None, :].copy(), np.zeros((1, 8)))
 
     def loop() -> None:
@@ -194,12 +228,10 @@ def _warmup(kernels: ModuleType, held: bool, events: bool) -> _Warmup:
 
     @functools.cache
     def signature() -> tuple[Any, tuple[Any, ...]]:
-        stepper, _, run_args, _ = _stepper_calls(
+        stepper, args, _ = _stepper_calls(
             code, p, _warmup_state(), t_eval, 1e-6, 1e-9, event, held_codes
         )
-        placeholders = (np.zeros(8), np.zeros(dop.N_COUNTS, dtype=np.int64), np.zeros(8))
-        args = run_args(*placeholders, 1)
-        return stepper.run, tuple(stepper.run.typeof_pyval(a) for a in args)
+        return stepper.run_rows, tuple(stepper.run_rows.typeof_pyval(a) for a in args(1))
 
     return _Warmup(rest, loop, signature, (kernels.PACKAGE, held, events))
 
@@ -221,11 +253,35 @@ def _helped(warm: _Warmup) -> bool:
     return _compile_helper.start(warm.key, warm.rest)
 
 
+def compile_shared() -> None:
+    """Compile (or load) the pieces of the stepper's loop that every model shares, for the
+    loop's argument types: the stage sums, error estimates, dense output and reaction
+    tracking (compiled once per cache, loaded in milliseconds after)."""
+    w = work_arrays()
+    K, Fd, ws, y, t, x = w["K"], w["Fd"], w["ws"], w["ynew"], 0.0, 0.5
+    track = np.zeros(dop.N_TRACK)
+    pieces: tuple[tuple[Any, tuple[Any, ...]], ...] = (
+        (step_stage, (K, 1, y, x, y)),
+        (dense_stage, (K, 13, y, x, y)),
+        (scaled_errors, (K, y, y, x, x, y, y)),
+        (dense_eval, (Fd, y, x, y)),
+        (reaction, (1, y, ws)),
+        (dop.reset_track, (track,)),
+        (dop.update_track, (track, t, x, x)),
+        (dop.dip_predicted, (t, x, t, x, t, x)),
+    )
+    for func, args in pieces:  # numba dispatchers (typed here as their Python functions)
+        call(func.compile, tuple(func.typeof_pyval(a) for a in args))
+
+
 def _compile_loop(warm: _Warmup) -> None:
     """Compile the stepper's loop here while the helper compiles the rest; the helper is
-    stopped if this fails or is interrupted."""
+    stopped if this fails or is interrupted. The shared pieces of the loop come first
+    (:func:`compile_shared`): meanwhile the helper saves the right-hand side, which the loop
+    then loads instead of compiling it again."""
     run, sig = warm.signature()
     try:
+        compile_shared()
         call(run.compile, sig)
     except BaseException:
         _compile_helper.stop(warm.key)
@@ -235,7 +291,7 @@ def _compile_loop(warm: _Warmup) -> None:
 def compile_ahead(code: int) -> None:
     """Compile the stepper's loop of the plain integrator of the package that runs kernel
     ``code`` while a helper process compiles the rest (the right-hand side, the constraint
-    projection, the stepper's start, the diagnostics), where the package is cold and a helper
+    projection, the diagnostics), where the package is cold and a helper
     may run (:mod:`._compile_helper`); else nothing. For a command about to project an initial
     state and then run it: registered with :func:`rollingtop._compiled.run_before_projection`,
     it runs after the state's checks (a bad file is refused before numba loads), and the
@@ -249,8 +305,8 @@ def compile_ahead(code: int) -> None:
 def _compile_package(kernels: ModuleType, held: bool = False, events: bool = False) -> float:
     """:func:`compile_kernels` for one compiled package (``held``, ``events``:
     :func:`compile_code`). A cold compile (the stepper's loop neither in memory nor in numba's
-    cache) leaves the start, the projection and the diagnostics to a forked helper where one may
-    run (:mod:`._compile_helper`), while this process compiles the loop."""
+    cache) leaves the right-hand side, the projection and the diagnostics to a forked helper
+    where one may run (:mod:`._compile_helper`), while this process compiles the loop."""
     events = events and not held  # the held stepper locates events too
     warm = _warmup(kernels, held, events)
     if warm.key in _compiled:
@@ -279,15 +335,16 @@ def _stepper_calls(
     dips: bool = True,
 ) -> tuple[
     ModuleType,
-    tuple[Any, ...],
-    Callable[..., tuple[Any, ...]],
-    tuple[FloatArray, FloatArray, FloatArray],
+    Callable[[int], tuple[Any, ...]],
+    tuple[Rows, FloatArray, FloatArray, FloatArray],
 ]:
-    """The copy of the stepper a run needs (:mod:`rollingtop._compiled._instances`), the
-    arguments of its ``start`` (``y``: a copy of ``y0``, advanced in place by the run), a
-    function of ``start``'s result ``(ctrl, counts, track)`` and a step budget giving those of
-    its ``run``, and the arrays the run fills: the samples, the events' times and states."""
-    w = _workspace(t_eval.shape[0])
+    """The copy of the stepper a run needs (:mod:`rollingtop._compiled._instances`), a function
+    of a step budget giving the arguments of its ``run_rows`` for one row (started from ``y0``
+    by the first call, resumed by the next ones, up to ``budget`` more accepted steps each), and
+    the arrays the run fills: the row, its samples (shape (1, n, 18)), the events' times and
+    states."""
+    n = t_eval.shape[0]
+    w = work_arrays()
     icodes, targets, pw = held_arrays(code, p, y0, held)
     package = for_code(code)
     ev_code, ev_direction, capacity = event
@@ -302,39 +359,29 @@ def _stepper_calls(
     # np.empty: the pages of a large capacity are touched only by events actually found
     ev_t = np.empty(capacity)
     ev_y = np.empty((capacity, N_STATE))
-    y = y0.copy()
-    f = np.zeros(N_STATE)
-    start_args = (
-        code,
-        p,
-        y,
-        f,
-        t_eval,
-        rtol,
-        atol,
-        ev_code,
-        w["out"],
-        w["ytmp"],
-        w["ynew"],
-        w["ws"],
-    )
+    row = Rows.of(y0[None, :])
+    out = np.full((1, n, N_STATE), np.nan)
+    codes = np.array([code], dtype=np.int64)
+    P = np.ascontiguousarray(p[None, :])
+    stop = np.zeros(1, dtype=np.int64)  # the driver stops between calls instead
 
-    def run_args(
-        ctrl: FloatArray, counts: IntArray, track: FloatArray, budget: int
-    ) -> tuple[Any, ...]:
+    def run_args(budget: int) -> tuple[Any, ...]:
         return (
-            code,
-            p,
-            y,
-            f,
-            ctrl,
-            counts,
-            track,
+            codes,
+            P,
+            row.Y,
+            row.F,
+            row.CTRL,
+            row.COUNTS,
+            row.TRACK,
             t_eval,
-            w["out"],
+            out,
+            rtol,
+            atol,
             ev_spec,
             ev_t,
             ev_y,
+            int(row.COUNTS[0, dop.STEPS]) + budget,
             budget,
             w["K"],
             w["ynew"],
@@ -345,9 +392,11 @@ def _stepper_calls(
             icodes,
             targets,
             pw,
+            row.STATUS,
+            stop,
         )
 
-    return stepper, start_args, run_args, (w["out"], ev_t, ev_y)
+    return stepper, run_args, (row, out, ev_t, ev_y)
 
 
 def _run_compiled(
@@ -363,17 +412,18 @@ def _run_compiled(
     held: IntArray | None = None,
     dips: bool = True,
 ) -> tuple[FloatArray, IntArray, FloatArray, float, tuple[FloatArray, FloatArray, int]]:
-    stepper, start_args, run_args, (out, ev_t, ev_y) = _stepper_calls(
+    stepper, run_args, (row, out, ev_t, ev_y) = _stepper_calls(
         code, p, y0, t_eval, rtol, atol, event, held, dips
     )
-    ctrl, counts, track = call(stepper.start, *start_args)
+    ctrl, counts, track = row.CTRL[0], row.COUNTS[0], row.TRACK[0]
     t_end = float(t_eval[-1])
     start = time.perf_counter()
     while True:
         budget = PROGRESS_CHUNK
         if max_steps is not None:
             budget = min(budget, max_steps - int(counts[dop.STEPS]))
-        status = call(stepper.run, *run_args(ctrl, counts, track, budget))
+        call(stepper.run_rows, *run_args(budget))
+        status = int(row.STATUS[0])
         if progress is not None:
             progress(float(ctrl[dop.T]))
         if status != dop.BUDGET_EXHAUSTED:
@@ -391,12 +441,12 @@ def _run_compiled(
     _raise_for_status(status, ctrl, counts)
     found = int(counts[dop.N_EVENTS])
     kept = min(found, ev_t.shape[0])
-    return out, counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
+    return out[0], counts, track, wall, (ev_t[:kept].copy(), ev_y[:kept].copy(), found - kept)
 
 
 def _raise_for_status(status: int, ctrl: FloatArray, counts: IntArray) -> None:
-    """:class:`IntegrationError` (one line) for a status of the stepper's ``run`` that ends a run
-    early."""
+    """:class:`IntegrationError` (one line) for a status of the stepper's ``run_rows`` that ends
+    a run early."""
     t, h = float(ctrl[dop.T]), float(ctrl[dop.H_ABS])
     if status == dop.STEP_TOO_SMALL and np.isnan(h):
         raise IntegrationError(

@@ -16,19 +16,21 @@ trajectory. Polling only splits the stepper's loop into calls, which does not ch
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Callable
 from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rollingtop._compiled import by_package, compiling, for_code, packages_of
+from rollingtop._compiled import _dop853 as dop
+from rollingtop._compiled import by_package, for_code, packages_of
+from rollingtop._compiled._flags import STOP_POLL_STEPS
 from rollingtop._jit import call
-from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
-from rollingtop._types import FloatArray
+from rollingtop._layout import N_PARAMS, N_STATE
+from rollingtop._types import FloatArray, IntArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
 from rollingtop.integrate._threads import run_rows
+from rollingtop.integrate.driver import Rows, compile_code, work_arrays
 
 __all__ = ["integrate_batch", "compile_ensemble", "compile_ensemble_code"]
 
@@ -37,53 +39,101 @@ __all__ = ["integrate_batch", "compile_ensemble", "compile_ensemble_code"]
 #: chunks taken on demand keep every core busy to the end.
 CHUNK = 4
 
-_compiled: set[str] = set()
 _lock = threading.Lock()
 
 
 def compile_ensemble(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:
-    """Compile (or load from the cache) ``model``'s parallel kernel, and no other model's;
-    seconds spent (0 when done in this process). ``variants``: also its variants' (their own
+    """Compile (or load from the cache) the compiled loop ``model``'s ensembles run -- a single
+    run's, :func:`rollingtop.integrate.driver.compile_kernels` -- and no other model's; seconds
+    spent (0 when done in this process). ``variants``: also its variants' (their own
     compiled package, :data:`rollingtop._compiled.GROUPS`)."""
     return sum(_compile_package(kernels) for kernels in packages_of(model, variants=variants))
 
 
 def compile_ensemble_code(code: int) -> float:
-    """:func:`compile_ensemble` for the package that runs kernel code ``code``; seconds spent
-    (the integration's own compile: :func:`integrate_batch` does it, untimed, where needed)."""
+    """:func:`compile_ensemble` for the package that runs kernel code ``code``; seconds spent.
+    An ensemble runs the single run's compiled loop (:func:`.driver.compile_code`), so after a
+    single run of the package there is nothing left to compile."""
     return _compile_package(for_code(int(code)))
 
 
 def _compile_package(kernels: ModuleType) -> float:
     with _lock:  # Dask runs tasks in threads: one compilation of a package per process
-        return _compile_package_locked(kernels)
+        return compile_code(kernels._dispatch.CODES[0])
 
 
-def _compile_package_locked(kernels: ModuleType) -> float:
-    if kernels.PACKAGE in _compiled:
-        return 0.0
-    start = time.perf_counter()
-    y = np.zeros((1, N_STATE))
-    y[0, 6:15] = (1.0, 0.0, 0.0, 0.0, 0.8, -0.6, 0.0, 0.6, 0.8)
-    P = np.array([WARMUP_PARAMS])
-    codes = np.full(1, kernels._dispatch.CODES[0], dtype=np.int64)
-    with compiling(kernels, "ensemble"):
+def _batch(kernels: ModuleType) -> Callable[..., None]:
+    """The batch that :func:`rollingtop.integrate._threads.run_rows` calls on each chunk of
+    trajectories of ``kernels``' package: their rows and work arrays, then the plain stepper's
+    compiled loop over them (:func:`._template.stepper.run_rows`, without the GIL), each run to
+    its end or ``max_steps`` accepted steps, the stop flag read every ``STOP_POLL_STEPS``
+    steps; then the final states and statistics."""
+    run_rows = kernels.stepper.run_rows
+
+    def batch(
+        codes: IntArray,
+        P: FloatArray,
+        Y0: FloatArray,
+        t_eval: FloatArray,
+        rtol: float,
+        atol: float,
+        max_steps: int,
+        out: FloatArray,
+        final: FloatArray,
+        stats: FloatArray,
+        stop: IntArray,
+    ) -> None:
+        row = Rows.of(Y0)
+        w = work_arrays()
         call(
-            kernels.ensemble.batch,
+            run_rows,
             codes,
             P,
-            y,
-            np.array([0.0, 1e-3]),
-            1e-6,
-            1e-9,
-            10,
-            np.zeros((1, 2, N_STATE)),
-            np.zeros((1, N_STATE)),
-            np.zeros((1, 6)),
-            np.zeros(1, dtype=np.int64),
+            row.Y,
+            row.F,
+            row.CTRL,
+            row.COUNTS,
+            row.TRACK,
+            t_eval,
+            out,
+            rtol,
+            atol,
+            _EV_SPEC,
+            _NO_EVENTS,
+            _NO_EVENT_STATES,
+            max_steps,
+            STOP_POLL_STEPS,
+            w["K"],
+            w["ynew"],
+            w["ytmp"],
+            w["y_old"],
+            w["Fd"],
+            w["ws"],
+            _NO_CODES,
+            _NO_TARGETS,
+            _NO_WORK,
+            row.STATUS,
+            stop,
         )
-    _compiled.add(kernels.PACKAGE)
-    return time.perf_counter() - start
+        started = row.COUNTS[:, dop.NEXT_SAMPLE] > 0  # a row left by a stop keeps NaN
+        final[started] = row.Y[started]
+        stats[:, 0] = row.STATUS
+        stats[started, 1] = row.COUNTS[started, dop.STEPS]
+        stats[started, 2] = row.COUNTS[started, dop.REJECTED]
+        stats[started, 3] = row.COUNTS[started, dop.NFEV]
+        stats[started, 4] = row.TRACK[started, dop.MIN_NORMAL]
+        stats[started, 5] = row.TRACK[started, dop.MAX_RATIO]
+
+    return batch
+
+
+#: The arguments of the compiled loop that an ensemble does not use (read only): no event
+#: (the normal force's minima inside steps located, as a single run does), no integral held.
+_EV_SPEC = np.array([0, 0, 1], dtype=np.int64)
+_NO_EVENTS = np.empty(1)
+_NO_EVENT_STATES = np.empty((1, N_STATE))
+# those of :func:`rollingtop.integrate._held.held_arrays` for none: the single run's types
+_NO_CODES, _NO_TARGETS, _NO_WORK = np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8))
 
 
 def integrate_batch(
@@ -168,7 +218,7 @@ def integrate_batch(
         # a slice is a view the kernel writes into; fancy indexing is a copy, written back
         part = out[rows], final[rows], stats[rows]
         seconds, _ = run_rows(
-            kernels.ensemble.batch,
+            _batch(kernels),
             (codes[rows], params[rows], states[rows], t_eval, rtol, atol, max_steps, *part),
             (0, 1, 2, 7, 8, 9),
             idx.size,

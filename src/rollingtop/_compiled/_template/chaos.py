@@ -15,7 +15,7 @@ from rollingtop._compiled._kernel import new_workspace
 from rollingtop._compiled._section import NO_CROSSING, POLISH_DT, POLISH_ITERATIONS
 from rollingtop._compiled._template.dynamics import project, rhs
 from rollingtop._compiled._template.events import event_value
-from rollingtop._compiled._template.stepper import run, start
+from rollingtop._compiled._template.stepper import run_rows
 from rollingtop._compiled._template.tangent import run_indicators
 from rollingtop._jit import compiled, kernel
 from rollingtop._layout import N_STATE
@@ -77,16 +77,24 @@ def section_one(
     y_old = np.zeros(n)
     Fd = np.zeros((7, n))
     ws = new_workspace()
-    y = y0.copy()
-    f = np.zeros(n)
+    # one row of the stepper's loop (``run_rows``), started by its first call
+    codes = np.full(1, code, dtype=np.int64)
+    P = np.empty((1, p.shape[0]))
+    P[0] = p
+    Y = np.empty((1, n))
+    Y[0] = y0
+    F = np.zeros((1, n))
+    CTRL = np.zeros((1, dop.N_CTRL))
+    COUNTS = np.zeros((1, dop.N_COUNTS), dtype=np.int64)
+    TRACK = np.zeros((1, dop.N_TRACK))
+    STATUS = np.zeros(1, dtype=np.int64)
     t_eval = np.array([0.0, t_max])
-    out = np.zeros((2, n))
+    out = np.zeros((1, 2, n))
     ev_spec = np.array([W_TAU, 1, 1], dtype=np.int64)  # rising zeros; dips located
     no_codes = np.zeros(0, dtype=np.int64)  # no projection onto the integrals here
     no_targets = np.zeros(0)
     no_work = np.zeros((1, 8))
-    # the event code read from the array: the literal W_TAU would compile a second start
-    ctrl, counts, track = start(code, p, y, f, t_eval, rtol, atol, ev_spec[0], out, ytmp, ynew, ws)
+    counts, ctrl, track, f = COUNTS[0], CTRL[0], TRACK[0], F[0]
     wanted = ev_t.shape[0]
     last_events, last_steps = 0, 0
     while True:
@@ -94,19 +102,22 @@ def section_one(
             status = dop.INTERRUPTED
             break
         budget = min(STOP_POLL_STEPS // 10, max_steps - counts[dop.STEPS])
-        status = run(
-            code,
-            p,
-            y,
-            f,
-            ctrl,
-            counts,
-            track,
+        run_rows(
+            codes,
+            P,
+            Y,
+            F,
+            CTRL,
+            COUNTS,
+            TRACK,
             t_eval,
             out,
+            rtol,
+            atol,
             ev_spec,
             ev_t,
             ev_y,
+            counts[dop.STEPS] + budget,
             budget,
             K,
             ynew,
@@ -117,7 +128,10 @@ def section_one(
             no_codes,
             no_targets,
             no_work,
+            STATUS,
+            stop,
         )
+        status = STATUS[0]
         if counts[dop.N_EVENTS] >= wanted:
             status = dop.FINISHED
             break

@@ -4,9 +4,11 @@ The 7th-order continuous extension of the step (Hairer, Norsett & Wanner, *Solvi
 Sec. II.10; the coefficients of :mod:`rollingtop._compiled._dop853_tableau`), built from the
 step's own stages (:func:`prepare_dense`; evaluated by the shared
 :func:`rollingtop._compiled._dop853_dense.dense_eval`), and the bisections on it that locate the
-first loss of contact and the zeros of an event function. Called by the stepper
-(:func:`.stepper.run`); compiled without reference counting like it
-(:func:`rollingtop._jit.kernel`).
+first loss of contact and the zeros of an event function. Called by the stepper's loop
+(:func:`.stepper.run_rows`); compiled without reference counting like it
+(:func:`rollingtop._jit.kernel`). The dense output, the loss of contact and the dip search are
+called at one site of the loop and compiled into it (:func:`rollingtop._jit.spliced`): as
+functions of their own they were optimised and emitted twice, alone and in the loop.
 """
 
 from __future__ import annotations
@@ -24,16 +26,16 @@ from rollingtop._compiled._dop853 import (
     dip_predicted,
 )
 from rollingtop._compiled._dop853_dense import dense_eval
-from rollingtop._compiled._dop853_stages import stage
+from rollingtop._compiled._dop853_stages import dense_stage
 from rollingtop._compiled._dop853_tableau import D
 from rollingtop._compiled._kernel import reaction
 from rollingtop._compiled._template.dynamics import project, rhs
 from rollingtop._compiled._template.events import event_value
-from rollingtop._jit import kernel
+from rollingtop._jit import kernel, spliced
 from rollingtop._types import FloatArray, IntArray, Workspace
 
 
-@kernel
+@spliced
 def prepare_dense(
     code: int,
     p: FloatArray,
@@ -48,7 +50,7 @@ def prepare_dense(
     """Extra stages 14-16 and the coefficients ``Fd`` of the 7th-order interpolant on a step."""
     n = y.shape[0]
     for s in range(13, 16):
-        stage(K, s, y, h, ytmp)
+        dense_stage(K, s, y, h, ytmp)
         rhs(code, p, ytmp, K[s], ws)
     for i in range(n):
         dlt = ynew[i] - y[i]
@@ -62,7 +64,7 @@ def prepare_dense(
             Fd[3 + r, i] = h * acc
 
 
-@kernel
+@spliced
 def normal_root(
     code: int,
     p: FloatArray,
@@ -117,7 +119,7 @@ def normal_at(
     return reaction(nc, ytmp, ws)
 
 
-@kernel
+@spliced
 def dip_minimum(
     code: int,
     p: FloatArray,

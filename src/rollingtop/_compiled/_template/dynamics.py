@@ -71,10 +71,10 @@ def rhs_inline(code: int, p: FloatArray, y: FloatArray, dy: FloatArray, ws: Work
 
     After the call ``ws[4][:nrows]`` holds the multipliers ``lambda`` and ``ws[2]`` the force
     directions, from which :func:`rollingtop._compiled._kernel.reaction` forms the contact force.
-    The model's closed form where it has one, else the general path (:func:`rhs_rows`). Inlined
-    into the stepper's stage loop (:func:`.stepper.run`): a call there passes the workspace's five
-    arrays field by field, twelve times a step, which cost 15 % of the paper's model's time
-    against the C limit (``benchmarks/c_limit.py``); elsewhere :func:`rhs` calls it.
+    The model's closed form where it has one, else the general path (:func:`rhs_rows`). Inlined into
+    the stepper's stage loop (:func:`.stepper.run_rows`): a call there passes the workspace's five
+    arrays field by field, twelve times a step, which cost 15 % of the paper's model's time against
+    the C limit (``benchmarks/c_limit.py``); elsewhere :func:`rhs` calls it.
     """
     if CLOSED_ACCEL:
         # the kinematics first: a model whose last slot is a velocity of its own (shell-rotor)

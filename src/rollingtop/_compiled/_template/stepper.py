@@ -26,8 +26,12 @@ from rollingtop._compiled._dop853 import (
     ERROR_EXPONENT,
     EV_CODE,
     EV_DIPS,
+    EV_PREV_G,
+    EV_PREV_T,
     FINISHED,
+    G_OLD,
     H_ABS,
+    INTERRUPTED,
     LAST_NORMAL,
     MAX_FACTOR,
     MAX_RATIO,
@@ -45,6 +49,7 @@ from rollingtop._compiled._dop853 import (
     PROJECTION_FAILED,
     REJECTED,
     RTOL,
+    RUNNING,
     SAFETY,
     STEP_TOO_SMALL,
     STEPS,
@@ -54,11 +59,12 @@ from rollingtop._compiled._dop853 import (
     TOO_MANY_REJECTED,
     T,
     dip_predicted,
-    new_track,
+    reset_track,
     update_track,
 )
 from rollingtop._compiled._dop853_dense import dense_eval
-from rollingtop._compiled._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._dop853_stages import scaled_errors, step_stage
+from rollingtop._compiled._flags import read_flag
 from rollingtop._compiled._kernel import reaction
 from rollingtop._compiled._template._dispatch import INLINE_RHS
 from rollingtop._compiled._template.dense import (
@@ -70,18 +76,19 @@ from rollingtop._compiled._template.dense import (
 from rollingtop._compiled._template.dynamics import project, rhs, rhs_inline
 from rollingtop._compiled._template.events import event_value
 from rollingtop._compiled._template.invariants import WORK_ROWS, project_integrals
-from rollingtop._jit import compiled, loop
+from rollingtop._jit import loop, spliced
 from rollingtop._types import FloatArray, IntArray, Workspace
 
-#: Whether :func:`run` holds integrals by projection: ``True`` in the instance ``stepper_held``.
-#: numba prunes a branch on a global constant before typing: a plain run never compiles it.
+#: Whether :func:`run_rows` holds integrals by projection: ``True`` in the instance
+#: ``stepper_held``. numba prunes a branch on a global constant before typing: a plain run never
+#: compiles it.
 HELD = False
-#: Whether :func:`run` locates the zeros of an event function (:func:`.dense.step_events`):
+#: Whether :func:`run_rows` locates the zeros of an event function (:func:`.dense.step_events`):
 #: ``True`` in the instances ``stepper_events`` and ``stepper_held``; pruned like ``HELD``.
 EVENTS = False
 
 
-@compiled()
+@spliced
 def initial_step(
     code: int,
     p: FloatArray,
@@ -98,8 +105,8 @@ def initial_step(
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4), as in SciPy.
 
     NaN (and no evaluation of the right-hand side) when the scaled norm of ``y`` or ``f`` is not
-    finite: :func:`run` then stops at once, with ``NOT_FINITE`` for a non-finite ``y`` or ``f``,
-    else (the norm overflows: a tiny ``atol`` or huge values) with ``STEP_TOO_SMALL``.
+    finite: :func:`run_rows` then stops at once, with ``NOT_FINITE`` for a non-finite ``y`` or
+    ``f``, else (the norm overflows: a tiny ``atol`` or huge values) with ``STEP_TOO_SMALL``.
     """
     n = y.shape[0]
     d0 = 0.0
@@ -111,7 +118,7 @@ def initial_step(
     d0 = math.sqrt(d0 / n)
     d1 = math.sqrt(d1 / n)
     if not (math.isfinite(d0) and math.isfinite(d1)):
-        # a non-finite state or derivative, or one that overflows: no step; ``run`` reports it
+        # a non-finite state or derivative, or one that overflows: no step; ``run_rows`` reports it
         return math.nan
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, t_end - t0)
@@ -130,7 +137,7 @@ def initial_step(
     return min(100.0 * h0, h1, t_end - t0)
 
 
-@compiled()
+@spliced
 def start(
     code: int,
     p: FloatArray,
@@ -144,40 +151,54 @@ def start(
     ytmp: FloatArray,
     ynew: FloatArray,
     ws: Workspace,
-) -> tuple[FloatArray, IntArray, FloatArray]:
+    ctrl: FloatArray,
+    counts: IntArray,
+    track: FloatArray,
+) -> None:
     """Prepare a run from ``y`` at ``t_eval[0]``: derivative ``f``, reaction tracking, initial
-    step, the first sample ``out[0]``. Returns ``(ctrl, counts, track)`` for :func:`run`."""
+    step, the first sample ``out[0]``; fills ``ctrl``, ``counts`` and ``track`` (shapes
+    (``N_CTRL``,), (``N_COUNTS``,), (``N_TRACK``,)) for :func:`run_rows`."""
     nc = rhs(code, p, y, f, ws)
-    track = new_track()
+    reset_track(track)
     N0, T0 = reaction(nc, y, ws)
     update_track(track, t_eval[0], N0, T0)
     track[LAST_NORMAL] = N0
     t0, t_end = t_eval[0], t_eval[-1]
     h0 = initial_step(code, p, y, f, t_end, t0, rtol, atol, ytmp, ynew, ws)
-    ctrl = np.array([t0, h0, t_end, rtol, atol, event_value(ev_code, code, y), np.nan, np.nan])
-    counts = np.zeros(N_COUNTS, dtype=np.int64)
+    ctrl[T] = t0
+    ctrl[H_ABS] = h0
+    ctrl[T_END] = t_end
+    ctrl[RTOL] = rtol
+    ctrl[ATOL] = atol
+    ctrl[G_OLD] = event_value(ev_code, code, y)
+    ctrl[EV_PREV_T] = np.nan
+    ctrl[EV_PREV_G] = np.nan
+    for i in range(N_COUNTS):
+        counts[i] = 0
     counts[NFEV] = 2
     for i in range(y.shape[0]):
         out[0, i] = y[i]
     counts[NEXT_SAMPLE] = 1
-    return ctrl, counts, track
 
 
 @loop
-def run(
-    code: int,
-    p: FloatArray,
-    y: FloatArray,
-    f: FloatArray,
-    ctrl: FloatArray,
-    counts: IntArray,
-    track: FloatArray,
+def run_rows(
+    codes: IntArray,
+    P: FloatArray,
+    Y: FloatArray,
+    F: FloatArray,
+    CTRL: FloatArray,
+    COUNTS: IntArray,
+    TRACK: FloatArray,
     t_eval: FloatArray,
-    out: FloatArray,
+    OUT: FloatArray,
+    rtol0: float,
+    atol0: float,
     ev_spec: IntArray,
     ev_t: FloatArray,
     ev_y: FloatArray,
-    budget: int,
+    limit: int,
+    poll: int,
     K: FloatArray,
     ynew: FloatArray,
     ytmp: FloatArray,
@@ -187,223 +208,266 @@ def run(
     icodes: IntArray,
     targets: FloatArray,
     pw: FloatArray,
-) -> int:
-    """Advance ``(t, y)`` towards ``ctrl[T_END]``, writing dense samples at ``t_eval`` into ``out``.
+    STATUS: IntArray,
+    stop: IntArray,
+) -> None:
+    """Advance each row of ``Y`` towards its ``CTRL[k, T_END]``, writing dense samples at
+    ``t_eval`` into its ``OUT[k]``: the stepper's loop, the entry point of every run. Python
+    calls it, a single run with one row and a limit a chunk of steps ahead (it resumes the row:
+    splitting a run into calls does not change its steps), an ensemble with rows of trajectories
+    run to their end on threads (it releases the GIL, ``nogil``).
 
     Parameters
     ----------
-    code : int
-        Contact model code.
-    p : ndarray, shape (9,)
-        Body parameters.
-    y, f : ndarray, shape (18,)
-        Current state (projected) and its derivative; updated in place.
-    ctrl : ndarray, shape (8,)
+    codes : ndarray of int64, shape (rows,)
+        Each row's kernel code (one of this package's).
+    P : ndarray, shape (rows, 9)
+        Each row's body parameters.
+    Y, F : ndarray, shape (rows, 18)
+        Current states (projected) and their derivatives; updated in place.
+    CTRL : ndarray, shape (rows, 8)
         ``t, h_abs, t_end, rtol, atol, g_old`` (event function at ``t``), and the time and
         event function at the previous step end (``EV_PREV_T, EV_PREV_G``); updated.
-    counts : ndarray of int64, shape (8,)
+    COUNTS : ndarray of int64, shape (rows, 8)
         Next sample index, accepted steps, rejected steps, right-hand-side evaluations, events
         found (also those beyond the capacity of ``ev_t``), the projection's passes, the steps
         at which it left a nonlinear integral for the next ones, and the right-hand sides spent
-        on the normal force inside steps.
-    track : ndarray, shape (5,)
-        Reaction tracking (see :func:`new_track`), updated at every accepted step.
+        on the normal force inside steps. A row whose next sample index is 0 is started first
+        (:func:`start`, with ``rtol0``, ``atol0`` and the event code ``ev_spec[EV_CODE]``).
+    TRACK : ndarray, shape (rows, 8)
+        Reaction tracking (see :func:`reset_track`), updated at every accepted step.
     t_eval : ndarray, shape (n_samples,)
-        Increasing sample times within ``[t0, t_end]``.
-    out : ndarray, shape (n_samples, 18)
+        Increasing sample times within ``[t0, t_end]``, shared by the rows.
+    OUT : ndarray, shape (rows, n_samples, 18)
         Samples, each projected onto the constraints.
+    rtol0, atol0 : float
+        Tolerances of a row started here (a row resumed keeps those of its ``CTRL``).
     ev_spec : ndarray of int64, shape (3,)
         Event function code (:mod:`rollingtop._compiled._events`, 0 for none) and direction
         (+1: rising zeros only, -1: falling, 0: both), then 1 to locate the normal force's
         minima inside steps (0: the reactions are monitored at step ends, and a loss of contact
-        located where a step ends with a negative normal force). Located only by the copies compiled
-        with ``EVENTS = True`` (``stepper_events``, ``stepper_held``): the plain stepper
-        ignores a code, so callers pick the copy (the driver does).
+        located where a step ends with a negative normal force). Located only by the copies
+        compiled with ``EVENTS = True`` (``stepper_events``, ``stepper_held``): the plain
+        stepper ignores a code, so callers pick the copy (the driver does).
     ev_t, ev_y : ndarray, shapes (capacity,) and (capacity, 18)
-        Times and projected states of the located events.
-    budget : int
-        Maximum number of accepted steps in this call (the caller resumes for progress output).
+        Times and projected states of the located events (a single run's: one row).
+    limit : int
+        Accepted steps (in all, ``COUNTS[k, STEPS]``) at which a row stops with
+        ``BUDGET_EXHAUSTED``.
+    poll : int
+        Accepted steps between two reads of ``stop`` (int64, shape (1,)); it is read before
+        each row too. Set, the row stops ``INTERRUPTED`` (one not started is left as it was).
     K, ynew, ytmp, y_old, Fd, ws
-        Work arrays: stages ``(16, 18)``, three states, dense-output coefficients ``(7, 18)`` and
-        the kernel workspace.
+        Work arrays shared by the rows: stages ``(16, 18)``, three states, dense-output
+        coefficients ``(7, 18)`` and the kernel workspace.
     icodes, targets, pw : ndarrays, shapes (k,), (k,), ``invariants.WORK_SHAPE``
         The integrals held by projection after every accepted step (codes of
         :mod:`rollingtop._compiled._integrals`; ``k = 0``: none), their values, and the
-        projection's work array (:func:`.invariants.project_integrals`).
+        projection's work array (:func:`.invariants.project_integrals`; a single run's).
+    STATUS : ndarray of int64, shape (rows,)
+        Each row's status: ``FINISHED``, ``BUDGET_EXHAUSTED``, ``INTERRUPTED``,
+        ``STEP_TOO_SMALL``, ``NOT_FINITE``, ``TOO_MANY_REJECTED`` or ``PROJECTION_FAILED``.
+        Every call ends: each row after at most ``limit`` accepted steps, each preceded by
+        fewer than :data:`MAX_REJECTED_IN_A_ROW` rejected attempts.
 
-    Returns
-    -------
-    status : int
-        ``FINISHED``, ``BUDGET_EXHAUSTED``, ``STEP_TOO_SMALL``, ``NOT_FINITE``,
-        ``TOO_MANY_REJECTED`` or ``PROJECTION_FAILED``. Every call ends: after at most
-        ``budget`` accepted steps, each preceded by fewer than :data:`MAX_REJECTED_IN_A_ROW`
-        rejected attempts. Splitting a run into calls does not change its steps.
+    One function for both, written out here rather than a function per trajectory called from
+    the rows' loop: numba optimises and emits a callee's code again inside each caller, and
+    inlining it at numba's level types it again, each about a second of every model's first
+    compile.
     """
-    n = y.shape[0]
-    t = ctrl[T]
-    h_abs = ctrl[H_ABS]
-    t_end = ctrl[T_END]
-    rtol = ctrl[RTOL]
-    atol = ctrl[ATOL]
-    n_samples = t_eval.shape[0]
-    for i in range(n):
-        if not math.isfinite(y[i]) or not math.isfinite(f[i]):
-            return NOT_FINITE
-    taken = 0
-    while t < t_end:
-        if taken >= budget:
-            ctrl[T] = t
-            ctrl[H_ABS] = h_abs
-            return BUDGET_EXHAUSTED
-        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
-        rejected = 0  # attempts rejected in a row
-        while True:
-            if not h_abs >= min_step:  # also a NaN step
-                ctrl[T] = t
-                ctrl[H_ABS] = h_abs
-                return STEP_TOO_SMALL
-            t_new = t + h_abs
-            if t_new > t_end:
-                t_new = t_end
-            h = t_new - t
-            for i in range(n):
-                K[0, i] = f[i]
-            for s in range(1, 12):
-                stage(K, s, y, h, ytmp)
-                if INLINE_RHS:
-                    rhs_inline(code, p, ytmp, K[s], ws)
-                else:
-                    rhs(code, p, ytmp, K[s], ws)
-            # new point: the 13th stage's combination is the solution's (first same as last)
-            stage(K, int(np.int64(12)), y, h, ynew)  # not a literal: one compile of stage
-            nc_new = rhs(code, p, ynew, K[12], ws)
-            counts[NFEV] += 12
-            # 5th- and 3rd-order error estimates, in Fd[0] and Fd[1] (free until the dense output
-            # of an accepted step is prepared)
-            err5, err3 = Fd[0], Fd[1]
-            scaled_errors(K, y, ynew, rtol, atol, err5, err3)
-            e5 = 0.0
-            e3 = 0.0
-            for i in range(n):
-                e5 += err5[i] * err5[i]
-                e3 += err3[i] * err3[i]
-            if e5 == 0.0 and e3 == 0.0:
-                err = 0.0
-            else:
-                err = h * e5 / math.sqrt((e5 + 0.01 * e3) * n)
-            if not math.isfinite(err):
-                h_abs *= MIN_FACTOR
-                counts[REJECTED] += 1
-                rejected += 1
-                if rejected >= MAX_REJECTED_IN_A_ROW:
-                    ctrl[T] = t
-                    ctrl[H_ABS] = h_abs
-                    return NOT_FINITE
-            elif err < 1.0:
-                factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
-                if rejected > 0:
-                    factor = min(1.0, factor)
-                h_abs *= factor
-                break
-            else:
-                h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
-                counts[REJECTED] += 1
-                rejected += 1
-                if rejected >= MAX_REJECTED_IN_A_ROW:
-                    ctrl[T] = t
-                    ctrl[H_ABS] = h_abs
-                    return TOO_MANY_REJECTED
-        # Contact reaction at the new point, from the last stage (FSAL), before ws is reused.
-        N, T_force = reaction(nc_new, ynew, ws)
-        # Dense output over [t, t_new] for the samples that fall in it.
-        dense_ready = False
-        k = counts[NEXT_SAMPLE]
-        if k < n_samples and t_eval[k] <= t_new:
-            prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
-            counts[NFEV] += 3
-            dense_ready = True
-            while k < n_samples and t_eval[k] <= t_new:
-                dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
-                project(code, p, out[k], ws)
-                if HELD:  # the samples on the level too
-                    if project_integrals(code, p, out[k], icodes, targets, pw, ws) < 0:
-                        ctrl[T] = t_new
-                        return PROJECTION_FAILED
-                    if pw[WORK_ROWS - 1, 7] > 0.0:  # a sample off the level is counted too
-                        counts[PROJ_DEFERRED] += 1
-                k += 1
-            counts[NEXT_SAMPLE] = k
-        # Accept: project onto the constraints. The derivative at the new point is the last
-        # stage (first same as last): the projection moves the state by round-off-sized amounts
-        # (truncation error at most), far below what would change the next step.
-        for i in range(n):
-            y_old[i] = y[i]
-            y[i] = ynew[i]
-            f[i] = K[12, i]
-        project(code, p, y, ws)
-        if HELD:
-            passes = project_integrals(code, p, y, icodes, targets, pw, ws)
-            if passes < 0:
-                ctrl[T] = t_new
-                return PROJECTION_FAILED
-            counts[PROJ_PASSES] += passes
-            if pw[WORK_ROWS - 1, 7] > 0.0:
-                counts[PROJ_DEFERRED] += 1
+    n = Y.shape[1]
+    for row in range(Y.shape[0]):
+        if read_flag(stop) != 0:
+            STATUS[row] = INTERRUPTED
+            continue
+        code, p, y, f, out = codes[row], P[row], Y[row], F[row], OUT[row]
+        ctrl, counts, track = CTRL[row], COUNTS[row], TRACK[row]
+        if counts[NEXT_SAMPLE] == 0:
+            start(code, p, y, f, t_eval, rtol0, atol0, ev_spec[EV_CODE], out, ytmp, ynew, ws,
+                  ctrl, counts, track)  # fmt: skip
+        t = ctrl[T]
+        h_abs = ctrl[H_ABS]
+        t_end = ctrl[T_END]
+        rtol = ctrl[RTOL]
+        atol = ctrl[ATOL]
+        n_samples = t_eval.shape[0]
+        status = RUNNING
+        end_t = t  # where ctrl[T] is left, with h_abs unless a step failed after it was accepted
+        keep_h = True
         for i in range(n):
             if not math.isfinite(y[i]) or not math.isfinite(f[i]):
-                ctrl[T] = t_new
-                return NOT_FINITE
-        N_old = track[LAST_NORMAL]
-        if N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and N_old >= 0.0:
-            # first loss of contact: locate N = 0 inside the step on the dense output
-            if not dense_ready:
-                prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
-                counts[NFEV] += 3
-                dense_ready = True
-            track[T_CONTACT_LOST] = normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
-            counts[NFEV] += 60
-        elif ev_spec[EV_DIPS] != 0 and dip_predicted(
-            track[PREV_T], track[PREV_NORMAL], t, N_old, t_new, N
-        ):
-            # a minimum of the normal force inside the step: found on the dense output, with
-            # its loss of contact if it dips below zero between two positive ends
-            if not dense_ready:
-                prepare_dense(code, p, K, y_old, ynew, h, ytmp, Fd, ws)
-                counts[MONITOR_EVALS] += 3
-                dense_ready = True
-            found = K[14]  # stages 14-16 are free once the dense output is built
-            counts[MONITOR_EVALS] += dip_minimum(code, p, Fd, y_old, t, h, ytmp, K[13], ws, found)
-            if not math.isnan(found[2]) and math.isnan(track[T_CONTACT_LOST]):
-                track[T_CONTACT_LOST] = found[2]
-            update_track(track, found[0], found[1], 0.0)
-            if found[3] > track[MAX_RATIO]:
-                track[MAX_RATIO], track[T_MAX_RATIO] = found[3], found[4]
-        track[PREV_T], track[PREV_NORMAL] = t, N_old
-        track[LAST_NORMAL] = N
-        update_track(track, t_new, N, T_force)
-        if EVENTS and ev_spec[EV_CODE] != 0:
-            dense_ready = step_events(
-                code,
-                p,
-                K,
-                Fd,
-                y_old,
-                ynew,
-                t,
-                h,
-                y,
-                ctrl,
-                counts,
-                ev_spec,
-                ev_t,
-                ev_y,
-                ytmp,
-                ws,
-                dense_ready,
+                status = NOT_FINITE
+        taken = 0  # accepted steps since the stop flag was read
+        while status == RUNNING and t < t_end:
+            if counts[STEPS] >= limit:
+                status = BUDGET_EXHAUSTED
+                break
+            if taken >= poll:
+                if read_flag(stop) != 0:
+                    status = INTERRUPTED
+                    break
+                taken = 0
+            min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+            rejected = 0  # attempts rejected in a row
+            while True:
+                if not h_abs >= min_step:  # also a NaN step
+                    status = STEP_TOO_SMALL
+                    break
+                t_new = t + h_abs
+                if t_new > t_end:
+                    t_new = t_end
+                h = t_new - t
+                for i in range(n):
+                    K[0, i] = f[i]
+                for s in range(1, 12):
+                    step_stage(K, s, y, h, ytmp)
+                    if INLINE_RHS:
+                        rhs_inline(code, p, ytmp, K[s], ws)
+                    else:
+                        rhs(code, p, ytmp, K[s], ws)
+                # new point: the 13th stage's combination is the solution's (first same as last)
+                step_stage(K, int(np.int64(12)), y, h, ynew)  # not a literal: one compile
+                nc_new = rhs(code, p, ynew, K[12], ws)
+                counts[NFEV] += 12
+                # 5th- and 3rd-order error estimates, in Fd[0] and Fd[1] (free until the dense
+                # output of an accepted step is prepared)
+                err5, err3 = Fd[0], Fd[1]
+                scaled_errors(K, y, ynew, rtol, atol, err5, err3)
+                e5 = 0.0
+                e3 = 0.0
+                for i in range(n):
+                    e5 += err5[i] * err5[i]
+                    e3 += err3[i] * err3[i]
+                if e5 == 0.0 and e3 == 0.0:
+                    err = 0.0
+                else:
+                    err = h * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+                if not math.isfinite(err):
+                    h_abs *= MIN_FACTOR
+                    counts[REJECTED] += 1
+                    rejected += 1
+                    if rejected >= MAX_REJECTED_IN_A_ROW:
+                        status = NOT_FINITE
+                        break
+                elif err < 1.0:
+                    factor = (
+                        MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
+                    )
+                    if rejected > 0:
+                        factor = min(1.0, factor)
+                    h_abs *= factor
+                    break
+                else:
+                    h_abs *= max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
+                    counts[REJECTED] += 1
+                    rejected += 1
+                    if rejected >= MAX_REJECTED_IN_A_ROW:
+                        status = TOO_MANY_REJECTED
+                        break
+            if status != RUNNING:
+                break
+            # Contact reaction at the new point, from the last stage (FSAL), before ws is reused.
+            N, T_force = reaction(nc_new, ynew, ws)
+            # What the step needs of the dense output over [t, t_new]: the samples that fall in
+            # it, the first loss of contact located in it, or a minimum of the normal force
+            # inside it (found on it, with its loss of contact if it dips below zero between two
+            # positive ends). Built at one call site: compiled once into this function.
+            N_old = track[LAST_NORMAL]
+            k = counts[NEXT_SAMPLE]
+            sampled = k < n_samples and t_eval[k] <= t_new
+            lost = N < 0.0 and math.isnan(track[T_CONTACT_LOST]) and N_old >= 0.0
+            dip = (
+                not lost
+                and ev_spec[EV_DIPS] != 0
+                and dip_predicted(track[PREV_T], track[PREV_NORMAL], t, N_old, t_new, N)
             )
-        t = t_new
-        counts[STEPS] += 1
-        taken += 1
-    ctrl[T] = t
-    ctrl[H_ABS] = h_abs
-    return FINISHED
+            dense_ready = sampled or lost or dip
+            if dense_ready:
+                prepare_dense(code, p, K, y, ynew, h, ytmp, Fd, ws)
+                if sampled or lost:
+                    counts[NFEV] += 3
+                else:  # for the dip search alone
+                    counts[MONITOR_EVALS] += 3
+            if sampled:
+                while k < n_samples and t_eval[k] <= t_new:
+                    dense_eval(Fd, y, (t_eval[k] - t) / h, out[k])
+                    project(code, p, out[k], ws)
+                    if HELD:  # the samples on the level too
+                        if project_integrals(code, p, out[k], icodes, targets, pw, ws) < 0:
+                            status = PROJECTION_FAILED
+                            break
+                        if pw[WORK_ROWS - 1, 7] > 0.0:  # a sample off the level is counted too
+                            counts[PROJ_DEFERRED] += 1
+                    k += 1
+                if status != RUNNING:
+                    end_t, keep_h = t_new, False
+                    break
+                counts[NEXT_SAMPLE] = k
+            # Accept: project onto the constraints. The derivative at the new point is the last
+            # stage (first same as last): the projection moves the state by round-off-sized amounts
+            # (truncation error at most), far below what would change the next step.
+            for i in range(n):
+                y_old[i] = y[i]
+                y[i] = ynew[i]
+                f[i] = K[12, i]
+            project(code, p, y, ws)
+            if HELD:
+                passes = project_integrals(code, p, y, icodes, targets, pw, ws)
+                if passes < 0:
+                    status = PROJECTION_FAILED
+                    end_t, keep_h = t_new, False
+                    break
+                counts[PROJ_PASSES] += passes
+                if pw[WORK_ROWS - 1, 7] > 0.0:
+                    counts[PROJ_DEFERRED] += 1
+            for i in range(n):
+                if not math.isfinite(y[i]) or not math.isfinite(f[i]):
+                    status = NOT_FINITE
+            if status != RUNNING:
+                end_t, keep_h = t_new, False
+                break
+            if lost:
+                # first loss of contact: locate N = 0 inside the step on the dense output
+                track[T_CONTACT_LOST] = normal_root(code, p, Fd, y_old, t, h, ytmp, K[13], ws)
+                counts[NFEV] += 60
+            elif dip:
+                found = K[14]  # stages 14-16 are free once the dense output is built
+                counts[MONITOR_EVALS] += dip_minimum(
+                    code, p, Fd, y_old, t, h, ytmp, K[13], ws, found
+                )
+                if not math.isnan(found[2]) and math.isnan(track[T_CONTACT_LOST]):
+                    track[T_CONTACT_LOST] = found[2]
+                update_track(track, found[0], found[1], 0.0)
+                if found[3] > track[MAX_RATIO]:
+                    track[MAX_RATIO], track[T_MAX_RATIO] = found[3], found[4]
+            track[PREV_T], track[PREV_NORMAL] = t, N_old
+            track[LAST_NORMAL] = N
+            update_track(track, t_new, N, T_force)
+            if EVENTS and ev_spec[EV_CODE] != 0:
+                dense_ready = step_events(
+                    code,
+                    p,
+                    K,
+                    Fd,
+                    y_old,
+                    ynew,
+                    t,
+                    h,
+                    y,
+                    ctrl,
+                    counts,
+                    ev_spec,
+                    ev_t,
+                    ev_y,
+                    ytmp,
+                    ws,
+                    dense_ready,
+                )
+            t = t_new
+            counts[STEPS] += 1
+            taken += 1
+        if keep_h:
+            end_t = t
+            ctrl[H_ABS] = h_abs
+        ctrl[T] = end_t
+        STATUS[row] = FINISHED if status == RUNNING else status

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from rollingtop._compiled import _dop853 as dop
-from rollingtop._compiled._dop853_stages import scaled_errors, stage
+from rollingtop._compiled._dop853_stages import scaled_errors, step_stage
 from rollingtop._compiled._kernel import new_workspace
 from rollingtop._compiled._tangent import (
     ATOL,
@@ -187,9 +187,9 @@ def advance(
             for i in range(N_AUG):
                 K[0, i] = fz[i]
             for s in range(1, 12):
-                stage(K, s, z, h, ztmp)
+                step_stage(K, s, z, h, ztmp)
                 aug_rhs(code, p, ztmp, K[s], y1, f1, f2, ws)
-            stage(K, int(np.int64(12)), z, h, znew)  # not a literal: one compile of stage
+            step_stage(K, int(np.int64(12)), z, h, znew)  # not a literal: one compile
             aug_rhs(code, p, znew, K[12], y1, f1, f2, ws)
             counts[NFEV] += 36
             err5, err3 = K[13], K[14]  # free: no dense output here
