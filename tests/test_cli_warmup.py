@@ -75,5 +75,16 @@ def test_warmup_runs_packages_in_separate_processes():
     assert list(seconds) == ["meridian", "rough"] and sorted(told) == ["meridian", "rough"]
     assert all(set(g) == set(_warmup.GROUPS) for g in seconds.values())
     packages = [g.package for g in _warmup._packages(["meridian", "rough"])]
-    # the longest first (by the model's module), a model's variants right after its own
-    assert packages == ["meridian", "meridian_variants", "rough"]
+    assert sorted(packages) == ["meridian", "meridian_variants", "rough"]
+    # the longest first, by the seconds measured for each
+    measured = [_warmup.PACKAGE_SECONDS[p] for p in packages]
+    assert measured == sorted(measured, reverse=True)
+
+
+def test_a_package_not_measured_is_handed_out_first(monkeypatch):
+    """A package without measured seconds (a new model's) comes before every measured one: the
+    longest first is the safe guess."""
+    measured = {k: v for k, v in _warmup.PACKAGE_SECONDS.items() if k != "rough"}
+    monkeypatch.setattr(_warmup, "PACKAGE_SECONDS", measured)
+    packages = [g.package for g in _warmup._packages(["meridian", "rough"])]
+    assert packages[0] == "rough" and sorted(packages[1:]) == ["meridian", "meridian_variants"]

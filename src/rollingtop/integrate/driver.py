@@ -21,21 +21,14 @@ from rollingtop._compiled._kernel import reaction, workspace
 from rollingtop._errors import IntegrationError, NotFiniteAtStart
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
-from rollingtop._types import FloatArray, IntArray, Workspace
+from rollingtop._types import FloatArray, IntArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
 from rollingtop.integrate import _compile_helper
 from rollingtop.integrate._held import held_arrays
 from rollingtop.integrate._pace import check_pace
+from rollingtop.integrate._rows import Rows, work_arrays
 
-__all__ = [
-    "IntegrationResult",
-    "Rows",
-    "StepReactions",
-    "compile_code",
-    "compile_kernels",
-    "integrate",
-    "work_arrays",
-]
+__all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "compile_kernels"]
 
 #: Accepted steps per call of the compiled loop (tens of milliseconds). Between calls the driver
 #: is back in Python: the progress callback runs and so do signal handlers (Ctrl-C, SIGTERM;
@@ -105,57 +98,6 @@ class IntegrationResult:
     projection_passes: int = 0
     projection_deferred: int = 0
     monitor_evals: int = 0
-
-
-class _Work(TypedDict):
-    """Work arrays of one run of the compiled loop (:func:`._template.stepper.run_rows`)."""
-
-    K: FloatArray
-    ynew: FloatArray
-    ytmp: FloatArray
-    y_old: FloatArray
-    Fd: FloatArray
-    ws: Workspace
-
-
-def work_arrays() -> _Work:
-    """The work arrays of the stepper's loop (:func:`._template.stepper.run_rows`), shared by
-    the rows of one call: the stages, three states, the dense output's coefficients and the
-    kernels' workspace."""
-    return _Work(
-        K=np.zeros((16, N_STATE)),
-        ynew=np.zeros(N_STATE),
-        ytmp=np.zeros(N_STATE),
-        y_old=np.zeros(N_STATE),
-        Fd=np.zeros((7, N_STATE)),
-        ws=workspace(),
-    )
-
-
-class Rows(NamedTuple):
-    """The per-row arrays of the stepper's loop (:func:`._template.stepper.run_rows`) for ``n``
-    trajectories: states (advanced in place), derivatives, control, counters, reaction
-    tracking and status; a row whose counters are 0 is started by the loop."""
-
-    Y: FloatArray
-    F: FloatArray
-    CTRL: FloatArray
-    COUNTS: IntArray
-    TRACK: FloatArray
-    STATUS: IntArray
-
-    @classmethod
-    def of(cls, states: FloatArray) -> Rows:
-        """Rows starting from ``states`` (shape (n, 18), copied)."""
-        n = states.shape[0]
-        return cls(
-            np.array(states, dtype=float, order="C"),
-            np.zeros((n, N_STATE)),
-            np.zeros((n, dop.N_CTRL)),
-            np.zeros((n, dop.N_COUNTS), dtype=np.int64),
-            np.zeros((n, dop.N_TRACK)),
-            np.zeros(n, dtype=np.int64),
-        )
 
 
 def compile_kernels(model: str | ContactModel = DEFAULT_MODEL, *, variants: bool = False) -> float:

@@ -29,8 +29,9 @@ from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
+from rollingtop.integrate._rows import Rows, work_arrays
 from rollingtop.integrate._threads import run_rows
-from rollingtop.integrate.driver import Rows, compile_code, work_arrays
+from rollingtop.integrate.driver import compile_code
 
 __all__ = ["integrate_batch", "compile_ensemble", "compile_ensemble_code"]
 
@@ -65,9 +66,9 @@ def _compile_package(kernels: ModuleType) -> float:
 def _batch(kernels: ModuleType) -> Callable[..., None]:
     """The batch that :func:`rollingtop.integrate._threads.run_rows` calls on each chunk of
     trajectories of ``kernels``' package: their rows and work arrays, then the plain stepper's
-    compiled loop over them (:func:`._template.stepper.run_rows`, without the GIL), each run to
-    its end or ``max_steps`` accepted steps, the stop flag read every ``STOP_POLL_STEPS``
-    steps; then the final states and statistics."""
+    compiled loop over them (``stepper.run_rows``, without the GIL), each run to its end or
+    ``max_steps`` accepted steps, the stop flag read every ``STOP_POLL_STEPS`` steps; then the final
+    states and statistics."""
     run_rows = kernels.stepper.run_rows
 
     def batch(

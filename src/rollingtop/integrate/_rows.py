@@ -1,0 +1,68 @@
+"""The arrays of the stepper's loop (``run_rows``):
+the work arrays one call shares between its rows, and each row's own. Made here, with NumPy, by
+the single run's driver and by the ensemble's chunks alike, so that both pass the loop the same
+types (one compile)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple, TypedDict
+
+import numpy as np
+
+from rollingtop._compiled import _dop853 as dop
+from rollingtop._compiled._kernel import workspace
+from rollingtop._layout import N_STATE
+from rollingtop._types import FloatArray, IntArray, Workspace
+
+__all__ = ["Rows", "work_arrays"]
+
+
+class Work(TypedDict):
+    """Work arrays of one run of the compiled loop (``run_rows``)."""
+
+    K: FloatArray
+    ynew: FloatArray
+    ytmp: FloatArray
+    y_old: FloatArray
+    Fd: FloatArray
+    ws: Workspace
+
+
+def work_arrays() -> Work:
+    """The work arrays of the stepper's loop (``run_rows``), shared by
+    the rows of one call: the stages, three states, the dense output's coefficients and the
+    kernels' workspace."""
+    return Work(
+        K=np.zeros((16, N_STATE)),
+        ynew=np.zeros(N_STATE),
+        ytmp=np.zeros(N_STATE),
+        y_old=np.zeros(N_STATE),
+        Fd=np.zeros((7, N_STATE)),
+        ws=workspace(),
+    )
+
+
+class Rows(NamedTuple):
+    """The per-row arrays of the stepper's loop (``run_rows``) for ``n``
+    trajectories: states (advanced in place), derivatives, control, counters, reaction
+    tracking and status; a row whose counters are 0 is started by the loop."""
+
+    Y: FloatArray
+    F: FloatArray
+    CTRL: FloatArray
+    COUNTS: IntArray
+    TRACK: FloatArray
+    STATUS: IntArray
+
+    @classmethod
+    def of(cls, states: FloatArray) -> Rows:
+        """Rows starting from ``states`` (shape (n, 18), copied)."""
+        n = states.shape[0]
+        return cls(
+            np.array(states, dtype=float, order="C"),
+            np.zeros((n, N_STATE)),
+            np.zeros((n, dop.N_CTRL)),
+            np.zeros((n, dop.N_COUNTS), dtype=np.int64),
+            np.zeros((n, dop.N_TRACK)),
+            np.zeros(n, dtype=np.int64),
+        )
