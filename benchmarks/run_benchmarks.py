@@ -205,7 +205,7 @@ ROUGH_COMMAND = ["-m", "rollingtop.cli", "simulate", "examples/rough.toml", "--t
                  "--json"]  # fmt: skip
 WARMUP_COMMAND = ["-m", "rollingtop.cli", "warmup", "--json"]
 #: Modules that ``import rollingtop`` must not import (they load with the commands that use them).
-HEAVY_MODULES = ("matplotlib", "xarray", "dask", "distributed", "sympy")
+HEAVY_MODULES = ("matplotlib", "xarray", "dask", "distributed", "sympy", "numba")
 
 
 def _wall(argv, env) -> float:

@@ -164,3 +164,16 @@ def test_compiling_one_model_compiles_no_other(tmp_path):
         "rollingtop.contact._rows",
         "rollingtop.contact._closed",
     }
+
+
+def test_importing_the_package_does_not_import_numba():
+    """``import rollingtop`` (every public name, the ensemble's and the command line's modules
+    among them) leaves numba unloaded: a command that runs no compiled code never pays for it
+    (the ensemble's driver once imported the stop flag's module, which imports numba)."""
+    code = (
+        "import sys, rollingtop, rollingtop.cli, rollingtop.integrate.ensemble\n"
+        "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] == 'numba')))\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", "import json\n" + code], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120, check=True)  # fmt: skip
+    assert json.loads(proc.stdout) == []

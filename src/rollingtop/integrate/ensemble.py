@@ -24,7 +24,6 @@ from numpy.typing import ArrayLike
 
 from rollingtop._compiled import _dop853 as dop
 from rollingtop._compiled import by_package, for_code, packages_of
-from rollingtop._compiled._flags import STOP_POLL_STEPS
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE
 from rollingtop._types import FloatArray, IntArray
@@ -69,6 +68,8 @@ def _batch(kernels: ModuleType) -> Callable[..., None]:
     compiled loop over them (``stepper.run_rows``, without the GIL), each run to its end or
     ``max_steps`` accepted steps, the stop flag read every ``STOP_POLL_STEPS`` steps; then the final
     states and statistics."""
+    from rollingtop._compiled._flags import STOP_POLL_STEPS  # here: _flags imports numba
+
     run_rows = kernels.stepper.run_rows
 
     def batch(
