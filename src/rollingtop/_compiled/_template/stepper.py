@@ -170,7 +170,9 @@ def start(
     ctrl[T_END] = t_end
     ctrl[RTOL] = rtol
     ctrl[ATOL] = atol
-    ctrl[G_OLD] = event_value(ev_code, code, y)
+    # the event function where events are located (pruned from the plain copy, which locates
+    # none: 1.0, the value of no event, without compiling the event functions into it)
+    ctrl[G_OLD] = event_value(ev_code, code, y) if EVENTS else 1.0
     ctrl[EV_PREV_T] = np.nan
     ctrl[EV_PREV_G] = np.nan
     for i in range(N_COUNTS):
