@@ -5,7 +5,7 @@ types (one compile)."""
 
 from __future__ import annotations
 
-from typing import NamedTuple, TypedDict
+from typing import Any, NamedTuple, TypedDict
 
 import numpy as np
 
@@ -14,7 +14,7 @@ from rollingtop._compiled._kernel import workspace
 from rollingtop._layout import N_STATE
 from rollingtop._types import FloatArray, IntArray, Workspace
 
-__all__ = ["Rows", "work_arrays"]
+__all__ = ["Rows", "loop_args", "work_arrays"]
 
 
 class Work(TypedDict):
@@ -66,3 +66,45 @@ class Rows(NamedTuple):
             np.zeros((n, dop.N_TRACK)),
             np.zeros(n, dtype=np.int64),
         )
+
+
+def loop_args(
+    codes: IntArray,
+    P: FloatArray,
+    row: Rows,
+    t_eval: FloatArray,
+    out: FloatArray,
+    tolerances: tuple[float, float],
+    events: tuple[IntArray, FloatArray, FloatArray],
+    steps: tuple[int, int],
+    w: Work,
+    held: tuple[IntArray, FloatArray, FloatArray],
+    stop: IntArray,
+) -> tuple[Any, ...]:
+    """The arguments of the stepper's loop (``run_rows``), in its order: the rows' codes,
+    parameters and arrays, the sample times and samples ``out``, ``(rtol, atol)``, the events
+    ``(ev_spec, ev_t, ev_y)``, ``(limit, poll)`` in accepted steps, the work arrays, the
+    integrals held ``(icodes, targets, pw)`` and the stop flag."""
+    return (
+        codes,
+        P,
+        row.Y,
+        row.F,
+        row.CTRL,
+        row.COUNTS,
+        row.TRACK,
+        t_eval,
+        out,
+        *tolerances,
+        *events,
+        *steps,
+        w["K"],
+        w["ynew"],
+        w["ytmp"],
+        w["y_old"],
+        w["Fd"],
+        w["ws"],
+        *held,
+        row.STATUS,
+        stop,
+    )

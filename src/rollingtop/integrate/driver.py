@@ -26,7 +26,7 @@ from rollingtop.contact import DEFAULT_MODEL, ContactModel
 from rollingtop.integrate import _compile_helper
 from rollingtop.integrate._held import held_arrays
 from rollingtop.integrate._pace import check_pace
-from rollingtop.integrate._rows import Rows, work_arrays
+from rollingtop.integrate._rows import Rows, loop_args, work_arrays
 
 __all__ = ["IntegrationResult", "StepReactions", "integrate", "compile_code", "compile_kernels"]
 
@@ -308,35 +308,9 @@ def _stepper_calls(
     stop = np.zeros(1, dtype=np.int64)  # the driver stops between calls instead
 
     def run_args(budget: int) -> tuple[Any, ...]:
-        return (
-            codes,
-            P,
-            row.Y,
-            row.F,
-            row.CTRL,
-            row.COUNTS,
-            row.TRACK,
-            t_eval,
-            out,
-            rtol,
-            atol,
-            ev_spec,
-            ev_t,
-            ev_y,
-            int(row.COUNTS[0, dop.STEPS]) + budget,
-            budget,
-            w["K"],
-            w["ynew"],
-            w["ytmp"],
-            w["y_old"],
-            w["Fd"],
-            w["ws"],
-            icodes,
-            targets,
-            pw,
-            row.STATUS,
-            stop,
-        )
+        limit = int(row.COUNTS[0, dop.STEPS]) + budget
+        return loop_args(codes, P, row, t_eval, out, (rtol, atol), (ev_spec, ev_t, ev_y),
+                         (limit, budget), w, (icodes, targets, pw), stop)  # fmt: skip
 
     return stepper, run_args, (row, out, ev_t, ev_y)
 

@@ -28,7 +28,7 @@ from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
-from rollingtop.integrate._rows import Rows, work_arrays
+from rollingtop.integrate._rows import Rows, loop_args, work_arrays
 from rollingtop.integrate._threads import run_rows
 from rollingtop.integrate.driver import compile_code
 
@@ -87,36 +87,10 @@ def _batch(kernels: ModuleType) -> Callable[..., None]:
     ) -> None:
         row = Rows.of(Y0)
         w = work_arrays()
-        call(
-            run_rows,
-            codes,
-            P,
-            row.Y,
-            row.F,
-            row.CTRL,
-            row.COUNTS,
-            row.TRACK,
-            t_eval,
-            out,
-            rtol,
-            atol,
-            _EV_SPEC,
-            _NO_EVENTS,
-            _NO_EVENT_STATES,
-            max_steps,
-            STOP_POLL_STEPS,
-            w["K"],
-            w["ynew"],
-            w["ytmp"],
-            w["y_old"],
-            w["Fd"],
-            w["ws"],
-            _NO_CODES,
-            _NO_TARGETS,
-            _NO_WORK,
-            row.STATUS,
-            stop,
-        )
+        events = (_EV_SPEC, _NO_EVENTS, _NO_EVENT_STATES)
+        held = (_NO_CODES, _NO_TARGETS, _NO_WORK)
+        call(run_rows, *loop_args(codes, P, row, t_eval, out, (rtol, atol), events,
+                                  (max_steps, STOP_POLL_STEPS), w, held, stop))  # fmt: skip
         started = row.COUNTS[:, dop.NEXT_SAMPLE] > 0  # a row left by a stop keeps NaN
         final[started] = row.Y[started]
         stats[:, 0] = row.STATUS
