@@ -28,6 +28,7 @@ from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE
 from rollingtop._types import FloatArray, IntArray
 from rollingtop.contact import DEFAULT_MODEL, ContactModel
+from rollingtop.integrate._held import none_held
 from rollingtop.integrate._rows import Rows, loop_args, work_arrays
 from rollingtop.integrate._threads import run_rows
 from rollingtop.integrate.driver import compile_code
@@ -88,9 +89,8 @@ def _batch(kernels: ModuleType) -> Callable[..., None]:
         row = Rows.of(Y0)
         w = work_arrays()
         events = (_EV_SPEC, _NO_EVENTS, _NO_EVENT_STATES)
-        held = (_NO_CODES, _NO_TARGETS, _NO_WORK)
         call(run_rows, *loop_args(codes, P, row, t_eval, out, (rtol, atol), events,
-                                  (max_steps, STOP_POLL_STEPS), w, held, stop))  # fmt: skip
+                                  (max_steps, STOP_POLL_STEPS), w, _NO_HELD, stop))  # fmt: skip
         started = row.COUNTS[:, dop.NEXT_SAMPLE] > 0  # a row left by a stop keeps NaN
         final[started] = row.Y[started]
         stats[:, 0] = row.STATUS
@@ -108,8 +108,7 @@ def _batch(kernels: ModuleType) -> Callable[..., None]:
 _EV_SPEC = np.array([0, 0, 1], dtype=np.int64)
 _NO_EVENTS = np.empty(1)
 _NO_EVENT_STATES = np.empty((1, N_STATE))
-# those of :func:`rollingtop.integrate._held.held_arrays` for none: the single run's types
-_NO_CODES, _NO_TARGETS, _NO_WORK = np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros((1, 8))
+_NO_HELD = none_held()  # the single run's types
 
 
 def integrate_batch(
