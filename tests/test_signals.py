@@ -1,4 +1,5 @@
-"""SIGINT and SIGTERM stop a long run promptly when the output is not a terminal.
+"""SIGINT and SIGTERM stop a long run promptly when the output is not a terminal, and a
+signal whose exception C code dropped still stops the command.
 
 The command line runs in a subprocess with stdin from ``/dev/null`` and pipes for stdout and
 stderr (no progress bar, so no progress callback): the compiled loops must return to Python on
@@ -7,24 +8,31 @@ the integration is under way: once the process has used :data:`INTEGRATING_CPU_S
 time than a whole short run of the same command takes (start-up, kernel loading, output).
 """
 
+import ctypes
+import ctypes.util
 import os
 import resource
 import signal
 import subprocess
 import sys
 import time
+import types
 from pathlib import Path
 
 import pytest
 
+from rollingtop import _jit
+from rollingtop._errors import Interrupted
+from rollingtop._signals import handle_signals
 from rollingtop.integrate.driver import compile_kernels
 from rollingtop.integrate.ensemble import compile_ensemble
 
 from .conftest import EXAMPLES
 
-pytestmark = [
+#: The tests of real processes, run until signalled (4 to 6 s each).
+PROCESSES = [
     pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc"),
-    pytest.mark.slow,  # real processes run until signalled: 4 to 6 s each
+    pytest.mark.slow,
 ]
 
 #: Seconds from the signal to the exit of the process (the compiled loops return to Python
@@ -75,6 +83,8 @@ def startup_cpu(tmp_path_factory):
     return cost
 
 
+@PROCESSES[0]
+@PROCESSES[1]
 @pytest.mark.parametrize(("signum", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 @pytest.mark.parametrize("command", list(COMMANDS))
 def test_signal_stops_a_long_run(tmp_path, startup_cpu, command, signum, status):
@@ -98,3 +108,65 @@ def test_signal_stops_a_long_run(tmp_path, startup_cpu, command, signum, status)
     assert err.splitlines() == [f"rollingtop: error: interrupted by {name}; no output was written"]
     assert stopped_after < STOP_WITHIN_S
     assert list(tmp_path.iterdir()) == []  # neither out.nc nor a temporary file
+
+
+LIBC = ctypes.CDLL(ctypes.util.find_library("c"))
+COMPARE = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int))
+
+
+def sort_signalled(signum):
+    """libc's qsort of 64 ints whose comparison (a Python callback, as LLVM calls numba back
+    when it has emitted machine code) sends ``signum`` to this process once: the handler's
+    exception is raised inside the callback, where ctypes prints and drops it; the sort goes
+    on. The sorted values and how often the callback ran."""
+    values = (ctypes.c_int * 64)(*range(64, 0, -1))
+    calls = []
+
+    def compare(a, b):
+        calls.append(1)
+        if len(calls) == 1:
+            os.kill(os.getpid(), signum)  # its handler runs here and raises
+        return a[0] - b[0]
+
+    LIBC.qsort(values, len(values), ctypes.sizeof(ctypes.c_int), COMPARE(compare))
+    return list(values), len(calls)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_dropped_by_c_code_stops_at_the_compiled_call(signum, monkeypatch):
+    """The C code finishes (the signal's exception dropped, kept from ``sys.unraisablehook``:
+    no traceback on stderr), and the call that ran it raises the signal: the block leaves as
+    Interrupted of that signal; other unraisable exceptions still reach the hook."""
+    dropped = []
+    monkeypatch.setattr(sys, "unraisablehook", dropped.append)
+    with pytest.raises(Interrupted) as info, handle_signals():
+        sys.unraisablehook(types.SimpleNamespace(exc_value=ValueError("another")))
+        _jit.call(sort_signalled, signum)
+    assert info.value.signum == signum
+    assert [type(d.exc_value).__name__ for d in dropped] == ["ValueError"]
+    assert sys.unraisablehook == dropped.append  # restored
+
+
+def test_a_signal_dropped_then_another_error_leaves_as_the_signal(monkeypatch):
+    """numba's case: the dropped exception leaves the compile without its machine code, and the
+    compile fails later (RuntimeError): the block reports the signal, not that failure."""
+    monkeypatch.setattr(sys, "unraisablehook", lambda hook: None)
+    with pytest.raises(Interrupted) as info, handle_signals():
+        values, calls = sort_signalled(signal.SIGINT)
+        assert calls > 64
+        assert values == sorted(values)  # the C code went on after the dropped exception
+        raise RuntimeError("no compiled object yet")
+    assert info.value.signum == signal.SIGINT
+
+
+def test_without_a_signal_errors_and_calls_pass_unchanged(monkeypatch):
+    """No signal: an error leaves the block as itself; a call returns its value; a signal of an
+    earlier block is forgotten."""
+    monkeypatch.setattr(sys, "unraisablehook", lambda hook: None)
+    with pytest.raises(Interrupted), handle_signals():
+        sort_signalled(signal.SIGINT)
+        raise RuntimeError
+    with pytest.raises(RuntimeError, match="its own"), handle_signals():
+        raise RuntimeError("its own")
+    with handle_signals():
+        assert _jit.call(max, 2, 3) == 3

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from rollingtop import _kernel_cache
+from rollingtop import _kernel_cache, _signals
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -312,10 +312,14 @@ def call(func: Callable[..., R], *args: Any) -> R:
     compile without trying to save. Repeating the call without that cost one more compilation of
     the caller per cached function of the chain (minutes). The failure is reported once, as a
     :class:`CacheNotSaved` warning.
+
+    A SIGINT or SIGTERM whose exception was lost inside the call (numba's compiler runs Python
+    callbacks from C, which drop exceptions) is raised once it returns
+    (:func:`rollingtop._signals.raise_lost`).
     """
     for _ in range(MAX_SAVE_FAILURES):
         try:
-            return func(*args)
+            result = func(*args)
         except OSError as exc:
             if not _from_numba_cache(exc):
                 raise
@@ -330,4 +334,9 @@ def call(func: Callable[..., R], *args: Any) -> R:
                     ),
                     stacklevel=2,
                 )
-    return func(*args)
+        else:
+            _signals.raise_lost()
+            return result
+    result = func(*args)
+    _signals.raise_lost()
+    return result

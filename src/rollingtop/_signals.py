@@ -12,20 +12,32 @@ Inside the block the handler raises :class:`Signalled`, a ``BaseException`` that
 reason is click: its ``main`` catches every ``KeyboardInterrupt`` raised by a command, writes an
 empty line to stderr and raises ``Abort`` instead, which would lose the signal's number (exit
 130 for SIGTERM too) and add a line to the one-line error report.
+
+A handler's exception can be lost: where the signal arrives while Python runs a callback of C
+code (numba's compiler is called back by LLVM when it has emitted a module's machine code),
+``ctypes`` prints the exception and drops it, and the C code goes on. numba then fails later
+(``RuntimeError: no compiled object yet``) or, with its cache off, finishes the compile and
+the run goes on as though no signal had come. So the handler also records the signal: the block
+turns any exception that leaves it after a signal into :class:`Interrupted`, and
+:func:`raise_lost` (called after each compiled call, :func:`rollingtop._jit.call`) raises a
+signal whose exception was dropped. The block's ``sys.unraisablehook`` keeps a dropped
+:class:`Signalled` quiet (its traceback is not the one-line report); others pass to the hook
+it replaced.
 """
 
 from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from types import FrameType
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from rollingtop._errors import Interrupted
 
-__all__ = ["Signalled", "handle_signals"]
+__all__ = ["Signalled", "handle_signals", "raise_lost"]
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
@@ -40,8 +52,32 @@ class Signalled(BaseException):
         self.signum = int(signum)
 
 
+#: The signals received inside the current block, in order (main thread only).
+_received: list[int] = []
+
+
 def _raise(signum: int, frame: FrameType | None) -> NoReturn:
+    _received.append(int(signum))
     raise Signalled(signum)
+
+
+def _quiet_dropped(previous: Any) -> Callable[[Any], None]:
+    """An unraisable hook that drops :class:`Signalled` (recorded by the handler already) and
+    hands any other exception to ``previous``."""
+
+    def hook(unraisable: Any) -> None:
+        if not isinstance(unraisable.exc_value, Signalled):
+            previous(unraisable)
+
+    return hook
+
+
+def raise_lost() -> None:
+    """Raise :class:`Signalled` for the first signal received in the current block, where a
+    call returned normally since: the handler's exception was lost on the way (see the module
+    docstring). Nothing outside a block or where no signal came."""
+    if _received:
+        raise Signalled(_received[0])
 
 
 @contextlib.contextmanager
@@ -53,10 +89,19 @@ def handle_signals() -> Iterator[None]:
         yield
         return
     previous = {sig: signal.signal(sig, _raise) for sig in SIGNALS}
+    unraisable = sys.unraisablehook
+    sys.unraisablehook = _quiet_dropped(unraisable)
+    _received.clear()
     try:
         yield
     except Signalled as exc:
         raise Interrupted(exc.signum) from None
+    except BaseException:
+        if _received:  # the signal's exception was lost and another followed (a RuntimeError)
+            raise Interrupted(_received[0]) from None
+        raise
     finally:
+        _received.clear()
+        sys.unraisablehook = unraisable
         for sig, handler in previous.items():
             signal.signal(sig, handler)
