@@ -26,6 +26,28 @@ FREE = {
     "rubber": {},
 }
 
+#: The start of a script run with ``python -c``: numba's compile events are listened to, and
+#: the functions this process compiles are listed in ``compiled`` (module.qualname), for the
+#: script to print.
+COMPILE_LISTENER = r"""
+import json, sys
+from numba.core import event
+
+compiled = []
+
+
+class Count(event.Listener):
+    def on_start(self, ev):
+        func = getattr(ev.data.get("dispatcher"), "py_func", None)
+        compiled.append(f"{func.__module__}.{func.__qualname__}")
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Count())
+"""
+
 
 #: Default of ``--fuzz-budget``: keeps test_fuzz.py's click-driven section near a minute on 2 cores.
 FUZZ_BUDGET = 6

@@ -20,28 +20,14 @@ import pytest
 from rollingtop import _compiled, _kernel_cache
 from rollingtop._compiled import _instances
 
-from .conftest import ROOT
+from .conftest import COMPILE_LISTENER, ROOT
 
 SRC = ROOT / "src"
 #: The smooth model's state and step of examples/smooth.toml, by hand (no scenario parsing).
-SCRIPT = r"""
-import json, sys
+SCRIPT = (
+    COMPILE_LISTENER
+    + r"""
 import numpy as np
-from numba.core import event
-
-compiled = []
-
-
-class Count(event.Listener):
-    def on_start(self, ev):
-        func = getattr(ev.data.get("dispatcher"), "py_func", None)
-        compiled.append(f"{func.__module__}.{func.__qualname__}")
-
-    def on_end(self, ev):
-        pass
-
-
-event.register("numba:compile", Count())
 from rollingtop import SphericalTop, initial_state
 from rollingtop._compiled import for_model
 from rollingtop._compiled._kernel import new_workspace
@@ -66,6 +52,7 @@ else:
 out["compiled"] = compiled
 print(json.dumps(out))
 """
+)
 
 
 def _copy_tree(tmp_path: Path) -> Path:

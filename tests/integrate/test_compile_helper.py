@@ -17,26 +17,12 @@ import pytest
 
 from rollingtop.integrate._compile_helper import ENV
 
-from ..conftest import EXAMPLES, ROOT
+from ..conftest import COMPILE_LISTENER, EXAMPLES, ROOT
 
 #: The simulate command under a listener of numba's compile events: what this process compiled.
-COUNTED = r"""
-import json, sys
-from numba.core import event
-
-compiled = []
-
-
-class Count(event.Listener):
-    def on_start(self, ev):
-        func = getattr(ev.data.get("dispatcher"), "py_func", None)
-        compiled.append(f"{func.__module__}.{func.__qualname__}")
-
-    def on_end(self, ev):
-        pass
-
-
-event.register("numba:compile", Count())
+COUNTED = (
+    COMPILE_LISTENER
+    + r"""
 from rollingtop.cli import main
 
 try:
@@ -45,6 +31,7 @@ except SystemExit:
     pass
 print(json.dumps(compiled), file=sys.stderr)
 """
+)
 
 
 def simulate(cache, helper, *args):
