@@ -151,12 +151,22 @@ def test_a_signal_dropped_then_another_error_leaves_as_the_signal(monkeypatch):
     """numba's case: the dropped exception leaves the compile without its machine code, and the
     compile fails later (RuntimeError): the block reports the signal, not that failure."""
     monkeypatch.setattr(sys, "unraisablehook", lambda hook: None)
-    with pytest.raises(Interrupted) as info, handle_signals():
+
+    def compile_without_its_object():
         values, calls = sort_signalled(signal.SIGINT)
         assert calls > 64
         assert values == sorted(values)  # the C code went on after the dropped exception
         raise RuntimeError("no compiled object yet")
+
+    cleaned = []
+    with pytest.raises(Interrupted) as info, handle_signals():
+        try:
+            _jit.call(compile_without_its_object)
+        finally:  # cleanup that calls compiled code runs to its end
+            cleaned.append(_jit.call(max, 2, 3))
+            cleaned.append(True)
     assert info.value.signum == signal.SIGINT
+    assert cleaned == [3, True]
 
 
 def test_without_a_signal_errors_and_calls_pass_unchanged(monkeypatch):

@@ -317,9 +317,20 @@ def call(func: Callable[..., R], *args: Any) -> R:
     callbacks from C, which drop exceptions) is raised once it returns
     (:func:`rollingtop._signals.raise_lost`).
     """
+    try:
+        result = _call_saving(func, *args)
+    except BaseException:
+        _signals.forget_lost()  # an exception is on its way: the block reports the signal
+        raise
+    _signals.raise_lost()
+    return result
+
+
+def _call_saving(func: Callable[..., R], *args: Any) -> R:
+    """:func:`call` without its check for a lost signal."""
     for _ in range(MAX_SAVE_FAILURES):
         try:
-            result = func(*args)
+            return func(*args)
         except OSError as exc:
             if not _from_numba_cache(exc):
                 raise
@@ -332,11 +343,6 @@ def call(func: Callable[..., R], *args: Any) -> R:
                         f"compiled kernels not saved to {where} ({exc.strerror or exc}): they "
                         "are compiled again in every run until it can be written"
                     ),
-                    stacklevel=2,
+                    stacklevel=3,
                 )
-        else:
-            _signals.raise_lost()
-            return result
-    result = func(*args)
-    _signals.raise_lost()
-    return result
+    return func(*args)

@@ -17,12 +17,12 @@ A handler's exception can be lost: where the signal arrives while Python runs a 
 code (numba's compiler is called back by LLVM when it has emitted a module's machine code),
 ``ctypes`` prints the exception and drops it, and the C code goes on. numba then fails later
 (``RuntimeError: no compiled object yet``) or, with its cache off, finishes the compile and
-the run goes on as though no signal had come. So the handler also records the signal: the block
-turns any exception that leaves it after a signal into :class:`Interrupted`, and
-:func:`raise_lost` (called after each compiled call, :func:`rollingtop._jit.call`) raises a
-signal whose exception was dropped. The block's ``sys.unraisablehook`` keeps a dropped
-:class:`Signalled` quiet (its traceback is not the one-line report); others pass to the hook
-it replaced.
+the run goes on as though no signal had come. So the handler also records the signal, and the
+block turns any exception that leaves it after a signal into :class:`Interrupted`. The block's
+``sys.unraisablehook`` (where a dropped exception goes) records a dropped :class:`Signalled`
+and keeps it quiet (its traceback is not the one-line report; others pass to the hook it
+replaced), and :func:`raise_lost` (called after each compiled call,
+:func:`rollingtop._jit.call`) raises it once.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from typing import Any, NoReturn
 
 from rollingtop._errors import Interrupted
 
-__all__ = ["Signalled", "handle_signals", "raise_lost"]
+__all__ = ["Signalled", "forget_lost", "handle_signals", "raise_lost"]
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
@@ -54,6 +54,8 @@ class Signalled(BaseException):
 
 #: The signals received inside the current block, in order (main thread only).
 _received: list[int] = []
+#: Those whose :class:`Signalled` was dropped in a callback and not raised again since.
+_lost: list[int] = []
 
 
 def _raise(signum: int, frame: FrameType | None) -> NoReturn:
@@ -62,22 +64,33 @@ def _raise(signum: int, frame: FrameType | None) -> NoReturn:
 
 
 def _quiet_dropped(previous: Any) -> Callable[[Any], None]:
-    """An unraisable hook that drops :class:`Signalled` (recorded by the handler already) and
-    hands any other exception to ``previous``."""
+    """An unraisable hook that records a dropped :class:`Signalled` for :func:`raise_lost`
+    and hands any other exception to ``previous``."""
 
     def hook(unraisable: Any) -> None:
-        if not isinstance(unraisable.exc_value, Signalled):
+        if isinstance(unraisable.exc_value, Signalled):
+            _lost.append(unraisable.exc_value.signum)
+        else:
             previous(unraisable)
 
     return hook
 
 
 def raise_lost() -> None:
-    """Raise :class:`Signalled` for the first signal received in the current block, where a
-    call returned normally since: the handler's exception was lost on the way (see the module
-    docstring). Nothing outside a block or where no signal came."""
-    if _received:
-        raise Signalled(_received[0])
+    """Raise :class:`Signalled` again for the first signal of the current block whose exception
+    was dropped in a callback (see the module docstring), once; nothing where none was (outside
+    a block, no signal, or one forgotten by :func:`forget_lost` because an exception followed:
+    cleanup that calls compiled code in ``finally`` then runs on)."""
+    if _lost:
+        signum = _lost[0]
+        _lost.clear()
+        raise Signalled(signum)
+
+
+def forget_lost() -> None:
+    """Forget the dropped signals of the block: an exception that followed is on its way out,
+    and the block reports the signal in its place."""
+    _lost.clear()
 
 
 @contextlib.contextmanager
@@ -92,6 +105,7 @@ def handle_signals() -> Iterator[None]:
     unraisable = sys.unraisablehook
     sys.unraisablehook = _quiet_dropped(unraisable)
     _received.clear()
+    _lost.clear()
     try:
         yield
     except Signalled as exc:
@@ -102,6 +116,7 @@ def handle_signals() -> Iterator[None]:
         raise
     finally:
         _received.clear()
+        _lost.clear()
         sys.unraisablehook = unraisable
         for sig, handler in previous.items():
             signal.signal(sig, handler)
