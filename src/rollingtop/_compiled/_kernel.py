@@ -1,10 +1,12 @@
-"""The model-independent pieces of the compiled dynamics: work arrays, the contact force, and
-the small Cholesky solve of the general path.
+"""The model-independent pieces of the compiled dynamics: work arrays, the contact force, the
+small Cholesky solve of the general path, the frame's kinematics.
 
 Everything that depends on a contact model -- the right-hand side, the projection, the
 diagnostics -- is compiled per model (:mod:`rollingtop._compiled`, from the template
 :mod:`rollingtop._compiled._template.dynamics`, where the equations are written out); these
-helpers are shared by every model and cached once.
+helpers are shared by every model and cached once (a model's compile pays only for what is its
+own: the frame's rates, written in the template before, cost each compiled package about
+0.15 s of typing and lowering).
 """
 
 from __future__ import annotations
@@ -17,7 +19,13 @@ from rollingtop._jit import compiled, inline, kernel
 from rollingtop._layout import MAX_ROWS
 from rollingtop._types import FloatArray, Workspace
 
-__all__ = ["new_workspace", "reaction", "solve_spd", "workspace"]
+__all__ = [
+    "frame_rates",
+    "new_workspace",
+    "reaction",
+    "solve_spd",
+    "workspace",
+]
 
 
 def workspace() -> Workspace:
@@ -80,3 +88,18 @@ def reaction(nc: int, y: FloatArray, ws: Workspace) -> tuple[float, float]:
     N = F1 * g1 + F2 * g2 + F3 * g3
     t1, t2, t3 = F1 - N * g1, F2 - N * g2, F3 - N * g3
     return N, math.sqrt(t1 * t1 + t2 * t2 + t3 * t3)
+
+
+@inline
+def frame_rates(y: FloatArray, dy: FloatArray) -> None:
+    """The kinematics of every model (eq. 2.1) into ``dy``: ``alpha' = alpha x w``,
+    ``beta' = beta x w``, ``gamma' = gamma x w`` (slots 6..14), ``X' = (v, alpha)``,
+    ``Y' = (v, beta)`` (15, 16); slot 17 is the model's (shape ``(18,)`` each)."""
+    w1, w2, w3 = y[3], y[4], y[5]
+    for base in (6, 9, 12):
+        e1, e2, e3 = y[base], y[base + 1], y[base + 2]
+        dy[base] = e2 * w3 - e3 * w2
+        dy[base + 1] = e3 * w1 - e1 * w3
+        dy[base + 2] = e1 * w2 - e2 * w1
+    dy[15] = y[0] * y[6] + y[1] * y[7] + y[2] * y[8]
+    dy[16] = y[0] * y[9] + y[1] * y[10] + y[2] * y[11]

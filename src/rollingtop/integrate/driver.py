@@ -17,7 +17,7 @@ from rollingtop._compiled import compiling, for_code, packages_of
 from rollingtop._compiled._dop853_dense import dense_eval
 from rollingtop._compiled._dop853_stages import dense_stage, scaled_errors, step_stage
 from rollingtop._compiled._events import EVENTS, NONE
-from rollingtop._compiled._kernel import reaction, workspace
+from rollingtop._compiled._kernel import frame_rates, reaction, workspace
 from rollingtop._errors import IntegrationError, NotFiniteAtStart
 from rollingtop._jit import call
 from rollingtop._layout import N_PARAMS, N_STATE, WARMUP_PARAMS
@@ -197,8 +197,8 @@ def _helped(warm: _Warmup) -> bool:
 
 def compile_shared() -> None:
     """Compile (or load) the pieces of the stepper's loop that every model shares, for the
-    loop's argument types: the stage sums, error estimates, dense output and reaction
-    tracking (compiled once per cache, loaded in milliseconds after)."""
+    loop's argument types: the stage sums, error estimates, dense output, reaction tracking
+    and the frame's kinematics (compiled once per cache, loaded in milliseconds after)."""
     w = work_arrays()
     K, Fd, ws, y, t, x = w["K"], w["Fd"], w["ws"], w["ynew"], 0.0, 0.5
     track = np.zeros(dop.N_TRACK)
@@ -208,6 +208,7 @@ def compile_shared() -> None:
         (scaled_errors, (K, y, y, x, x, y, y)),
         (dense_eval, (Fd, y, x, y)),
         (reaction, (1, y, ws)),
+        (frame_rates, (y, y)),
         (dop.reset_track, (track,)),
         (dop.update_track, (track, t, x, x)),
         (dop.dip_predicted, (t, x, t, x, t, x)),

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rollingtop._compiled._kernel import new_workspace, reaction, solve_spd
+from rollingtop._compiled._kernel import frame_rates, new_workspace, reaction, solve_spd
 from rollingtop._compiled._template import _dispatch
 from rollingtop._compiled._template._dispatch import CLOSED_ACCEL, CLOSED_PROJECTION
 from rollingtop._compiled._template._dispatch import rows as constraint_rows
@@ -54,14 +54,7 @@ __all__ = [
 
 @inline
 def _kinematics(code: int, p: FloatArray, y: FloatArray, dy: FloatArray) -> None:
-    w1, w2, w3 = y[3], y[4], y[5]
-    for base in (6, 9, 12):
-        e1, e2, e3 = y[base], y[base + 1], y[base + 2]
-        dy[base] = e2 * w3 - e3 * w2
-        dy[base + 1] = e3 * w1 - e1 * w3
-        dy[base + 2] = e1 * w2 - e2 * w1
-    dy[15] = y[0] * y[6] + y[1] * y[7] + y[2] * y[8]
-    dy[16] = y[0] * y[9] + y[1] * y[10] + y[2] * y[11]
+    frame_rates(y, dy)  # the model's own part: the rate of its last slot
     dy[17] = _dispatch.direction_rate(code, p, y)
 
 
@@ -138,6 +131,9 @@ def project(code: int, p: FloatArray, y: FloatArray, ws: Workspace) -> None:
     re-synchronised with the axis azimuth (see :mod:`rollingtop.contact.meridian`). The
     velocity ``u`` then goes to the nearest point, in the kinetic-energy metric, of ``J u = 0``:
     ``u <- u - M^-1 J^T (J M^-1 J^T)^-1 J u``.
+
+    The steps stay written here, not in a shared helper: compiled apart, LLVM fuses their
+    multiply-adds otherwise, and the C limit (``benchmarks/c_limit/dop853.c``) mirrors these.
     """
     for _ in range(FRAME_ITERATIONS):
         # Q Q^T (rows alpha, beta, gamma at offsets 6, 9, 12)
