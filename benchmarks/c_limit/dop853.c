@@ -7,20 +7,21 @@
  * so that the run takes the same accepted and rejected steps and, on a CPU with FMA, ends in the
  * same state to the last bit:
  *
- *   - tableau, stages, error estimates: src/rollingtop/integrate/_dop853_tableau.py and the
+ *   - tableau, stages, error estimates: src/rollingtop/_compiled/_dop853_tableau.py and the
  *     generated _dop853_stages.py (stage, scaled_errors), coefficients printed to full precision;
  *   - step-size controller, initial step, FSAL, final step cut to hit t_end exactly, status codes:
- *     integrate/_dop853.py (initial_step, start, run);
+ *     _compiled/_dop853.py and _compiled/_template/stepper.py (initial_step, start, run_rows);
  *   - dense output at the sample times (stages 14-16, 7th-order interpolant), each sample
  *     projected; the first loss of contact located by bisection on it: _dop853_dense.py;
  *   - closed-form right-hand side: contact/meridian.py (nu_geometric, accel) ->
  *     contact/_closed.py (rhs_contact) with the helpers of contact/_rows.py, kinematics of
- *     dynamics/_kernel.py (_kinematics);
- *   - projection after every accepted step: dynamics/_kernel.py (project: one Newton-Schulz step of
- *     the frame, then meridian sync_direction, then the closed-form project_velocity);
+ *     _compiled/_template/dynamics.py (_kinematics, with _compiled/_kernel.py frame_rates);
+ *   - projection after every accepted step: _compiled/_template/dynamics.py (project:
+ *     Newton-Schulz steps of the frame, then meridian sync_direction, then the closed-form
+ *     project_velocity);
  *   - reaction monitoring after every accepted step: _kernel.reaction and _dop853.update_track.
  *
- * Events are omitted. The state has the layout of dynamics/_layout.py:
+ * Events are omitted. The state has the layout of src/rollingtop/_layout.py:
  * y = (v[3], w[3], alpha[3], beta[3], gamma[3], X, Y, psi_nu); parameters p = (R, m, g, a3, I1,
  * I2, I3).
  *
@@ -47,7 +48,7 @@
 #define FMA(a, b, c) ((a) * (b) + (c))
 #endif
 
-/* status codes of integrate/_dop853.py */
+/* status codes of _compiled/_dop853.py */
 #define FINISHED 0
 #define STEP_TOO_SMALL (-1)
 #define NOT_FINITE (-2)
@@ -112,8 +113,9 @@ static inline void nu_geometric(const double *y, double *n1, double *n2, double 
 #define MASS_ENTRY(dd, x1, y1, x2, y2, x3, y3)                                                   \
     FMA((x3) * (y3), i3, FMA((x2) * (y2), i2, FMA((dd), im, (x1) * (y1) * i1)))
 
-/* dynamics/_kernel.py rhs for code 0: meridian accel (contact/_closed.py rhs_contact with the
- * row along the geometric nu) and _kinematics. Returns the number of rows, 2. */
+/* _compiled/_template/dynamics.py rhs for code 0: meridian accel (contact/_closed.py
+ * rhs_contact with the row along the geometric nu) and _kinematics. Returns the number of
+ * rows, 2. */
 static int rhs(const double *p, const double *y, double *dy, Reaction *ws)
 {
     double n1, n2, n3, nd1, nd2, nd3;
@@ -173,7 +175,7 @@ static int rhs(const double *p, const double *y, double *dy, Reaction *ws)
     ws->d1[2] = n3;
     ws->l1 = l1;
     ws->l2 = l2;
-    /* _kinematics */
+    /* _kinematics (_kernel.frame_rates, then the model's slot 17) */
     for (int base = 6; base <= 12; base += 3) {
         double e1 = y[base], e2 = y[base + 1], e3 = y[base + 2];
         dy[base] = FMA(e2, w3, -(e3 * w2));
@@ -186,7 +188,7 @@ static int rhs(const double *p, const double *y, double *dy, Reaction *ws)
     return 2;
 }
 
-/* dynamics/_kernel.py reaction: normal force N = (F, gamma) and |F - N gamma| */
+/* _compiled/_kernel.py reaction: normal force N = (F, gamma) and |F - N gamma| */
 static void reaction(const double *y, const Reaction *ws, double *N_out, double *T_out)
 {
     double F1 = FMA(ws->l2, ws->d1[0], FMA(ws->l1, ws->d0[0], 0.0));
@@ -199,9 +201,9 @@ static void reaction(const double *y, const Reaction *ws, double *N_out, double 
     *T_out = sqrt(FMA(t3, t3, FMA(t1, t1, t2 * t2)));
 }
 
-/* dynamics/_kernel.py project (code 0): Newton-Schulz steps of the frame, psi_nu synchronised with
- * the axis azimuth (contact/_rows.py sync_direction), closed-form velocity projection
- * (contact/_closed.py project_contact with the geometric nu). */
+/* _compiled/_template/dynamics.py project (code 0): Newton-Schulz steps of the frame, psi_nu
+ * synchronised with the axis azimuth (contact/_rows.py sync_direction), closed-form velocity
+ * projection (contact/_closed.py project_contact with the geometric nu). */
 static void project(const double *p, double *y)
 {
     /* FRAME_ITERATIONS steps at most, until a step starts within FRAME_ONE_STEP */
@@ -260,7 +262,7 @@ static void project(const double *p, double *y)
     y[5] = FMA(-FMA(l1, a3_, l2 * b3), i3, w3);
 }
 
-/* integrate/_dop853.py update_track */
+/* _compiled/_dop853.py update_track */
 static void update_track(double *track, double t, double N_, double T_force)
 {
     if (N_ < track[MIN_NORMAL]) {

@@ -54,8 +54,8 @@ __all__ = [
 
 @inline
 def _kinematics(code: int, p: FloatArray, y: FloatArray, dy: FloatArray) -> None:
-    frame_rates(y, dy)  # the model's own part: the rate of its last slot
-    dy[17] = _dispatch.direction_rate(code, p, y)
+    frame_rates(y, dy)  # shared by every model (slots 6..16)
+    dy[17] = _dispatch.direction_rate(code, p, y)  # the model's own slot
 
 
 @inline
