@@ -230,7 +230,8 @@ def inline(func: F) -> F:
     it is called: the caller's machine code is that of the function written out in place.
     numba's own inlining (``inline="always"``) gave the same code but ran the helper's front
     end, typing and lowering again at every call site, nested helpers once per path: 1.2 to
-    2.9 s of each model's 8 to 11 s first compile (``docs/development.md``, "Compile time").
+    2.9 s of each model's 8 to 11 s first compile (``docs/guide/development.md``, "Compiled
+    code and its cache").
     Like a :func:`kernel` it must not allocate."""
     return _make(func, INLINE_OPTIONS)
 

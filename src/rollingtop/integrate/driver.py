@@ -134,9 +134,8 @@ def _warmup_state() -> FloatArray:
 class _Warmup(NamedTuple):
     """What compiles a package's integrator (:func:`compile_code`, :func:`_warmup`)."""
 
-    #: Compiles (or loads) all but the stepper's loop: what the loop calls of the model's
-    #: (the dense output, the projection, the normal force's root and dips, the right-hand side)
-    #: and the samples' diagnostics (a helper's half).
+    #: Compiles (or loads) all but the stepper's loop: the right-hand side and the constraint
+    #: projection (which the loop calls) and the samples' diagnostics (a helper's half).
     rest: Callable[[], None]
     #: Runs the warm-up run (compiles the loop, loads the rest).
     loop: Callable[[], None]

@@ -294,8 +294,7 @@ def run_rows(
         atol = ctrl[ATOL]
         n_samples = t_eval.shape[0]
         status = RUNNING
-        end_t = t  # where ctrl[T] is left, with h_abs unless a step failed after it was accepted
-        keep_h = True
+        keep_h = True  # h_abs is left in ctrl unless a step failed after it was accepted
         for i in range(n):
             if not math.isfinite(y[i]) or not math.isfinite(f[i]):
                 status = NOT_FINITE
@@ -402,7 +401,7 @@ def run_rows(
                             counts[PROJ_DEFERRED] += 1
                     k += 1
                 if status != RUNNING:
-                    end_t, keep_h = t_new, False
+                    t, keep_h = t_new, False  # ctrl[T] is left at the step's end
                     break
                 counts[NEXT_SAMPLE] = k
             # Accept: project onto the constraints. The derivative at the new point is the last
@@ -417,7 +416,7 @@ def run_rows(
                 passes = project_integrals(code, p, y, icodes, targets, pw, ws)
                 if passes < 0:
                     status = PROJECTION_FAILED
-                    end_t, keep_h = t_new, False
+                    t, keep_h = t_new, False  # ctrl[T] is left at the step's end
                     break
                 counts[PROJ_PASSES] += passes
                 if pw[WORK_ROWS - 1, 7] > 0.0:
@@ -426,7 +425,7 @@ def run_rows(
                 if not math.isfinite(y[i]) or not math.isfinite(f[i]):
                     status = NOT_FINITE
             if status != RUNNING:
-                end_t, keep_h = t_new, False
+                t, keep_h = t_new, False  # ctrl[T] is left at the step's end
                 break
             if lost:
                 # first loss of contact: locate N = 0 inside the step on the dense output
@@ -468,8 +467,7 @@ def run_rows(
             t = t_new
             counts[STEPS] += 1
             taken += 1
+        ctrl[T] = t
         if keep_h:
-            end_t = t
             ctrl[H_ABS] = h_abs
-        ctrl[T] = end_t
         STATUS[row] = FINISHED if status == RUNNING else status
