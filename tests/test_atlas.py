@@ -37,8 +37,9 @@ SMALL = {"a3": [0.05, 0.2], "C2": {"start": -3.0, "stop": 0.0, "num": 4}, "C1": 
 def client():
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as c:  # fmt: skip
+    port = {"dashboard_address": "127.0.0.1:0"}  # the HTTP server on a free port (8787: warns)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
+                      scheduler_kwargs=port) as cluster, Client(cluster) as c:  # fmt: skip
         yield c
 
 
@@ -175,6 +176,45 @@ def test_cli_atlas_on_the_embedded_cluster(capsys, tmp_path, monkeypatch):
     with xr.open_dataset(out) as f:
         assert f["n_steady"].values.tolist() == [[3, 3], [1, 1]]
     assert list(temp.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_the_embedded_cluster_stays_quiet_until_its_close_has_ended(monkeypatch):
+    """A record Dask logs after ``LocalCluster``'s own ``silence_logs`` has ended (inside its
+    close, before its IO loop stops) does not reach Dask's handlers (CI: the scheduler's
+    "Batched Comm Closed" of a killed worker and its traceback, after a Ctrl-C); the handlers'
+    levels are restored afterwards."""
+    import logging
+
+    from distributed.deploy.spec import SpecCluster
+
+    from rollingtop.atlas._run import _client
+
+    class Records(logging.Handler):
+        def __init__(self) -> None:
+            super().__init__()
+            self.seen: list[str] = []
+
+        def emit(self, record: logging.LogRecord) -> None:
+            self.seen.append(record.getMessage())
+
+    close = SpecCluster._close
+
+    async def close_then_log(self, *args, **kwargs):
+        await close(self, *args, **kwargs)
+        logging.getLogger("distributed.batched").info("logged after the cluster's close")
+
+    monkeypatch.setattr(SpecCluster, "_close", close_then_log)
+    handler = Records()
+    logging.getLogger("distributed").addHandler(handler)
+    try:
+        with _client(None, 1, None, 10.0):
+            pass
+        assert handler.seen == [] and handler.level == logging.NOTSET
+        logging.getLogger("distributed.batched").info("logged after the run")
+        assert handler.seen == ["logged after the run"]
+    finally:
+        logging.getLogger("distributed").removeHandler(handler)
 
 
 @pytest.mark.parametrize(

@@ -101,8 +101,9 @@ def test_rotation_shows_progress_on_a_terminal(capsys, terminal):
 def client():
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as c:  # fmt: skip
+    port = {"dashboard_address": "127.0.0.1:0"}  # the HTTP server on a free port (8787: warns)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
+                      scheduler_kwargs=port) as cluster, Client(cluster) as c:  # fmt: skip
         yield c
 
 

@@ -202,8 +202,9 @@ def test_a_fresh_process_imports_a_models_kernels_by_name(tmp_path):
         return dynamics.__file__, dy.tolist()
 
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                                  dashboard_address=None,
-                                  local_directory=str(tmp_path)) as cluster:  # fmt: skip
+                                  dashboard_address=None, local_directory=str(tmp_path),
+                                  scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}
+                                  ) as cluster:  # fmt: skip
         with distributed.Client(cluster) as client:
             file, dy = client.submit(rhs_by_name, name).result(timeout=300)
     assert Path(file) == _instances.TEMPLATE / "dynamics.py"

@@ -160,8 +160,9 @@ def test_indicator_map_on_dask_equals_in_process(chaotic):
     body, model, y0 = chaotic
     states = level_states(body, model, y0, 5, seed=1)
     here = indicator_map(body, model, states, t_end=50.0, samples=2)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
+    port = {"dashboard_address": "127.0.0.1:0"}  # the HTTP server on a free port (8787: warns)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
+                      scheduler_kwargs=port) as cluster, Client(cluster) as client:  # fmt: skip
         there = indicator_map(body, model, states, t_end=50.0, samples=2, client=client)
     np.testing.assert_allclose(there["lyapunov"].values, here["lyapunov"].values, rtol=1e-7)
     np.testing.assert_allclose(there["megno"].values, here["megno"].values, rtol=1e-7)
