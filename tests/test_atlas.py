@@ -201,7 +201,10 @@ def test_the_embedded_cluster_stays_quiet_until_its_close_has_ended(monkeypatch)
         logging.getLogger("distributed.batched").info("logged after the cluster's close")
 
     monkeypatch.setattr(SpecCluster, "_close", close_then_log)
-    logging.getLogger("distributed").addHandler(handler)
+    logger = logging.getLogger("distributed")
+    level = logger.level
+    logger.setLevel(logging.INFO)  # Dask's default, whatever ran before
+    logger.addHandler(handler)
     try:
         with _client(None, 1, None, 10.0):
             pass
@@ -209,7 +212,8 @@ def test_the_embedded_cluster_stays_quiet_until_its_close_has_ended(monkeypatch)
         logging.getLogger("distributed.batched").info("logged after the run")
         assert seen.getvalue() == "logged after the run\n"
     finally:
-        logging.getLogger("distributed").removeHandler(handler)
+        logger.removeHandler(handler)
+        logger.setLevel(level)
 
 
 @pytest.mark.parametrize(
