@@ -26,6 +26,19 @@ FREE = {
     "rubber": {},
 }
 
+
+def local_cluster(n_workers: int, *, processes: bool = False, **options):
+    """A Dask ``LocalCluster`` for a test: one thread per worker, in this process unless
+    ``processes``, no dashboard, and the scheduler's HTTP server on a free port (on 8787, taken
+    by another test's cluster, Dask warns "Port 8787 is already in use"), as the atlas's own."""
+    from distributed import LocalCluster
+
+    return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=processes,
+                        dashboard_address=None,
+                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                        **options)  # fmt: skip
+
+
 #: The start of a script run with ``python -c``: numba's compile events are listened to, and
 #: the functions this process compiles are listed in ``compiled`` (module.qualname), for the
 #: script to print.

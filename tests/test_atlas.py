@@ -19,6 +19,7 @@ from rollingtop.atlas import (
 )
 from rollingtop.reduction import LevelSet, steady_motions
 
+from .conftest import local_cluster
 from .reduction.test_models import _mp_potential
 from .test_cli import run_cli
 
@@ -35,11 +36,9 @@ SMALL = {"a3": [0.05, 0.2], "C2": {"start": -3.0, "stop": 0.0, "num": 4}, "C1": 
 
 @pytest.fixture(scope="module")
 def client():
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
-    port = {"dashboard_address": "127.0.0.1:0"}  # the HTTP server on a free port (8787: warns)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
-                      scheduler_kwargs=port) as cluster, Client(cluster) as c:  # fmt: skip
+    with local_cluster(2) as cluster, Client(cluster) as c:
         yield c
 
 
@@ -541,13 +540,7 @@ def test_a_store_that_cannot_be_written_is_named_and_the_cells_are_kept(client, 
 
 def test_a_running_scheduler_passes_the_probe(tmp_path):
     """The probe of --scheduler accepts a real Dask scheduler (and the atlas runs on it)."""
-    from distributed import LocalCluster
-
     spec = atlas_spec_from_dict(spec_dict({"C2": [-2.0, 0.0]}))
-    # the scheduler's HTTP server on a free port, as the atlas's own cluster (on 8787, taken by
-    # another test's cluster, distributed warns)
-    free_port = {"dashboard_address": "127.0.0.1:0"}
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
-                      scheduler_kwargs=free_port) as cluster:  # fmt: skip
+    with local_cluster(1) as cluster:
         ds = atlas(spec, scheduler=cluster.scheduler_address, scheduler_timeout=5.0)
     assert ds["n_steady"].values.tolist() == [3, 1]

@@ -10,7 +10,7 @@ import json
 
 import pytest
 
-from .conftest import EXAMPLES
+from .conftest import EXAMPLES, local_cluster
 from .test_cli import run_cli
 
 FIG5 = str(EXAMPLES / "fig5.toml")
@@ -99,11 +99,9 @@ def test_rotation_shows_progress_on_a_terminal(capsys, terminal):
 
 @pytest.fixture(scope="module")
 def client():
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
-    port = {"dashboard_address": "127.0.0.1:0"}  # the HTTP server on a free port (8787: warns)
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
-                      scheduler_kwargs=port) as cluster, Client(cluster) as c:  # fmt: skip
+    with local_cluster(1) as cluster, Client(cluster) as c:
         yield c
 
 

@@ -20,7 +20,7 @@ import pytest
 from rollingtop import _compiled, _kernel_cache
 from rollingtop._compiled import _instances
 
-from .conftest import COMPILE_LISTENER, ROOT
+from .conftest import COMPILE_LISTENER, ROOT, local_cluster
 
 SRC = ROOT / "src"
 #: The smooth model's state and step of examples/smooth.toml, by hand (no scenario parsing).
@@ -201,10 +201,7 @@ def test_a_fresh_process_imports_a_models_kernels_by_name(tmp_path):
         call(dynamics.rhs, code, np.array(WARMUP_PARAMS), y, dy, call(new_workspace))
         return dynamics.__file__, dy.tolist()
 
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                                  dashboard_address=None, local_directory=str(tmp_path),
-                                  scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}
-                                  ) as cluster:  # fmt: skip
+    with local_cluster(1, processes=True, local_directory=str(tmp_path)) as cluster:
         with distributed.Client(cluster) as client:
             file, dy = client.submit(rhs_by_name, name).result(timeout=300)
     assert Path(file) == _instances.TEMPLATE / "dynamics.py"

@@ -18,7 +18,7 @@ from rollingtop.chaos.lyapunov import initial_tangent
 from rollingtop.dynamics.state import project_state
 from rollingtop.integrate import integrate
 
-from ..conftest import FREE, GAMMA0, OMEGA0, PAPER_BODY
+from ..conftest import FREE, GAMMA0, OMEGA0, PAPER_BODY, local_cluster
 
 PAPER = SphericalTop(**PAPER_BODY)
 #: Acceptance criteria (issue): on the integrable model at t = 1e4.
@@ -155,14 +155,12 @@ def test_chaos_indicators_refuse_bad_input(chaotic):
 
 def test_indicator_map_on_dask_equals_in_process(chaotic):
     """The same map on an embedded Dask cluster (chunks of states, one thread each)."""
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     body, model, y0 = chaotic
     states = level_states(body, model, y0, 5, seed=1)
     here = indicator_map(body, model, states, t_end=50.0, samples=2)
-    port = {"dashboard_address": "127.0.0.1:0"}  # the HTTP server on a free port (8787: warns)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
-                      scheduler_kwargs=port) as cluster, Client(cluster) as client:  # fmt: skip
+    with local_cluster(2) as cluster, Client(cluster) as client:
         there = indicator_map(body, model, states, t_end=50.0, samples=2, client=client)
     np.testing.assert_allclose(there["lyapunov"].values, here["lyapunov"].values, rtol=1e-7)
     np.testing.assert_allclose(there["megno"].values, here["megno"].values, rtol=1e-7)
